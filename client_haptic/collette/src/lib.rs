@@ -1,0 +1,1 @@
+//! collette (being built).

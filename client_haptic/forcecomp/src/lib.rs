@@ -1,0 +1,1 @@
+//! forcecomp (being built).

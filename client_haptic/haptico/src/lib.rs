@@ -1,0 +1,1 @@
+//! haptico (being built).

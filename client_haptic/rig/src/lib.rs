@@ -1,0 +1,1 @@
+//! haptic_rig (being built).

@@ -1,0 +1,1 @@
+//! heist_server (being built).

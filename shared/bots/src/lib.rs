@@ -1,0 +1,1 @@
+//! heist_bots (being built).

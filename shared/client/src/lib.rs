@@ -1,0 +1,1 @@
+//! heist_client (being built).

@@ -1,0 +1,1 @@
+//! heist_shared (being built).

@@ -1,0 +1,1 @@
+//! heist_tests (being built).
