@@ -122,6 +122,11 @@ impl<T: ?Sized + 'static> Delegator<T> {
         self.add_delegate(move |event: &T| method(&mut receiver, event))
     }
 
+    /// Reserves room for `additional` more delegates (allocates: call before the real-time thread starts).
+    pub fn reserve(&mut self, additional: usize) {
+        self.slots.reserve(additional);
+    }
+
     /// Binds a delegate boxed elsewhere; allocation-free while the reserved capacity lasts.
     /// Returns the delegate back when the capacity is exhausted, so the caller can free it off-thread.
     pub fn bind_boxed(&mut self, pending: PendingDelegate<T>) -> Result<(), PendingDelegate<T>> {
