@@ -32,13 +32,16 @@ pub struct Observed {
     pub size_m: [f32; 3],
 }
 
-/// Measures the feature count of a copy of `kind` from its mesh alone.
+/// Measures the feature count of a copy of `kind` from its mesh alone. The mesh may be moved and
+/// turned about the vertical (+y) axis; it must stand upright.
 pub fn analyze(kind: ArtifactKind, mesh: &HapticMesh) -> Observed {
     let (lo, hi) = mesh.bounds();
+    // The features are spread evenly around the axis, so the solid's centroid lies on it.
+    let axis = mesh.centroid();
     let profile = match kind {
-        ArtifactKind::Crown => rim_heights(mesh),
-        ArtifactKind::Amphora => radii_at(mesh, lo.y + 0.42 * (hi.y - lo.y)),
-        ArtifactKind::Idol => radii_at(mesh, lo.y + 0.35 * (hi.y - lo.y)),
+        ArtifactKind::Crown => rim_heights(mesh, axis),
+        ArtifactKind::Amphora => radii_at(mesh, axis, lo.y + 0.42 * (hi.y - lo.y)),
+        ArtifactKind::Idol => radii_at(mesh, axis, lo.y + 0.35 * (hi.y - lo.y)),
     };
     let (min, max) = profile.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
     let feature_size_m = if profile.is_empty() { 0.0 } else { max - min };
@@ -57,27 +60,29 @@ pub fn matches(briefing: &Briefing, observed: &Observed, material: &Material) ->
         && MaterialClass::nearest(material) == briefing.material
 }
 
-/// Height of the top surface just inside the outermost radius, around the axis, metres.
-fn rim_heights(mesh: &HapticMesh) -> Vec<f32> {
-    let r_max = mesh.vertices.iter().map(|p| p[0].hypot(p[2])).fold(0.0f32, f32::max);
+/// Height of the top surface just inside the outermost radius, around the vertical axis through
+/// `axis`, metres.
+fn rim_heights(mesh: &HapticMesh, axis: Vec3) -> Vec<f32> {
+    let radius = |p: Vec3| (p.x - axis.x).hypot(p.z - axis.z);
+    let r_max = mesh.vertices.iter().map(|p| radius(Vec3::from_array(*p))).fold(0.0f32, f32::max);
     let r = (r_max - 0.004).max(0.0);
     let (_, hi) = mesh.bounds();
     // Only triangles reaching out to the probe circle can be hit.
     let near: Vec<[Vec3; 3]> = (0..mesh.triangle_count())
         .map(|t| mesh.corners(t))
-        .filter(|c| c.iter().any(|p| p.x.hypot(p.z) >= r - 0.01))
+        .filter(|c| c.iter().any(|p| radius(*p) >= r - 0.01))
         .collect();
     probe_angles()
         .map(|phi| {
-            let origin = Vec3::new(r * phi.cos(), hi.y + 0.01, -r * phi.sin());
+            let origin = Vec3::new(axis.x + r * phi.cos(), hi.y + 0.01, axis.z - r * phi.sin());
             let t = near.iter().filter_map(|c| ray_hit(origin, Vec3::NEG_Y, c)).fold(f32::INFINITY, f32::min);
             if t.is_finite() { origin.y - t } else { hi.y - 1.0 }
         })
         .collect()
 }
 
-/// Outermost surface radius at height `y` around the axis, metres.
-fn radii_at(mesh: &HapticMesh, y: f32) -> Vec<f32> {
+/// Outermost surface radius at height `y` around the vertical axis through `axis`, metres.
+fn radii_at(mesh: &HapticMesh, axis: Vec3, y: f32) -> Vec<f32> {
     let near: Vec<[Vec3; 3]> = (0..mesh.triangle_count())
         .map(|t| mesh.corners(t))
         .filter(|c| {
@@ -87,7 +92,7 @@ fn radii_at(mesh: &HapticMesh, y: f32) -> Vec<f32> {
         .collect();
     probe_angles()
         .map(|phi| {
-            let origin = Vec3::new(0.0, y, 0.0);
+            let origin = Vec3::new(axis.x, y, axis.z);
             let dir = Vec3::new(phi.cos(), 0.0, -phi.sin());
             near.iter().filter_map(|c| ray_hit(origin, dir, c)).fold(0.0, f32::max)
         })
@@ -170,6 +175,26 @@ mod tests {
     }
 
     #[test]
+    fn analysis_does_not_care_where_the_copy_stands_or_which_way_it_faces() {
+        for kind in ArtifactKind::ALL {
+            let n = *kind.feature_range().end();
+            let traits = CopyTraits { kind, feature_count: n, material: MaterialClass::SoftSmooth };
+            let mesh = build_mesh(&traits, 77);
+            let (sin, cos) = 0.7f32.sin_cos();
+            let moved = HapticMesh {
+                vertices: mesh
+                    .vertices
+                    .iter()
+                    .map(|p| [cos * p[0] + sin * p[2] + 0.4, p[1] + 0.9, -sin * p[0] + cos * p[2] - 1.3])
+                    .collect(),
+                triangles: mesh.triangles.clone(),
+            };
+            assert_eq!(moved.validate(), Ok(()));
+            assert_eq!(analyze(kind, &moved).feature_count, n, "{kind}");
+        }
+    }
+
+    #[test]
     fn features_measure_at_least_eight_millimetres() {
         for kind in ArtifactKind::ALL {
             for n in kind.feature_range() {
@@ -212,5 +237,22 @@ mod tests {
     #[test]
     fn an_empty_mesh_has_no_features() {
         assert_eq!(analyze(ArtifactKind::Amphora, &HapticMesh::default()).feature_count, 0);
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(48))]
+        #[test]
+        fn any_generated_copy_is_valid_and_analysed_exactly(kind_index in 0usize..3, seed: u64, build_seed: u64) {
+            let kind = ArtifactKind::ALL[kind_index];
+            let (copies, real) = generate_copies(kind, seed, 3);
+            let b = briefing(&copies[real]);
+            for (i, c) in copies.iter().enumerate() {
+                let mesh = build_mesh(c, build_seed.wrapping_add(i as u64));
+                proptest::prop_assert_eq!(mesh.validate(), Ok(()));
+                let observed = analyze(kind, &mesh);
+                proptest::prop_assert_eq!(observed.feature_count, c.feature_count);
+                proptest::prop_assert_eq!(matches(&b, &observed, &c.material.material()), i == real);
+            }
+        }
     }
 }

@@ -90,12 +90,36 @@ impl HapticMesh {
         // Summed in f64: thousands of small tetrahedra would lose digits in f32.
         let mut v = 0.0f64;
         for t in &self.triangles {
-            let [a, b, c] = t.map(|i| {
-                self.vertices.get(i as usize).map_or(glam::DVec3::ZERO, |p| Vec3::from_array(*p).as_dvec3())
-            });
-            v += a.dot(b.cross(c));
+            if let Some([a, b, c]) = corners_checked(&self.vertices, t) {
+                v += a.dot(b.cross(c));
+            }
         }
         (v / 6.0) as f32
+    }
+
+    /// Centre of mass of the enclosed solid (uniform density), metres; the bounds' centre when the
+    /// mesh encloses no volume.
+    pub fn centroid(&self) -> Vec3 {
+        let mut weighted = glam::DVec3::ZERO;
+        let mut volume = 0.0f64;
+        for t in &self.triangles {
+            let Some([a, b, c]) = corners_checked(&self.vertices, t) else { continue };
+            let v = a.dot(b.cross(c));
+            weighted += (a + b + c) * v / 4.0;
+            volume += v;
+        }
+        if volume.abs() > 1e-15 && weighted.is_finite() {
+            (weighted / volume).as_vec3()
+        } else {
+            let (lo, hi) = self.bounds();
+            (lo + hi) * 0.5
+        }
+    }
+
+    /// The same mesh moved by `offset`, metres (e.g. into the workbench frame).
+    pub fn translated(&self, offset: Vec3) -> HapticMesh {
+        let vertices = self.vertices.iter().map(|p| (Vec3::from_array(*p) + offset).to_array()).collect();
+        HapticMesh { vertices, triangles: self.triangles.clone() }
     }
 
     /// Axis-aligned bounds (min, max), metres; zeros for an empty mesh.
@@ -152,6 +176,12 @@ impl HapticMesh {
     }
 }
 
+/// The corners of `t` in f64, or `None` if an index is out of range.
+fn corners_checked(vertices: &[[f32; 3]], t: &[u32; 3]) -> Option<[glam::DVec3; 3]> {
+    let p = |i: u32| vertices.get(i as usize).map(|p| Vec3::from_array(*p).as_dvec3());
+    Some([p(t[0])?, p(t[1])?, p(t[2])?])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -169,6 +199,15 @@ mod tests {
         assert_eq!(m.validate(), Ok(()));
         assert!((m.signed_volume() - 0.001 / 6.0).abs() < 1e-9);
         assert_eq!(m.triangle_count(), 4);
+    }
+
+    #[test]
+    fn the_centroid_follows_a_translation() {
+        let m = tetrahedron();
+        assert!((m.centroid() - Vec3::splat(0.025)).length() < 1e-6);
+        let moved = m.translated(Vec3::new(1.0, 2.0, -3.0));
+        assert!((moved.centroid() - Vec3::new(1.025, 2.025, -2.975)).length() < 1e-5);
+        assert_eq!(moved.validate(), Ok(()));
     }
 
     #[test]

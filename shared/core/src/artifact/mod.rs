@@ -21,3 +21,24 @@ pub use generate::{MIN_COPIES, generate_copies};
 pub use kind::{ArtifactKind, ArtifactLook, CopyTraits, Material, MaterialClass, look};
 pub use mesh::{HapticMesh, MIN_TRIANGLE_AREA_M2, MeshError};
 pub use shapes::{AMPHORA_RIDGE_HEIGHT_M, CROWN_POINT_HEIGHT_M, IDOL_NOTCH_DEPTH_M, IDOL_NOTCH_WIDTH_M, build_mesh};
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn artifact_data_survives_a_round_trip_through_the_wire_format() {
+        let (copies, real) = generate_copies(ArtifactKind::Amphora, 11, 3);
+        let mesh = build_mesh(&copies[0], 11);
+        let bytes = postcard::to_allocvec(&(&mesh, copies[0].material.material())).expect("encodes");
+        assert!(bytes.len() < 64 * 1024, "a workbench mesh is {} bytes", bytes.len());
+        let back: (HapticMesh, Material) = postcard::from_bytes(&bytes).expect("decodes");
+        assert_eq!(back, (mesh, copies[0].material.material()));
+        let b = briefing(&copies[real]);
+        let back: Briefing = postcard::from_bytes(&postcard::to_allocvec(&b).expect("encodes")).expect("decodes");
+        assert_eq!(back, b);
+        let l = look(ArtifactKind::Amphora);
+        let back: ArtifactLook = postcard::from_bytes(&postcard::to_allocvec(&l).expect("encodes")).expect("decodes");
+        assert_eq!(back, l);
+    }
+}
