@@ -1,0 +1,150 @@
+//! Building an Inner Sphere Tree from a mesh: voxel distance field, greedy sphere packing, hierarchy.
+//!
+//! You need this module to turn a closed mesh into an [`InnerSphereTree`] (or use the `collette build`
+//! command, which calls [`build`] and saves the result).
+
+mod distance_field;
+mod greedy;
+
+pub use distance_field::{DistanceField, to_parry};
+
+use crate::error::BuildError;
+use crate::partitioning::InnerSphereTree;
+use crate::shape::TriMesh;
+use std::time::Instant;
+
+/// Options of the builder. With neither target set, packs [`BuildOptions::DEFAULT_SPHERES`] spheres.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct BuildOptions {
+    /// Stop after this many spheres. Default: 10,000 when `target_coverage` is also unset.
+    pub target_spheres: Option<usize>,
+    /// Stop once packed volume / mesh volume reaches this fraction (0..1). Default: unset.
+    pub target_coverage: Option<f32>,
+    /// Never place a sphere smaller than this radius (mesh units). Default: a quarter voxel.
+    pub min_radius: Option<f32>,
+    /// Voxels along the longest side of the mesh's box. Default: chosen from the sphere target (see
+    /// [`BuildOptions::resolution`]).
+    pub grid_resolution: Option<usize>,
+}
+
+impl BuildOptions {
+    /// Sphere count used when no target is given.
+    pub const DEFAULT_SPHERES: usize = 10_000;
+
+    /// Options for a sphere-count target.
+    pub fn spheres(n: usize) -> Self {
+        Self { target_spheres: Some(n), ..Self::default() }
+    }
+
+    /// Options for a coverage target (0..1).
+    pub fn coverage(c: f32) -> Self {
+        Self { target_coverage: Some(c), ..Self::default() }
+    }
+
+    /// The grid resolution used: the explicit one, or one that grows with the cube root of the target.
+    pub fn resolution(&self) -> usize {
+        if let Some(r) = self.grid_resolution {
+            return r;
+        }
+        let n = match (self.target_spheres, self.target_coverage) {
+            (Some(n), _) => n,
+            (None, Some(c)) => (1000.0 * (1.0 / (1.0 - c.clamp(0.0, 0.99) as f64)).powf(2.0)) as usize,
+            (None, None) => Self::DEFAULT_SPHERES,
+        };
+        ((n as f64).cbrt() * 7.0).clamp(48.0, 400.0) as usize
+    }
+}
+
+/// What a build produced.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BuildReport {
+    /// Spheres packed.
+    pub spheres: usize,
+    /// Packed volume / exact mesh volume.
+    pub coverage: f64,
+    /// Exact mesh volume (mesh units³).
+    pub mesh_volume: f64,
+    /// Summed sphere volume.
+    pub packed_volume: f64,
+    /// Wall-clock build time in seconds (distance field + packing + hierarchy).
+    pub build_seconds: f64,
+    /// Voxels along the longest side.
+    pub grid_resolution: usize,
+    /// Voxel centres found inside the mesh.
+    pub interior_voxels: usize,
+}
+
+/// Build stages reported to the progress callback.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BuildProgress {
+    /// The distance field is being computed.
+    DistanceField,
+    /// `placed` spheres are packed so far, covering `coverage` of the mesh; `target` is the sphere cap.
+    Packing {
+        /// Spheres placed.
+        placed: usize,
+        /// Sphere cap (usize::MAX when only a coverage target is set).
+        target: usize,
+        /// Coverage reached so far.
+        coverage: f64,
+    },
+    /// The hierarchy is being built.
+    Hierarchy,
+}
+
+/// Builds the tree of `mesh`; `progress` is called from this thread as the build advances.
+///
+/// Deterministic: the same mesh and options give the same tree, whatever the thread count.
+pub fn build(
+    mesh: &TriMesh,
+    options: &BuildOptions,
+    progress: &mut dyn FnMut(BuildProgress),
+) -> Result<(InnerSphereTree, BuildReport), BuildError> {
+    let start = Instant::now();
+    let resolution = options.resolution();
+    if !(2..=2048).contains(&resolution) {
+        return Err(BuildError::InvalidOption(format!("grid resolution {resolution} is outside 2..=2048")));
+    }
+    if let Some(c) = options.target_coverage {
+        if !(c > 0.0 && c <= 1.0) {
+            return Err(BuildError::InvalidOption(format!("target coverage {c} is outside (0, 1]")));
+        }
+    }
+    if options.target_spheres == Some(0) {
+        return Err(BuildError::InvalidOption("target sphere count is 0".into()));
+    }
+    let max_spheres = match (options.target_spheres, options.target_coverage) {
+        (Some(n), _) => n,
+        (None, Some(_)) => usize::MAX,
+        (None, None) => BuildOptions::DEFAULT_SPHERES,
+    };
+    let mesh_volume = mesh.volume() as f64;
+    progress(BuildProgress::DistanceField);
+    let field = DistanceField::new(mesh, resolution);
+    let interior_voxels = field.interior_count();
+    if interior_voxels == 0 {
+        return Err(BuildError::NoInteriorVoxel);
+    }
+    let stop = greedy::StopRule {
+        max_spheres,
+        target_volume: options.target_coverage.map_or(f64::INFINITY, |c| c as f64 * mesh_volume),
+        min_radius: options.min_radius.unwrap_or(field.voxel_size * 0.25).max(f32::MIN_POSITIVE),
+    };
+    let spheres = greedy::pack(&field, stop, &mut |placed, packed| {
+        progress(BuildProgress::Packing { placed, target: max_spheres, coverage: packed / mesh_volume })
+    });
+    progress(BuildProgress::Hierarchy);
+    let packed_volume: f64 = spheres.iter().map(|s| s.volume() as f64).sum();
+    let count = spheres.len();
+    let tree = InnerSphereTree::from_spheres(spheres, mesh_volume as f32);
+    let report = BuildReport {
+        spheres: count,
+        coverage: packed_volume / mesh_volume,
+        mesh_volume,
+        packed_volume,
+        build_seconds: start.elapsed().as_secs_f64(),
+        grid_resolution: resolution,
+        interior_voxels,
+    };
+    Ok((tree, report))
+}

@@ -1,0 +1,98 @@
+//! The Inner Sphere Tree: packed leaf spheres under a wrapped hierarchy of bounding spheres.
+//!
+//! You need this module to inspect a tree (spheres, nodes, volumes); build one with
+//! [`crate::packing::build`] and query it with [`crate::query`]. Split by operation: `build` (top-down
+//! volume-weighted clustering), `traverse` (visiting nodes), `validate` (checking loaded trees).
+
+mod build;
+mod traverse;
+mod validate;
+
+pub use build::LEAF_SIZE;
+pub use traverse::for_each_leaf_in_sphere;
+
+use crate::shape::Sphere;
+
+/// One node of the hierarchy. Inner nodes point at `count` consecutive child nodes; leaves point at
+/// `count` consecutive spheres of [`InnerSphereTree::spheres`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Node {
+    /// Sphere enclosing every leaf sphere below this node (wrapped around the leaves, not the children).
+    pub bound: Sphere,
+    /// Summed volume of the leaf spheres below this node.
+    pub volume: f32,
+    /// Index of the first child node (inner) or first sphere (leaf).
+    pub first: u32,
+    /// Number of children (inner) or spheres (leaf).
+    pub count: u32,
+    /// True for a leaf node.
+    pub leaf: bool,
+}
+
+impl Node {
+    /// The index range of the node's children or spheres.
+    #[inline]
+    pub fn range(&self) -> std::ops::Range<usize> {
+        self.first as usize..(self.first + self.count) as usize
+    }
+}
+
+/// An Inner Sphere Tree: non-overlapping spheres inside one object, in the object's local frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InnerSphereTree {
+    pub(crate) spheres: Vec<Sphere>,
+    pub(crate) nodes: Vec<Node>,
+    pub(crate) mesh_volume: f32,
+}
+
+impl InnerSphereTree {
+    /// The packed spheres (leaves), in hierarchy order.
+    pub fn spheres(&self) -> &[Sphere] {
+        &self.spheres
+    }
+
+    /// The nodes; the root is `nodes()[0]`.
+    pub fn nodes(&self) -> &[Node] {
+        &self.nodes
+    }
+
+    /// The root node.
+    pub fn root(&self) -> &Node {
+        &self.nodes[0]
+    }
+
+    /// Exact volume of the mesh the tree was built from (mesh units³).
+    pub fn mesh_volume(&self) -> f32 {
+        self.mesh_volume
+    }
+
+    /// Summed volume of all spheres.
+    pub fn packed_volume(&self) -> f32 {
+        self.root().volume
+    }
+
+    /// Packed volume / mesh volume.
+    pub fn coverage(&self) -> f32 {
+        if self.mesh_volume > 0.0 { self.packed_volume() / self.mesh_volume } else { 0.0 }
+    }
+
+    /// Depth of the hierarchy (1 for a single leaf).
+    pub fn depth(&self) -> usize {
+        fn walk(t: &InnerSphereTree, n: usize) -> usize {
+            let node = &t.nodes[n];
+            if node.leaf { 1 } else { 1 + node.range().map(|c| walk(t, c)).max().unwrap_or(0) }
+        }
+        walk(self, 0)
+    }
+
+    /// A copy with every length multiplied by `factor` (> 0), e.g. to convert mesh units to metres.
+    pub fn scaled(&self, factor: f32) -> Self {
+        let s = |x: Sphere| Sphere::new(x.center * factor, x.radius * factor);
+        let v = factor * factor * factor;
+        Self {
+            spheres: self.spheres.iter().map(|&x| s(x)).collect(),
+            nodes: self.nodes.iter().map(|n| Node { bound: s(n.bound), volume: n.volume * v, ..*n }).collect(),
+            mesh_volume: self.mesh_volume * v,
+        }
+    }
+}

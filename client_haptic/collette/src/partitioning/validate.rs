@@ -1,0 +1,69 @@
+//! Structural checks of a tree (run on every loaded file, so a crafted file cannot cause a panic).
+
+use super::InnerSphereTree;
+
+impl InnerSphereTree {
+    /// Checks indices, ranges, finiteness, that bounds wrap their leaves and that volumes add up.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.nodes.is_empty() {
+            return Err("the tree has no root node".into());
+        }
+        if !self.mesh_volume.is_finite() || self.mesh_volume < 0.0 {
+            return Err(format!("mesh volume {} is not a finite positive number", self.mesh_volume));
+        }
+        if let Some(i) = self.spheres.iter().position(|s| !s.center.is_finite() || !(s.radius >= 0.0) || !s.radius.is_finite()) {
+            return Err(format!("sphere {i} has a non-finite centre or a bad radius"));
+        }
+        let mut seen = vec![false; self.spheres.len()];
+        let mut visited = vec![false; self.nodes.len()];
+        let mut stack = vec![(0usize, 0usize)];
+        while let Some((n, depth)) = stack.pop() {
+            if depth > 64 {
+                return Err("the hierarchy is deeper than 64 levels".into());
+            }
+            if std::mem::replace(&mut visited[n], true) {
+                return Err(format!("node {n} is reachable twice"));
+            }
+            let node = &self.nodes[n];
+            if !node.bound.center.is_finite() || !node.bound.radius.is_finite() || !node.volume.is_finite() {
+                return Err(format!("node {n} has non-finite values"));
+            }
+            let end = node.first as u64 + node.count as u64;
+            if node.leaf {
+                if end > self.spheres.len() as u64 {
+                    return Err(format!("leaf {n} points past the sphere array"));
+                }
+                let mut sum = 0.0f64;
+                for s in node.range() {
+                    if std::mem::replace(&mut seen[s], true) {
+                        return Err(format!("sphere {s} belongs to two leaves"));
+                    }
+                    let sp = &self.spheres[s];
+                    let slack = 1e-4 * node.bound.radius.max(sp.radius) + 1e-6;
+                    if node.bound.center.distance(sp.center) + sp.radius > node.bound.radius + slack {
+                        return Err(format!("leaf {n} does not enclose sphere {s}"));
+                    }
+                    sum += sp.volume() as f64;
+                }
+                if (sum as f32 - node.volume).abs() > 1e-3 * node.volume.max(1e-30) + 1e-30 {
+                    return Err(format!("leaf {n} volume {} differs from its spheres' {sum}", node.volume));
+                }
+            } else {
+                if node.count == 0 || end > self.nodes.len() as u64 || (node.first as usize) <= n {
+                    return Err(format!("inner node {n} has a bad child range"));
+                }
+                let sum: f64 = node.range().map(|c| self.nodes[c].volume as f64).sum();
+                if (sum as f32 - node.volume).abs() > 1e-3 * node.volume.max(1e-30) + 1e-30 {
+                    return Err(format!("node {n} volume {} differs from its children's {sum}", node.volume));
+                }
+                for c in node.range() {
+                    stack.push((c, depth + 1));
+                }
+            }
+        }
+        if let Some(s) = seen.iter().position(|s| !s) {
+            return Err(format!("sphere {s} is in no leaf"));
+        }
+        Ok(())
+    }
+}

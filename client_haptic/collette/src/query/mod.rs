@@ -1,0 +1,18 @@
+//! Queries between trees (overlap volume, time-budgeted overlap, separation distance) and probes.
+//!
+//! You need this module to detect collisions. Every query takes the two objects' world poses (the
+//! relative pose `pos12` maps object 2's frame into object 1's), a caller-owned [`QueryWorkspace`]
+//! created once, and, where it reports contacts, a caller-owned [`ContactSet`]: in steady state no
+//! query allocates.
+
+pub mod distance;
+pub mod overlap;
+pub mod probe;
+mod workspace;
+
+pub use distance::{Separation, separation};
+pub use overlap::{Budget, OverlapResult, overlap, overlap_budgeted, overlap_volume};
+pub use probe::{ProbeHit, probe};
+pub use workspace::QueryWorkspace;
+
+pub use haptic_common::{Contact, ContactSet, Pose};

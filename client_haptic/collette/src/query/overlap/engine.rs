@@ -1,0 +1,170 @@
+//! The simultaneous descent of two trees shared by the exact and budgeted overlap queries.
+
+use super::{Budget, OverlapResult};
+use crate::partitioning::{InnerSphereTree, Node};
+use crate::query::QueryWorkspace;
+use crate::shape::{Lens, lens, sphere_volume};
+use glam::Vec3;
+use haptic_common::Pose;
+use std::time::Instant;
+
+/// How many node pairs are tested between two clock reads.
+const CLOCK_STRIDE: u32 = 16;
+
+pub(super) struct Engine<'a, S> {
+    a: &'a InnerSphereTree,
+    b: &'a InnerSphereTree,
+    pos12: Pose,
+    budget: Budget,
+    sink: S,
+    until_clock: u32,
+    exhausted: bool,
+    pub(super) result: OverlapResult,
+}
+
+impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
+    pub(super) fn new(a: &'a InnerSphereTree, b: &'a InnerSphereTree, pos12: Pose, budget: Budget, sink: S) -> Self {
+        let result = OverlapResult { complete: true, ..OverlapResult::default() };
+        Self { a, b, pos12, budget, sink, until_clock: 0, exhausted: false, result }
+    }
+
+    /// Exact depth-first descent.
+    pub(super) fn run_depth_first(&mut self, ws: &mut QueryWorkspace) {
+        ws.stack.clear();
+        ws.stack.push((0, 0));
+        self.drain_stack(ws);
+    }
+
+    /// Breadth-first descent in a fixed ring; overflow is refined depth-first; stops on the budget.
+    pub(super) fn run_breadth_first(&mut self, ws: &mut QueryWorkspace) {
+        let cap = ws.ring.len();
+        let (mut head, mut len) = (0usize, 1usize);
+        ws.ring[0] = (0, 0);
+        ws.stack.clear();
+        while len > 0 {
+            if self.out_of_budget() {
+                break;
+            }
+            let (ia, ib) = ws.ring[head];
+            head = (head + 1) % cap;
+            len -= 1;
+            let (children, n) = self.visit(ia, ib);
+            for &pair in &children[..n] {
+                if len < cap {
+                    ws.ring[(head + len) % cap] = pair;
+                    len += 1;
+                } else {
+                    ws.stack.push(pair);
+                }
+            }
+            if !ws.stack.is_empty() {
+                self.drain_stack(ws);
+            }
+        }
+        for k in 0..len {
+            let (ia, ib) = ws.ring[(head + k) % cap];
+            self.estimate(ia, ib);
+        }
+    }
+
+    fn drain_stack(&mut self, ws: &mut QueryWorkspace) {
+        while let Some((ia, ib)) = ws.stack.pop() {
+            if self.out_of_budget() {
+                self.estimate(ia, ib);
+                while let Some((ia, ib)) = ws.stack.pop() {
+                    self.estimate(ia, ib);
+                }
+                return;
+            }
+            let (children, n) = self.visit(ia, ib);
+            ws.stack.extend_from_slice(&children[..n]);
+        }
+    }
+
+    fn out_of_budget(&mut self) -> bool {
+        if self.exhausted {
+            return true;
+        }
+        self.exhausted = match self.budget {
+            Budget::Unlimited => false,
+            Budget::NodePairs(max) => self.result.node_pairs >= max,
+            Budget::Deadline(deadline) => {
+                if self.until_clock == 0 {
+                    self.until_clock = CLOCK_STRIDE;
+                    Instant::now() >= deadline
+                } else {
+                    self.until_clock -= 1;
+                    false
+                }
+            }
+        };
+        if self.exhausted {
+            self.result.complete = false;
+        }
+        self.exhausted
+    }
+
+    /// Tests a node pair; refines leaf pairs exactly; returns the child pairs to visit.
+    #[inline]
+    fn visit(&mut self, ia: u32, ib: u32) -> ([(u32, u32); 4], usize) {
+        let mut children = [(0u32, 0u32); 4];
+        self.result.node_pairs += 1;
+        let na = &self.a.nodes[ia as usize];
+        let nb = &self.b.nodes[ib as usize];
+        let cb = self.pos12.transform_point(nb.bound.center);
+        let r = na.bound.radius + nb.bound.radius;
+        if na.bound.center.distance_squared(cb) >= r * r {
+            return (children, 0);
+        }
+        if na.leaf && nb.leaf {
+            self.leaf_pairs(na, nb);
+            return (children, 0);
+        }
+        let descend_a = nb.leaf || (!na.leaf && na.bound.radius >= nb.bound.radius);
+        let n = if descend_a {
+            for (k, c) in na.range().enumerate() {
+                children[k] = (c as u32, ib);
+            }
+            na.count as usize
+        } else {
+            for (k, c) in nb.range().enumerate() {
+                children[k] = (ia, c as u32);
+            }
+            nb.count as usize
+        };
+        (children, n)
+    }
+
+    #[inline]
+    fn leaf_pairs(&mut self, na: &Node, nb: &Node) {
+        for sb in &self.b.spheres[nb.range()] {
+            let cb = self.pos12.transform_point(sb.center);
+            for sa in &self.a.spheres[na.range()] {
+                if let Some(l) = lens(sa.center, sa.radius, cb, sb.radius) {
+                    if l.volume > 0.0 {
+                        self.result.total_volume += l.volume;
+                        self.result.leaf_pairs += 1;
+                        (self.sink)(&l, sa.center, cb);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Estimates a node pair from its bounds' lens scaled by both fill ratios.
+    fn estimate(&mut self, ia: u32, ib: u32) {
+        let na = &self.a.nodes[ia as usize];
+        let nb = &self.b.nodes[ib as usize];
+        let cb = self.pos12.transform_point(nb.bound.center);
+        let Some(mut l) = lens(na.bound.center, na.bound.radius, cb, nb.bound.radius) else { return };
+        let fill = |n: &Node| (n.volume / sphere_volume(n.bound.radius).max(f32::MIN_POSITIVE)).min(1.0);
+        l.volume = (l.volume * fill(na) * fill(nb)).min(na.volume).min(nb.volume);
+        if l.volume <= 0.0 {
+            return;
+        }
+        self.result.total_volume += l.volume;
+        self.result.estimated_volume += l.volume;
+        self.result.estimated_pairs += 1;
+        (self.sink)(&l, na.bound.center, cb);
+    }
+}

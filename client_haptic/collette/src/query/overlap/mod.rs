@@ -1,0 +1,106 @@
+//! Overlap of two Inner Sphere Trees: exact (every overlapping leaf pair) and time-budgeted (anytime).
+//!
+//! Inner spheres of one object never overlap each other, so the summed lens volumes are exactly the
+//! overlap volume of the two packings (a lower bound of the objects' intersection volume).
+
+mod engine;
+
+use crate::partitioning::InnerSphereTree;
+use crate::query::QueryWorkspace;
+use crate::shape::Lens;
+use engine::Engine;
+use glam::Vec3;
+use haptic_common::{Contact, ContactSet, Pose};
+use std::time::Instant;
+
+/// How much work a budgeted query may do before estimating the rest.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Budget {
+    /// No limit: the exact answer.
+    Unlimited,
+    /// Stop after testing this many node pairs (deterministic, for tests and replays).
+    NodePairs(u32),
+    /// Stop at this instant (checked every few node pairs).
+    Deadline(Instant),
+}
+
+/// Summary of an overlap query.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct OverlapResult {
+    /// Overlap volume, including `estimated_volume` (units³ of the trees).
+    pub total_volume: f32,
+    /// Part of `total_volume` estimated from inner nodes' summed volumes (budgeted queries only).
+    pub estimated_volume: f32,
+    /// Overlapping leaf-sphere pairs found exactly.
+    pub leaf_pairs: u32,
+    /// Node pairs estimated instead of refined.
+    pub estimated_pairs: u32,
+    /// Node pairs tested.
+    pub node_pairs: u32,
+    /// False when the budget stopped the traversal.
+    pub complete: bool,
+}
+
+/// Total overlap volume of `a` at `pose_a` and `b` at `pose_b` (exact, no contacts reported).
+pub fn overlap_volume(a: &InnerSphereTree, pose_a: &Pose, b: &InnerSphereTree, pose_b: &Pose, ws: &mut QueryWorkspace) -> OverlapResult {
+    let mut engine = Engine::new(a, b, pose_a.relative_to(pose_b), Budget::Unlimited, |_: &Lens, _: Vec3, _: Vec3| {});
+    engine.run_depth_first(ws);
+    engine.result
+}
+
+/// Every overlapping leaf pair of `a` and `b` as world-frame contacts in `out` (cleared first), plus
+/// the total volume (also stored in `out.total_volume`). Normals point from B towards A.
+///
+/// Pairs beyond `out`'s capacity still count in the volume; `out.truncated` is then set.
+pub fn overlap(
+    a: &InnerSphereTree,
+    pose_a: &Pose,
+    b: &InnerSphereTree,
+    pose_b: &Pose,
+    ws: &mut QueryWorkspace,
+    out: &mut ContactSet,
+) -> OverlapResult {
+    overlap_budgeted(a, pose_a, b, pose_b, Budget::Unlimited, ws, out)
+}
+
+/// Anytime overlap: refines breadth-first until `budget` runs out, then estimates every node pair not
+/// yet refined from its bounding spheres' lens scaled by both nodes' fill ratios (summed leaf volume /
+/// bound volume). Estimated pairs are reported as contacts too, so forces stay continuous.
+pub fn overlap_budgeted(
+    a: &InnerSphereTree,
+    pose_a: &Pose,
+    b: &InnerSphereTree,
+    pose_b: &Pose,
+    budget: Budget,
+    ws: &mut QueryWorkspace,
+    out: &mut ContactSet,
+) -> OverlapResult {
+    out.clear();
+    let rot = pose_a.rotation;
+    let fallback = fallback_normal(a, b, pose_a, pose_b);
+    let sink = |lens: &Lens, ca: Vec3, cb: Vec3| {
+        let delta = ca - cb;
+        let len = delta.length();
+        let normal = if len > 1e-12 { rot * (delta / len) } else { fallback };
+        out.push(Contact { point: pose_a.transform_point(lens.centroid), normal, volume: lens.volume, depth: lens.depth });
+    };
+    let mut engine = Engine::new(a, b, pose_a.relative_to(pose_b), budget, sink);
+    match budget {
+        Budget::Unlimited => engine.run_depth_first(ws),
+        _ => engine.run_breadth_first(ws),
+    }
+    let result = engine.result;
+    out.total_volume = result.total_volume;
+    out.estimated_volume = result.estimated_volume;
+    out.truncated |= !result.complete;
+    result
+}
+
+/// Normal used when two sphere centres coincide: from B's root centre to A's, else +Y.
+fn fallback_normal(a: &InnerSphereTree, b: &InnerSphereTree, pose_a: &Pose, pose_b: &Pose) -> Vec3 {
+    let d = pose_a.transform_point(a.root().bound.center) - pose_b.transform_point(b.root().bound.center);
+    d.try_normalize().unwrap_or(Vec3::Y)
+}
+
+#[cfg(test)]
+mod tests;
