@@ -60,6 +60,11 @@ pub fn matches(briefing: &Briefing, observed: &Observed, material: &Material) ->
         && MaterialClass::nearest(material) == briefing.material
 }
 
+/// Judges a received copy: analyses `mesh` as the briefed kind and [`matches`] it with `briefing`.
+pub fn judge(briefing: &Briefing, mesh: &HapticMesh, material: &Material) -> bool {
+    matches(briefing, &analyze(briefing.kind, mesh), material)
+}
+
 /// Height of the top surface just inside the outermost radius, around the vertical axis through
 /// `axis`, metres.
 fn rim_heights(mesh: &HapticMesh, axis: Vec3) -> Vec<f32> {
@@ -216,7 +221,7 @@ mod tests {
                     .enumerate()
                     .filter(|(i, c)| {
                         let mesh = build_mesh(c, seed.wrapping_mul(31).wrapping_add(*i as u64));
-                        matches(&b, &analyze(kind, &mesh), &c.material.material())
+                        judge(&b, &mesh, &c.material.material())
                     })
                     .map(|(i, _)| i)
                     .collect();

@@ -158,7 +158,7 @@ pub struct CopyTraits {
 pub struct ArtifactLook {
     /// Base colour, sRGB 0–255.
     pub colour_srgb: [u8; 3],
-    /// Bounding box (width x, height y, depth z), metres.
+    /// Nominal size: diameter along x, height along y, diameter along z, metres.
     pub size_m: [f32; 3],
     /// Index of the visual mesh in the VR client's catalogue (0 crown, 1 amphora, 2 idol).
     pub style_id: u16,
@@ -167,9 +167,9 @@ pub struct ArtifactLook {
 /// The look shared by all copies of `kind`.
 pub fn look(kind: ArtifactKind) -> ArtifactLook {
     match kind {
-        ArtifactKind::Crown => ArtifactLook { colour_srgb: [212, 175, 55], size_m: [0.11, 0.08, 0.11], style_id: 0 },
+        ArtifactKind::Crown => ArtifactLook { colour_srgb: [212, 175, 55], size_m: [0.10, 0.07, 0.10], style_id: 0 },
         ArtifactKind::Amphora => ArtifactLook { colour_srgb: [176, 96, 52], size_m: [0.10, 0.12, 0.10], style_id: 1 },
-        ArtifactKind::Idol => ArtifactLook { colour_srgb: [120, 128, 110], size_m: [0.09, 0.11, 0.09], style_id: 2 },
+        ArtifactKind::Idol => ArtifactLook { colour_srgb: [120, 128, 110], size_m: [0.086, 0.11, 0.086], style_id: 2 },
     }
 }
 

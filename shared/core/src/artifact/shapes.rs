@@ -271,6 +271,20 @@ mod tests {
     }
 
     #[test]
+    fn the_shared_look_has_the_size_of_every_copy() {
+        for kind in ArtifactKind::ALL {
+            let look = crate::artifact::look(kind);
+            for n in kind.feature_range() {
+                let mesh = build_mesh(&traits(kind, n), u64::from(n));
+                let (lo, hi) = mesh.bounds();
+                let diameter = 2.0 * mesh.vertices.iter().map(|p| p[0].hypot(p[2])).fold(0.0, f32::max);
+                assert!((diameter - look.size_m[0]).abs() < 0.005, "{kind} {n}: diameter {diameter}");
+                assert!((hi.y - lo.y - look.size_m[1]).abs() < 0.005, "{kind} {n}: height {}", hi.y - lo.y);
+            }
+        }
+    }
+
+    #[test]
     fn the_same_traits_and_seed_give_the_same_mesh() {
         let t = traits(ArtifactKind::Crown, 7);
         assert_eq!(build_mesh(&t, 42), build_mesh(&t, 42));
