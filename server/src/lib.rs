@@ -1,1 +1,144 @@
-//! heist_server (being built).
+//! The Phantom Heist server: an authoritative, headless Bevy app.
+//!
+//! [`build_server`] makes a ready-to-run [`App`] (and, in secure mode, the token endpoint) so the
+//! binary, the demo and the end-to-end tests all start the same server in-process.
+#![warn(missing_docs)]
+
+pub mod demo;
+pub mod game;
+pub mod net;
+pub mod session;
+
+use std::net::SocketAddr;
+use std::time::Duration;
+
+use anyhow::Context as _;
+use bevy::app::ScheduleRunnerPlugin;
+use bevy::prelude::*;
+use bevy::state::app::StatesPlugin;
+use bevy::time::TimeUpdateStrategy;
+use bevy_replicon::prelude::*;
+use bevy_replicon_renet::RepliconRenetPlugins;
+use heist_shared::level::Level;
+use heist_shared::protocol::{ProtocolPlugin, TICK_HZ};
+
+use game::{Game, GameOptions};
+use net::tokens::{RoleTable, TokenConfig, TokenService, new_join_code};
+use net::{Auth, NetSettings, ServerNetPlugin};
+use session::{GameState, SessionLog, SessionPlugin};
+
+/// How the server's clock advances.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Clock {
+    /// Wall-clock time; the app runs its own loop (`App::run`).
+    RealTime,
+    /// Each `app.update()` advances exactly one tick (tests, the demo).
+    Stepped,
+}
+
+/// Everything needed to start a server.
+#[derive(Clone)]
+pub struct ServerOptions {
+    /// The level to play.
+    pub level: Level,
+    /// Seed and overrides.
+    pub game: GameOptions,
+    /// UDP address for the game (port 0 picks a free one).
+    pub bind: SocketAddr,
+    /// TCP address for the token endpoint (port 0 picks a free one). Ignored when insecure.
+    pub token_bind: SocketAddr,
+    /// Accept unsigned clients claiming any role (LAN development only).
+    pub insecure: bool,
+    /// How time advances.
+    pub clock: Clock,
+    /// Print the session log as it is written.
+    pub echo_log: bool,
+    /// Refused messages tolerated per client before disconnecting it (default 50).
+    pub abuse_limit: u32,
+}
+
+impl ServerOptions {
+    /// Loopback, secure, stepped clock, the shipped museum.
+    pub fn local_test(seed: u64) -> Self {
+        let loopback: SocketAddr = "127.0.0.1:0".parse().unwrap_or_else(|_| unreachable!());
+        Self {
+            level: Level::museum(),
+            game: GameOptions { seed, time_limit_s: None },
+            bind: loopback,
+            token_bind: loopback,
+            insecure: false,
+            clock: Clock::Stepped,
+            echo_log: false,
+            abuse_limit: 50,
+        }
+    }
+}
+
+/// A built server, not yet running.
+pub struct HostedServer {
+    /// The Bevy app.
+    pub app: App,
+    /// Its game address.
+    pub addr: SocketAddr,
+    /// The token endpoint (secure mode).
+    pub tokens: Option<TokenService>,
+    /// The join code players exchange for tokens.
+    pub join_code: String,
+}
+
+impl HostedServer {
+    /// The session's game state.
+    pub fn game(&self) -> &Game {
+        &self.app.world().resource::<GameState>().0
+    }
+
+    /// The session log so far.
+    pub fn log(&self) -> &[String] {
+        &self.app.world().resource::<SessionLog>().lines
+    }
+}
+
+/// Builds the server app, binds its sockets and starts the token endpoint.
+pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
+    let socket = net::bind_game_socket(options.bind).with_context(|| format!("cannot bind UDP {}", options.bind))?;
+    let addr = socket.local_addr()?;
+    let roles = RoleTable::default();
+    let join_code = new_join_code();
+    let (auth, tokens) = if options.insecure {
+        (Auth::Insecure, None)
+    } else {
+        let private_key: [u8; 32] = rand::random();
+        let session: u64 = rand::random();
+        let service = TokenService::spawn(
+            options.token_bind,
+            TokenConfig { code: join_code.clone(), private_key, server_addr: addr, session, roles: roles.clone() },
+        )
+        .with_context(|| format!("cannot bind the token endpoint on TCP {}", options.token_bind))?;
+        (Auth::Secure { private_key, session }, Some(service))
+    };
+
+    let mut app = App::new();
+    let period = Duration::from_secs_f64(1.0 / TICK_HZ);
+    match options.clock {
+        Clock::RealTime => {
+            app.add_plugins(MinimalPlugins.set(ScheduleRunnerPlugin::run_loop(period / 2)));
+        }
+        Clock::Stepped => {
+            app.add_plugins(MinimalPlugins).insert_resource(TimeUpdateStrategy::ManualDuration(period));
+        }
+    }
+    app.insert_resource(Time::<Fixed>::from_hz(TICK_HZ))
+        .add_plugins((StatesPlugin, RepliconPlugins, RepliconRenetPlugins, ProtocolPlugin))
+        .insert_resource(GameState(Game::new(options.level, &options.game)))
+        .insert_resource(SessionLog { echo: options.echo_log, ..Default::default() })
+        .add_plugins(SessionPlugin)
+        .add_plugins(ServerNetPlugin {
+            socket: std::sync::Mutex::new(Some(socket)),
+            settings: NetSettings { auth, roles, abuse_limit: options.abuse_limit },
+        });
+    if options.clock == Clock::Stepped {
+        app.finish();
+        app.cleanup();
+    }
+    Ok(HostedServer { app, addr, tokens, join_code })
+}

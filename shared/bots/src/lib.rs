@@ -1,1 +1,13 @@
-//! heist_bots (being built).
+//! Headless bots that play Phantom Heist through the real client core, for tests, the demo and CI.
+//!
+//! [`ViveBotPlugin`] sneaks, breaks cases and carries copies; [`PhantomBotPlugin`] judges each copy from
+//! the geometry it receives and the briefing — never from a label. Both only read what their client
+//! receives (replicated components and [`heist_client::Inbox`]) and only write `ClientMsg`s.
+#![warn(missing_docs)]
+
+mod phantom;
+mod vive;
+mod vision;
+
+pub use phantom::{PhantomBotPlugin, PhantomBrain};
+pub use vive::{ViveBotPlugin, ViveBrain, ViveStyle};

@@ -1,1 +1,151 @@
-//! heist_client (being built).
+//! The client core both Phantom Heist clients (and the bots) stand on: exchange a join code for a
+//! connect token, connect over netcode/UDP, keep the latest server messages, send intents.
+//!
+//! It adds no rendering, audio or input: a client app adds [`ClientNetPlugin`], calls [`connect`] with a
+//! token from [`request_token`], then reads the replicated components (`heist_shared::protocol`) and
+//! [`Inbox`], and writes `ClientMsg` messages.
+#![warn(missing_docs)]
+
+mod error;
+mod token;
+
+pub use error::JoinError;
+pub use token::request_token;
+
+use std::net::UdpSocket;
+use std::time::{SystemTime, UNIX_EPOCH};
+
+use bevy::prelude::*;
+use bevy_replicon::prelude::*;
+use bevy_replicon_renet::netcode::{ClientAuthentication, ConnectToken, NetcodeClientTransport};
+use bevy_replicon_renet::renet::ConnectionConfig;
+use bevy_replicon_renet::{RenetChannelsExt, RenetClient};
+use heist_shared::artifact::Briefing;
+use heist_shared::level::Level;
+use heist_shared::protocol::{DisconnectReason, GameEvent, Refusal, Role, ServerMsg, WorkbenchCopy};
+
+/// What the server has told this client, kept for the app's systems to read.
+#[derive(Resource, Default, Debug)]
+pub struct Inbox {
+    /// The role granted by the server (after `Welcome`).
+    pub role: Option<Role>,
+    /// The level the server plays (after `Welcome`).
+    pub level: Option<Level>,
+    /// Briefings (Phantom only).
+    pub briefings: Vec<Briefing>,
+    /// The latest copy on the workbench not yet taken by the app (Phantom only).
+    pub workbench: Option<WorkbenchCopy>,
+    /// Game events not yet taken by the app, oldest first.
+    pub events: Vec<GameEvent>,
+    /// Every refusal received.
+    pub refusals: Vec<Refusal>,
+    /// Why the server disconnected us, if it said so.
+    pub disconnect: Option<DisconnectReason>,
+    /// Count of each kind of message received, for tests: (welcome, briefings, workbench, events).
+    pub received: MessageCounts,
+}
+
+/// How many server messages of each kind arrived.
+#[derive(Default, Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MessageCounts {
+    /// `Welcome`.
+    pub welcome: u32,
+    /// `Briefings`.
+    pub briefings: u32,
+    /// `Workbench`.
+    pub workbench: u32,
+    /// `Event`.
+    pub events: u32,
+}
+
+/// System sets of the client core.
+#[derive(SystemSet, Debug, Clone, PartialEq, Eq, Hash)]
+pub enum ClientNetSystems {
+    /// `PreUpdate`, after replicon's receive: server messages into [`Inbox`].
+    Receive,
+}
+
+/// Adds replicon + renet (client side) and the protocol, and fills [`Inbox`].
+pub struct ClientNetPlugin;
+
+impl Plugin for ClientNetPlugin {
+    fn build(&self, app: &mut App) {
+        if !app.is_plugin_added::<bevy::state::app::StatesPlugin>() {
+            app.add_plugins(bevy::state::app::StatesPlugin);
+        }
+        app.add_plugins((RepliconPlugins, bevy_replicon_renet::RepliconRenetPlugins))
+            .add_plugins(heist_shared::protocol::ProtocolPlugin)
+            .init_resource::<Inbox>()
+            .configure_sets(PreUpdate, ClientNetSystems::Receive.after(ClientSystems::Receive))
+            .add_systems(PreUpdate, fill_inbox.in_set(ClientNetSystems::Receive));
+    }
+}
+
+fn fill_inbox(mut messages: MessageReader<ServerMsg>, mut inbox: ResMut<Inbox>) {
+    for msg in messages.read() {
+        match msg.clone() {
+            ServerMsg::Welcome { role, level } => {
+                inbox.role = Some(role);
+                inbox.level = Some(*level);
+                inbox.received.welcome += 1;
+            }
+            ServerMsg::Refused(r) => inbox.refusals.push(r),
+            ServerMsg::Disconnecting(reason) => inbox.disconnect = Some(reason),
+            ServerMsg::Briefings(b) => {
+                inbox.briefings = b;
+                inbox.received.briefings += 1;
+            }
+            ServerMsg::Workbench(copy) => {
+                inbox.workbench = Some(copy);
+                inbox.received.workbench += 1;
+            }
+            ServerMsg::Event(e) => {
+                inbox.events.push(e);
+                inbox.received.events += 1;
+            }
+        }
+    }
+}
+
+/// Creates the netcode transport for `token` (call after [`ClientNetPlugin`] is added and all protocol
+/// registration is done, before the first update).
+pub fn connect(app: &mut App, token: ConnectToken) -> Result<(), JoinError> {
+    let server = token.server_addresses.iter().flatten().next().copied().ok_or(JoinError::NoServerAddress)?;
+    let bind = if server.ip().is_loopback() { "127.0.0.1:0" } else { "0.0.0.0:0" };
+    let socket = UdpSocket::bind(bind).map_err(JoinError::Socket)?;
+    let now = SystemTime::now().duration_since(UNIX_EPOCH).unwrap_or_default();
+    let transport = NetcodeClientTransport::new(now, ClientAuthentication::Secure { connect_token: token }, socket)
+        .map_err(|e| JoinError::Transport(e.to_string()))?;
+    let channels = app.world().resource::<RepliconChannels>();
+    let connection = ConnectionConfig {
+        server_channels_config: channels.server_configs(),
+        client_channels_config: channels.client_configs(),
+        ..Default::default()
+    };
+    app.insert_resource(RenetClient::new(connection)).insert_resource(transport);
+    Ok(())
+}
+
+/// Connects without a token (the server must run with `--insecure`), claiming `role`.
+pub fn connect_insecure(app: &mut App, server: std::net::SocketAddr, role: Role) -> Result<(), JoinError> {
+    let bind = if server.ip().is_loopback() { "127.0.0.1:0" } else { "0.0.0.0:0" };
+    let socket = UdpSocket::bind(bind).map_err(JoinError::Socket)?;
+    let now = SystemTime::now().duration_since(UNIX_EPOCH).unwrap_or_default();
+    let user_data = heist_shared::protocol::TokenUserData { role, session: 0 }.encode();
+    let auth = ClientAuthentication::Unsecure {
+        protocol_id: heist_shared::protocol::PROTOCOL_ID,
+        client_id: now.as_nanos() as u64,
+        server_addr: server,
+        user_data: Some(user_data),
+    };
+    let transport =
+        NetcodeClientTransport::new(now, auth, socket).map_err(|e| JoinError::Transport(e.to_string()))?;
+    let channels = app.world().resource::<RepliconChannels>();
+    let connection = ConnectionConfig {
+        server_channels_config: channels.server_configs(),
+        client_channels_config: channels.client_configs(),
+        ..Default::default()
+    };
+    app.insert_resource(RenetClient::new(connection)).insert_resource(transport);
+    Ok(())
+}

@@ -1,0 +1,114 @@
+//! A whole heist in one process: the real server, both bots as real clients, real UDP on loopback,
+//! secure tokens, and a clock stepped by hand so a ten-minute heist runs in seconds.
+//!
+//! The `demo` subcommand and the end-to-end tests use this.
+
+use std::time::Duration;
+
+use anyhow::Context as _;
+use bevy::prelude::*;
+use bevy::time::TimeUpdateStrategy;
+use heist_bots::{PhantomBotPlugin, ViveBotPlugin, ViveStyle};
+use heist_client::{ClientNetPlugin, request_token};
+use heist_shared::protocol::{Phase, Role, TICK_HZ};
+
+use crate::{HostedServer, ServerOptions, build_server};
+
+/// How long a token request may take.
+const TOKEN_TIMEOUT: Duration = Duration::from_secs(5);
+
+/// A client app driven by hand: minimal plugins, stepped clock, the client core.
+pub fn stepped_client_app() -> App {
+    let mut app = App::new();
+    app.add_plugins(MinimalPlugins)
+        .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f64(1.0 / TICK_HZ)))
+        .add_plugins(ClientNetPlugin);
+    app
+}
+
+/// Joins `server` as `role` through its token endpoint; `plugins` add the bot (or test probes).
+pub fn join(server: &HostedServer, role: Role, setup: impl FnOnce(&mut App)) -> anyhow::Result<App> {
+    let endpoint = server.tokens.as_ref().context("the server runs without a token endpoint")?.addr;
+    let token = request_token(endpoint, &server.join_code, role, TOKEN_TIMEOUT)?;
+    let mut app = stepped_client_app();
+    setup(&mut app);
+    app.finish();
+    app.cleanup();
+    heist_client::connect(&mut app, token)?;
+    Ok(app)
+}
+
+/// A server and its two bot clients, stepped together.
+pub struct Heist {
+    /// The server.
+    pub server: HostedServer,
+    /// Vive's client.
+    pub vive: App,
+    /// Phantom's client.
+    pub phantom: App,
+    /// Ticks stepped so far.
+    pub ticks: u64,
+}
+
+impl Heist {
+    /// Starts a server with `options` and joins both bots.
+    pub fn start(options: ServerOptions, style: ViveStyle) -> anyhow::Result<Self> {
+        let server = build_server(options)?;
+        let vive = join(&server, Role::Vive, |app| {
+            app.add_plugins(ViveBotPlugin { style });
+        })?;
+        let phantom = join(&server, Role::Phantom, |app| {
+            app.add_plugins(PhantomBotPlugin::default());
+        })?;
+        Ok(Self { server, vive, phantom, ticks: 0 })
+    }
+
+    /// One tick for everyone.
+    pub fn step(&mut self) {
+        self.server.app.update();
+        self.vive.update();
+        self.phantom.update();
+        self.ticks += 1;
+    }
+
+    /// Steps until the session ends or `max_game_s` of heist time passes (plus a bounded lobby);
+    /// returns the final phase.
+    pub fn run(&mut self, max_game_s: f32) -> Phase {
+        let max_ticks = ((max_game_s as f64 + 30.0) * TICK_HZ) as u64;
+        let trace = std::env::var_os("HEIST_TRACE").is_some();
+        for _ in 0..max_ticks {
+            self.step();
+            if trace && self.ticks % 30 == 0 {
+                let g = self.server.game();
+                let guards: Vec<String> = g
+                    .guards
+                    .iter()
+                    .map(|gd| format!("{}({:.1},{:.1} f{:.1} {:?})", gd.name, gd.position.x, gd.position.y, gd.facing, gd.alert))
+                    .collect();
+                println!(
+                    "  t={:.1} vive=({:.1},{:.1}) {:?} carry={:?} | {}",
+                    g.elapsed_s, g.vive.position.x, g.vive.position.y, g.vive.stance, g.vive.carrying, guards.join(" ")
+                );
+            }
+            if !self.server.game().is_running() {
+                // A few more ticks let the final messages reach the clients.
+                for _ in 0..10 {
+                    self.step();
+                }
+                break;
+            }
+        }
+        self.server.game().phase
+    }
+}
+
+/// Runs a whole heist with bots and prints the log and the result.
+pub fn run_demo(options: ServerOptions, style: ViveStyle) -> anyhow::Result<Phase> {
+    let limit = options.game.time_limit_s.unwrap_or(options.level.time_limit_s);
+    let mut heist = Heist::start(options, style)?;
+    let phase = heist.run(limit + 5.0);
+    let game = heist.server.game();
+    let result = crate::session::result_line(game).unwrap_or_else(|| format!("RESULT: unfinished ({phase:?})"));
+    println!("{result} after {:.1} s of game time", game.elapsed_s);
+    Ok(phase)
+}

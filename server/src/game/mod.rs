@@ -1,0 +1,313 @@
+//! The authoritative game: every rule of a heist, as plain data stepped by `dt`.
+//!
+//! Nothing here touches the network or the clock: [`Game::apply`] takes one client message, [`Game::step`]
+//! advances time, and both leave what happened in [`Game::drain_outgoing`]. That keeps every rule
+//! deterministic for a seed and testable without a server.
+
+mod actions;
+mod guard;
+mod setup;
+
+pub use guard::{Guard, GuardState, Perception};
+pub use setup::CopyTruth;
+
+use glam::Vec2;
+use heist_shared::artifact::{ArtifactKind, Briefing};
+use heist_shared::level::{Level, NavGraph, WallSet};
+use heist_shared::protocol::{
+    CaseId, ClientMsg, GameEvent, ItemId, ItemKind, ItemPlace, LobbyMsg, LossReason, NoiseKind, Phase, Refusal,
+    Role, ServerMsg, Stance, verify,
+};
+use heist_shared::rules;
+use rand_chacha::ChaCha8Rng;
+
+/// Seconds a player may be gone during a heist before it is lost as abandoned.
+pub const ABANDON_GRACE_S: f32 = 20.0;
+
+/// Options that change a session without editing the level.
+#[derive(Clone, Debug, Default)]
+pub struct GameOptions {
+    /// Seed for copy traits, case assignment and guard decisions.
+    pub seed: u64,
+    /// Replaces the level's time limit (seconds).
+    pub time_limit_s: Option<f32>,
+}
+
+/// Who receives an outgoing message.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Outgoing {
+    /// Both players.
+    All(ServerMsg),
+    /// One role only.
+    To(Role, ServerMsg),
+}
+
+/// Vive's server-side state.
+#[derive(Clone, Debug, Default)]
+pub struct Vive {
+    /// Position, metres.
+    pub position: Vec2,
+    /// Velocity, m/s.
+    pub velocity: Vec2,
+    /// Facing yaw, radians.
+    pub facing: f32,
+    /// Stance derived from the last gait.
+    pub stance: Stance,
+    /// Carried items.
+    pub carrying: Vec<ItemId>,
+    /// Last applied input sequence number.
+    pub last_input_seq: u32,
+    /// Current movement intent (direction with |d| <= 1, speed in m/s).
+    pub intent: (Vec2, f32),
+    footstep_timer: f32,
+}
+
+/// A display case.
+#[derive(Clone, Debug)]
+pub struct Case {
+    /// Position, metres.
+    pub position: Vec2,
+    /// Shattered?
+    pub broken: bool,
+}
+
+/// An item and, for copies, its hidden truth.
+#[derive(Clone, Debug)]
+pub struct Item {
+    /// What anyone can see.
+    pub kind: ItemKind,
+    /// Where it is.
+    pub place: ItemPlace,
+    /// For copies: which target, its traits, and whether it is the real one. Never replicated.
+    pub truth: Option<CopyTruth>,
+}
+
+/// A target artifact's progress.
+#[derive(Clone, Debug)]
+pub struct Target {
+    /// Which artifact.
+    pub kind: ArtifactKind,
+    /// What Phantom is told about the real copy.
+    pub briefing: Briefing,
+    /// Secured yet?
+    pub secured: bool,
+}
+
+/// A heist session.
+#[derive(Clone, Debug)]
+pub struct Game {
+    /// The level being played.
+    pub level: Level,
+    /// Walls for collision and sight.
+    pub walls: WallSet,
+    /// Room graph for routes and sound.
+    pub nav: NavGraph,
+    /// Current phase.
+    pub phase: Phase,
+    /// Seconds of game time left.
+    pub time_left_s: f32,
+    /// Seconds of heist time elapsed.
+    pub elapsed_s: f32,
+    /// Alarm level.
+    pub alarm: u8,
+    /// Vive.
+    pub vive: Vive,
+    /// Guards.
+    pub guards: Vec<Guard>,
+    /// Display cases.
+    pub cases: Vec<Case>,
+    /// Items (copies and props), indexed by `ItemId`.
+    pub items: Vec<Item>,
+    /// Targets in level order.
+    pub targets: Vec<Target>,
+    /// The copy on the workbench.
+    pub workbench: Option<ItemId>,
+    /// Connected roles (Vive, Phantom).
+    pub present: (bool, bool),
+    ready: (bool, bool),
+    absent_s: f32,
+    noises: Vec<(Vec2, f32)>,
+    outgoing: Vec<Outgoing>,
+    rng: ChaCha8Rng,
+}
+
+fn slot(role: Role) -> usize {
+    match role {
+        Role::Vive => 0,
+        Role::Phantom => 1,
+    }
+}
+
+fn get(pair: (bool, bool), role: Role) -> bool {
+    if slot(role) == 0 { pair.0 } else { pair.1 }
+}
+
+fn set(pair: &mut (bool, bool), role: Role, value: bool) {
+    if slot(role) == 0 { pair.0 = value } else { pair.1 = value }
+}
+
+impl Game {
+    /// A new session in the lobby.
+    pub fn new(level: Level, options: &GameOptions) -> Self {
+        setup::new_game(level, options)
+    }
+
+    /// A player connected.
+    pub fn join(&mut self, role: Role) {
+        set(&mut self.present, role, true);
+    }
+
+    /// A player disconnected.
+    pub fn leave(&mut self, role: Role) {
+        set(&mut self.present, role, false);
+        set(&mut self.ready, role, false);
+    }
+
+    /// True while the session has not ended.
+    pub fn is_running(&self) -> bool {
+        matches!(self.phase, Phase::Lobby | Phase::Heist)
+    }
+
+    /// Applies one message from a player; a refusal changes nothing.
+    pub fn apply(&mut self, role: Role, msg: &ClientMsg) -> Result<(), Refusal> {
+        verify(role, self.phase, msg)?;
+        match msg {
+            ClientMsg::Lobby(LobbyMsg::Ready) => {
+                set(&mut self.ready, role, true);
+                self.start_if_ready();
+                Ok(())
+            }
+            ClientMsg::Vive(m) => self.apply_vive(m),
+            ClientMsg::Phantom(m) => self.apply_phantom(m),
+            ClientMsg::Malformed(_) => unreachable!("verify refuses malformed messages"),
+        }
+    }
+
+    fn start_if_ready(&mut self) {
+        if self.phase == Phase::Lobby && self.present == (true, true) && self.ready == (true, true) {
+            self.set_phase(Phase::Heist);
+            let briefings = self.targets.iter().map(|t| t.briefing.clone()).collect();
+            self.outgoing.push(Outgoing::To(Role::Phantom, ServerMsg::Briefings(briefings)));
+        }
+    }
+
+    /// Advances the session by `dt` seconds.
+    pub fn step(&mut self, dt: f32) {
+        if self.phase == Phase::Lobby {
+            self.start_if_ready();
+            return;
+        }
+        if self.phase != Phase::Heist {
+            return;
+        }
+        self.elapsed_s += dt;
+        self.time_left_s = (self.time_left_s - dt).max(0.0);
+        self.move_vive(dt);
+        self.step_guards(dt);
+        self.noises.clear();
+        if self.phase != Phase::Heist {
+            return;
+        }
+        if self.present != (true, true) {
+            self.absent_s += dt;
+            if self.absent_s >= ABANDON_GRACE_S {
+                self.set_phase(Phase::Lost(LossReason::Abandoned));
+            }
+        } else {
+            self.absent_s = 0.0;
+        }
+        if self.time_left_s <= 0.0 && self.phase == Phase::Heist {
+            self.set_phase(Phase::Lost(LossReason::Time));
+        }
+    }
+
+    /// Messages produced since the last call, in order.
+    pub fn drain_outgoing(&mut self) -> std::vec::Drain<'_, Outgoing> {
+        self.outgoing.drain(..)
+    }
+
+    fn set_phase(&mut self, phase: Phase) {
+        if self.phase != phase {
+            self.phase = phase;
+            self.event(GameEvent::PhaseChanged(phase));
+        }
+    }
+
+    fn event(&mut self, event: GameEvent) {
+        self.outgoing.push(Outgoing::All(ServerMsg::Event(event)));
+    }
+
+    fn noise(&mut self, kind: NoiseKind, position: Vec2, loudness: f32) {
+        self.noises.push((position, loudness));
+        self.event(GameEvent::Noise { kind, position, loudness });
+    }
+
+    fn raise_alarm(&mut self) {
+        self.alarm = (self.alarm + 1).min(rules::ALARM_LOCKDOWN);
+        self.event(GameEvent::Alarm(self.alarm));
+        let at = self.level.workbench;
+        self.noise(NoiseKind::Alarm, at, 0.0);
+        if self.alarm >= rules::ALARM_LOCKDOWN {
+            self.set_phase(Phase::Lost(LossReason::Alarm));
+        }
+    }
+
+    fn move_vive(&mut self, dt: f32) {
+        let (dir, speed) = self.vive.intent;
+        let delta = dir * speed * dt;
+        let before = self.vive.position;
+        self.vive.position = self.walls.slide(before, delta, rules::BODY_RADIUS);
+        self.vive.velocity = (self.vive.position - before) / dt.max(1e-6);
+        if self.vive.stance == Stance::Running && self.vive.velocity.length() > 0.5 {
+            self.vive.footstep_timer -= dt;
+            if self.vive.footstep_timer <= 0.0 {
+                self.vive.footstep_timer = 0.5;
+                let at = self.vive.position;
+                self.noise(NoiseKind::Footsteps, at, rules::RUN_LOUDNESS);
+            }
+        }
+    }
+
+    fn step_guards(&mut self, dt: f32) {
+        let alarm = f32::from(self.alarm);
+        for i in 0..self.guards.len() {
+            let perception = guard::perceive(&self.guards[i], &self.vive, &self.walls, &self.nav, &self.noises, alarm);
+            let before = self.guards[i].alert;
+            let caught = guard::think_and_act(
+                &mut self.guards[i],
+                &perception,
+                &self.walls,
+                &self.nav,
+                alarm,
+                dt,
+            );
+            let g = &self.guards[i];
+            if g.alert != before {
+                let event = GameEvent::GuardAlert { guard: g.id, alert: g.alert, position: g.position };
+                self.event(event);
+            }
+            if caught {
+                self.set_phase(Phase::Lost(LossReason::Caught));
+                return;
+            }
+        }
+    }
+
+    /// The case with `id`, if it exists.
+    fn case(&self, id: CaseId) -> Result<&Case, Refusal> {
+        self.cases.get(usize::from(id.0)).ok_or(Refusal::Unknown)
+    }
+
+    /// The item with `id`, if it exists.
+    fn item(&self, id: ItemId) -> Result<&Item, Refusal> {
+        self.items.get(usize::from(id.0)).ok_or(Refusal::Unknown)
+    }
+
+    /// True when `role` is connected.
+    pub fn is_present(&self, role: Role) -> bool {
+        get(self.present, role)
+    }
+}
+
+#[cfg(test)]
+mod tests;

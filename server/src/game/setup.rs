@@ -1,0 +1,119 @@
+//! Building a session from a level and a seed: copies, their hidden truth, cases, guards.
+
+use glam::Vec2;
+use heist_shared::artifact::{self, CopyTraits, HapticMesh, Material};
+use heist_shared::level::{Level, NavGraph, WallSet};
+use heist_shared::protocol::{CaseId, GuardId, ItemId, ItemKind, ItemPlace, Phase};
+use rand::SeedableRng;
+use rand::seq::SliceRandom;
+use rand_chacha::ChaCha8Rng;
+
+use super::guard::Guard;
+use super::{Case, Game, GameOptions, Item, Target, Vive};
+
+/// What only the server knows about a copy.
+#[derive(Clone, Debug)]
+pub struct CopyTruth {
+    /// Index of its target in `Game::targets`.
+    pub target: usize,
+    /// What touch can tell.
+    pub traits: CopyTraits,
+    /// The one real copy of its target?
+    pub real: bool,
+    /// Its haptic geometry (generated once at set-up).
+    pub mesh: HapticMesh,
+    /// Its material.
+    pub material: Material,
+}
+
+pub(super) fn new_game(level: Level, options: &GameOptions) -> Game {
+    let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+    let walls = WallSet::new(&level);
+    let nav = NavGraph::new(&level);
+
+    // Copies first, each tagged with its truth; then shuffle so item ids and cases say nothing.
+    let mut copies = Vec::new();
+    let mut targets = Vec::new();
+    for (t, spec) in level.targets.iter().enumerate() {
+        let target_seed = options.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15).wrapping_add(t as u64);
+        let (traits, real_index) = artifact::generate_copies(spec.kind, target_seed, spec.copies);
+        targets.push(Target {
+            kind: spec.kind,
+            briefing: artifact::briefing(&traits[real_index]),
+            secured: false,
+        });
+        for (c, tr) in traits.into_iter().enumerate() {
+            let mesh = artifact::build_mesh(&tr, target_seed.wrapping_add(c as u64 * 7919));
+            let material = tr.material.material();
+            let kind = ItemKind::Copy { artifact: spec.kind, look: artifact::look(spec.kind) };
+            copies.push((kind, CopyTruth { target: t, traits: tr, real: c == real_index, mesh, material }));
+        }
+    }
+    copies.shuffle(&mut rng);
+    let mut case_order: Vec<usize> = (0..level.cases.len()).collect();
+    case_order.shuffle(&mut rng);
+
+    let mut items: Vec<Item> = copies
+        .into_iter()
+        .zip(&case_order)
+        .map(|((kind, truth), &case)| Item {
+            kind,
+            place: ItemPlace::InCase(CaseId(case as u16)),
+            truth: Some(truth),
+        })
+        .collect();
+    items.extend(level.props.iter().map(|&p| Item { kind: ItemKind::Prop, place: ItemPlace::Floor(p), truth: None }));
+
+    let guards = level
+        .guards
+        .iter()
+        .enumerate()
+        .map(|(i, g)| Guard::new(GuardId(i as u16), g.name.clone(), g.route.clone()))
+        .collect();
+    let cases = level.cases.iter().map(|c| Case { position: c.at, broken: false }).collect();
+    let vive = Vive { position: level.vive_spawn, facing: 0.0, ..Default::default() };
+    let time_left_s = options.time_limit_s.unwrap_or(level.time_limit_s);
+
+    Game {
+        walls,
+        nav,
+        phase: Phase::Lobby,
+        time_left_s,
+        elapsed_s: 0.0,
+        alarm: 0,
+        vive,
+        guards,
+        cases,
+        items,
+        targets,
+        workbench: None,
+        present: (false, false),
+        ready: (false, false),
+        absent_s: 0.0,
+        noises: Vec::new(),
+        outgoing: Vec::new(),
+        rng,
+        level,
+    }
+}
+
+impl Game {
+    /// The id of item number `index`.
+    pub fn item_id(index: usize) -> ItemId {
+        ItemId(index as u16)
+    }
+
+    /// Positions of items that lie on the floor (for tests and bots' sanity checks).
+    pub fn floor_items(&self) -> impl Iterator<Item = (ItemId, Vec2)> + '_ {
+        self.items.iter().enumerate().filter_map(|(i, it)| match it.place {
+            ItemPlace::Floor(p) => Some((Self::item_id(i), p)),
+            _ => None,
+        })
+    }
+
+    /// A uniform random number in `0..1` from the session's seeded generator.
+    pub fn random(&mut self) -> f32 {
+        use rand::Rng;
+        self.rng.random::<f32>()
+    }
+}

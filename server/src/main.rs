@@ -1,0 +1,146 @@
+//! `heist-server`: host a Phantom Heist session, join one as a bot, or watch a whole demo heist.
+
+use std::net::SocketAddr;
+use std::path::PathBuf;
+use std::time::Duration;
+
+use anyhow::Context as _;
+use bevy::prelude::*;
+use clap::{Parser, Subcommand, ValueEnum};
+use heist_bots::{PhantomBotPlugin, ViveBotPlugin, ViveStyle};
+use heist_server::game::GameOptions;
+use heist_server::{Clock, ServerOptions, build_server};
+use heist_shared::level::Level;
+use heist_shared::protocol::Role;
+
+#[derive(Parser)]
+#[command(name = "heist-server", about = "Phantom Heist: the authoritative server, its demo and its bots")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Style {
+    Careful,
+    Reckless,
+    Idle,
+}
+
+impl From<Style> for ViveStyle {
+    fn from(s: Style) -> Self {
+        match s {
+            Style::Careful => ViveStyle::Careful,
+            Style::Reckless => ViveStyle::Reckless,
+            Style::Idle => ViveStyle::Idle,
+        }
+    }
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Host a session on loopback with both bots, print the live log and the result.
+    Demo {
+        /// Seed for the copies and the guards.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Level file (default: the shipped museum).
+        #[arg(long)]
+        level: Option<PathBuf>,
+        /// How the Vive bot plays.
+        #[arg(long, value_enum, default_value_t = Style::Careful)]
+        vive: Style,
+        /// Override the level's time limit, seconds.
+        #[arg(long)]
+        time_limit: Option<f32>,
+    },
+    /// Host a session for players: prints the address and the join code.
+    Host {
+        /// UDP game address; the token endpoint listens on the same port over TCP.
+        #[arg(long, default_value = "127.0.0.1:5757")]
+        bind: SocketAddr,
+        /// Seed for the copies and the guards.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Level file (default: the shipped museum).
+        #[arg(long)]
+        level: Option<PathBuf>,
+        /// Accept clients without tokens, claiming any role. LAN development only.
+        #[arg(long)]
+        insecure: bool,
+    },
+    /// Join a hosted session as a bot.
+    Join {
+        /// The host's game address.
+        addr: SocketAddr,
+        /// Join code printed by the host.
+        #[arg(long)]
+        code: String,
+        /// Role to play.
+        #[arg(long)]
+        role: Role,
+        /// How a Vive bot plays.
+        #[arg(long, value_enum, default_value_t = Style::Careful)]
+        vive: Style,
+    },
+}
+
+fn load_level(path: Option<PathBuf>) -> anyhow::Result<Level> {
+    match path {
+        Some(p) => Ok(Level::load(p)?),
+        None => Ok(Level::museum()),
+    }
+}
+
+fn main() -> anyhow::Result<()> {
+    match Cli::parse().command {
+        Command::Demo { seed, level, vive, time_limit } => {
+            let mut options = ServerOptions::local_test(seed);
+            options.level = load_level(level)?;
+            options.game = GameOptions { seed, time_limit_s: time_limit };
+            options.echo_log = true;
+            println!("Phantom Heist demo: {} with seed {seed}, both bots over loopback UDP", options.level.name);
+            heist_server::demo::run_demo(options, vive.into())?;
+            Ok(())
+        }
+        Command::Host { bind, seed, level, insecure } => {
+            if insecure {
+                eprintln!("WARNING: --insecure: anyone who reaches {bind} can join as any role. LAN development only!");
+            }
+            let options = ServerOptions {
+                level: load_level(level)?,
+                game: GameOptions { seed, time_limit_s: None },
+                bind,
+                token_bind: bind,
+                insecure,
+                clock: Clock::RealTime,
+                echo_log: true,
+                abuse_limit: 50,
+            };
+            let mut server = build_server(options)?;
+            println!("hosting on {} (UDP game, TCP tokens)", server.addr);
+            if !insecure {
+                println!("join code: {}", server.join_code);
+            }
+            server.app.run();
+            Ok(())
+        }
+        Command::Join { addr, code, role, vive } => {
+            let token = heist_client::request_token(addr, &code, role, Duration::from_secs(5))
+                .with_context(|| format!("joining {addr} as {role}"))?;
+            let mut app = App::new();
+            app.add_plugins(MinimalPlugins.set(bevy::app::ScheduleRunnerPlugin::run_loop(Duration::from_secs_f64(1.0 / 60.0))))
+                .add_plugins(heist_client::ClientNetPlugin);
+            match role {
+                Role::Vive => app.add_plugins(ViveBotPlugin { style: vive.into() }),
+                Role::Phantom => app.add_plugins(PhantomBotPlugin::default()),
+            };
+            app.finish();
+            app.cleanup();
+            heist_client::connect(&mut app, token)?;
+            println!("joined {addr} as {role}");
+            app.run();
+            Ok(())
+        }
+    }
+}

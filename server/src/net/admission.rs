@@ -1,0 +1,118 @@
+//! Admitting a client: read role and session from its token, refuse thieves of a taken role.
+
+use bevy::prelude::*;
+use bevy_replicon::prelude::*;
+use bevy_replicon::shared::backend::connected_client::NetworkId;
+use bevy_replicon_renet::netcode::NetcodeServerTransport;
+use heist_shared::protocol::{ClientRole, DisconnectReason, Role, ServerMsg, TokenUserData};
+
+use super::{Auth, NetSettings};
+use crate::session::{GameState, SessionLog};
+
+/// An admitted player's client entity.
+#[derive(Component, Clone, Copy, Debug)]
+pub struct Player {
+    /// Role from the token.
+    pub role: Role,
+    /// Refused messages so far.
+    pub strikes: u32,
+}
+
+/// Which client entity plays which role.
+#[derive(Resource, Default, Debug)]
+pub struct Roles {
+    /// Vive's client.
+    pub vive: Option<Entity>,
+    /// Phantom's client.
+    pub phantom: Option<Entity>,
+}
+
+impl Roles {
+    /// The client playing `role`.
+    pub fn get(&self, role: Role) -> Option<Entity> {
+        match role {
+            Role::Vive => self.vive,
+            Role::Phantom => self.phantom,
+        }
+    }
+
+    fn slot(&mut self, role: Role) -> &mut Option<Entity> {
+        match role {
+            Role::Vive => &mut self.vive,
+            Role::Phantom => &mut self.phantom,
+        }
+    }
+}
+
+/// Disconnects `client` after telling it why.
+pub fn refuse_and_disconnect(
+    client: Entity,
+    reason: DisconnectReason,
+    messages: &mut MessageWriter<'_, ToClients<ServerMsg>>,
+    disconnects: &mut MessageWriter<'_, DisconnectRequest>,
+) {
+    messages.write(ToClients {
+        targets: SendTargets::Single(ClientId::Client(client)),
+        message: ServerMsg::Disconnecting(reason),
+    });
+    disconnects.write(DisconnectRequest { client });
+}
+
+#[allow(clippy::too_many_arguments)]
+pub(super) fn admit(
+    add: On<Add, ConnectedClient>,
+    mut commands: Commands,
+    ids: Query<&NetworkId>,
+    transport: Option<Res<NetcodeServerTransport>>,
+    settings: Res<NetSettings>,
+    mut roles: ResMut<Roles>,
+    mut game: ResMut<GameState>,
+    mut log: ResMut<SessionLog>,
+    mut messages: MessageWriter<ToClients<ServerMsg>>,
+    mut disconnects: MessageWriter<DisconnectRequest>,
+) {
+    let client = add.entity;
+    let user_data = ids.get(client).ok().zip(transport.as_ref()).and_then(|(id, t)| t.user_data(id.get()));
+    let claim = user_data.as_ref().and_then(TokenUserData::decode);
+    let claim = match (&settings.auth, claim) {
+        (Auth::Secure { session, .. }, Some(c)) if c.session == *session => c,
+        (Auth::Insecure, Some(c)) => c,
+        _ => {
+            log.line(game.0.elapsed_s, "a client with a foreign or missing token was refused".into());
+            refuse_and_disconnect(client, DisconnectReason::BadToken, &mut messages, &mut disconnects);
+            return;
+        }
+    };
+    let role = claim.role;
+    if roles.get(role).is_some() {
+        log.line(game.0.elapsed_s, format!("a second {role} was refused: the role is taken"));
+        refuse_and_disconnect(client, DisconnectReason::RoleTaken(role), &mut messages, &mut disconnects);
+        return;
+    }
+    *roles.slot(role) = Some(client);
+    settings.roles.set(role, true);
+    commands.entity(client).insert((Player { role, strikes: 0 }, ClientRole(role)));
+    game.0.join(role);
+    log.line(game.0.elapsed_s, format!("{role} joined"));
+    messages.write(ToClients {
+        targets: SendTargets::Single(ClientId::Client(client)),
+        message: ServerMsg::Welcome { role, level: Box::new(game.0.level.clone()) },
+    });
+}
+
+pub(super) fn forget(
+    remove: On<Remove, ConnectedClient>,
+    players: Query<&Player>,
+    settings: Res<NetSettings>,
+    mut roles: ResMut<Roles>,
+    mut game: ResMut<GameState>,
+    mut log: ResMut<SessionLog>,
+) {
+    let Ok(player) = players.get(remove.entity) else { return };
+    if roles.get(player.role) == Some(remove.entity) {
+        *roles.slot(player.role) = None;
+        settings.roles.set(player.role, false);
+        game.0.leave(player.role);
+        log.line(game.0.elapsed_s, format!("{} left", player.role));
+    }
+}

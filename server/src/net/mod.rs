@@ -1,0 +1,142 @@
+//! The server's network side: the UDP transport, the token endpoint, admitting clients by the role in
+//! their token, and moving messages between clients and the game.
+//!
+//! Systems run in `PreUpdate` (receive, after replicon's receive) and `PostUpdate` (send, before
+//! replicon's send).
+
+pub mod receive;
+pub mod send;
+pub mod tokens;
+mod admission;
+
+use std::net::{SocketAddr, UdpSocket};
+use std::time::{SystemTime, UNIX_EPOCH};
+
+use bevy::prelude::*;
+use bevy_replicon::prelude::*;
+use bevy_replicon_renet::netcode::{NetcodeServerTransport, ServerAuthentication, ServerConfig};
+use bevy_replicon_renet::renet::ConnectionConfig;
+use bevy_replicon_renet::{RenetChannelsExt, RenetServer};
+use heist_shared::protocol::{PROTOCOL_ID, Role};
+
+pub use admission::{Player, Roles};
+use tokens::RoleTable;
+
+/// How clients prove who they are.
+#[derive(Clone)]
+pub enum Auth {
+    /// Signed connect tokens from the token endpoint (the default).
+    Secure {
+        /// Netcode private key.
+        private_key: [u8; 32],
+        /// Session id the tokens must carry.
+        session: u64,
+    },
+    /// Any client may claim any role: LAN development only.
+    Insecure,
+}
+
+/// Network settings of the server.
+#[derive(Resource, Clone)]
+pub struct NetSettings {
+    /// Authentication mode.
+    pub auth: Auth,
+    /// Roles in play, shared with the token endpoint.
+    pub roles: RoleTable,
+    /// Refused messages tolerated per client before it is disconnected for abuse.
+    pub abuse_limit: u32,
+}
+
+/// The bound game socket, waiting for the transport to be created at start-up.
+#[derive(Resource)]
+struct PendingSocket(Option<UdpSocket>);
+
+/// The server's public game address.
+#[derive(Resource, Clone, Copy, Debug)]
+pub struct ServerAddr(pub SocketAddr);
+
+/// The network schedule sets, in order.
+#[derive(SystemSet, Debug, Clone, PartialEq, Eq, Hash)]
+pub enum NetSystems {
+    /// `PreUpdate`, after replicon's receive: client messages into the game.
+    Receive,
+    /// `PostUpdate`, before replicon's send: game output to clients.
+    Send,
+}
+
+/// Adds the server transport and message handling.
+pub struct ServerNetPlugin {
+    /// Bound UDP socket for the game.
+    pub socket: std::sync::Mutex<Option<UdpSocket>>,
+    /// Settings.
+    pub settings: NetSettings,
+}
+
+impl Plugin for ServerNetPlugin {
+    fn build(&self, app: &mut App) {
+        let socket = self.socket.lock().ok().and_then(|mut s| s.take());
+        if let Some(addr) = socket.as_ref().and_then(|s| s.local_addr().ok()) {
+            app.insert_resource(ServerAddr(addr));
+        }
+        app.insert_resource(PendingSocket(socket))
+            .insert_resource(self.settings.clone())
+            .init_resource::<Roles>()
+            .add_systems(Startup, start_transport)
+            .add_observer(admission::admit)
+            .add_observer(admission::forget)
+            .configure_sets(PreUpdate, NetSystems::Receive.after(ServerSystems::Receive))
+            .configure_sets(PostUpdate, NetSystems::Send.before(ServerSystems::Send))
+            .add_systems(PreUpdate, receive::apply_client_messages.in_set(NetSystems::Receive))
+            .add_systems(PostUpdate, send::send_outgoing.in_set(NetSystems::Send));
+    }
+}
+
+fn start_transport(
+    mut commands: Commands,
+    mut pending: ResMut<PendingSocket>,
+    settings: Res<NetSettings>,
+    channels: Res<RepliconChannels>,
+) {
+    let Some(socket) = pending.0.take() else {
+        error!("no game socket to serve on");
+        return;
+    };
+    let Ok(addr) = socket.local_addr() else {
+        error!("the game socket has no local address");
+        return;
+    };
+    let authentication = match &settings.auth {
+        Auth::Secure { private_key, .. } => ServerAuthentication::Secure { private_key: *private_key },
+        Auth::Insecure => ServerAuthentication::Unsecure,
+    };
+    let config = ServerConfig {
+        current_time: SystemTime::now().duration_since(UNIX_EPOCH).unwrap_or_default(),
+        // Room for a third client, so it can be told why it is refused.
+        max_clients: 4,
+        protocol_id: PROTOCOL_ID,
+        public_addresses: vec![addr],
+        authentication,
+    };
+    match NetcodeServerTransport::new(config, socket) {
+        Ok(transport) => {
+            let connection = ConnectionConfig {
+                server_channels_config: channels.server_configs(),
+                client_channels_config: channels.client_configs(),
+                ..Default::default()
+            };
+            commands.insert_resource(RenetServer::new(connection));
+            commands.insert_resource(transport);
+        }
+        Err(e) => error!("cannot start the game transport on {addr}: {e}"),
+    }
+}
+
+/// Binds the game socket (loopback for tests, any address for hosting).
+pub fn bind_game_socket(addr: SocketAddr) -> std::io::Result<UdpSocket> {
+    UdpSocket::bind(addr)
+}
+
+/// The role a connected client entity plays, if admitted.
+pub fn role_of(players: &Query<'_, '_, &Player>, client: Entity) -> Option<Role> {
+    players.get(client).ok().map(|p| p.role)
+}

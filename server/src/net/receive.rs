@@ -1,0 +1,52 @@
+//! Client messages into the game: decode (already done by the protocol), check, apply or refuse.
+
+use bevy::prelude::*;
+use bevy_replicon::prelude::*;
+use heist_shared::protocol::{ClientMsg, DisconnectReason, PhantomMsg, PhantomTool, ServerMsg};
+
+use super::admission::{Player, refuse_and_disconnect};
+use super::NetSettings;
+use crate::session::{GameState, SessionLog};
+
+/// Applies every message received this frame, in order.
+#[allow(clippy::too_many_arguments)]
+pub fn apply_client_messages(
+    mut received: MessageReader<FromClient<ClientMsg>>,
+    mut players: Query<&mut Player>,
+    mut game: ResMut<GameState>,
+    mut tool: Query<&mut PhantomTool>,
+    settings: Res<NetSettings>,
+    mut log: ResMut<SessionLog>,
+    mut messages: MessageWriter<ToClients<ServerMsg>>,
+    mut disconnects: MessageWriter<DisconnectRequest>,
+) {
+    for FromClient { client_id, message } in received.read() {
+        let ClientId::Client(client) = *client_id else { continue };
+        let Ok(mut player) = players.get_mut(client) else {
+            // Not admitted (yet, or refused): nothing it says counts.
+            continue;
+        };
+        if player.strikes > settings.abuse_limit {
+            continue; // already being disconnected
+        }
+        if let ClientMsg::Phantom(PhantomMsg::ToolPose { position, rotation }) = message
+            && position.is_finite()
+            && rotation.is_finite()
+            && let Ok(mut t) = tool.single_mut()
+        {
+            t.set_if_neq(PhantomTool { position: *position, rotation: *rotation });
+        }
+        if let Err(refusal) = game.0.apply(player.role, message) {
+            player.strikes += 1;
+            log.debug(game.0.elapsed_s, format!("{} refused: {refusal:?}", player.role));
+            messages.write(ToClients {
+                targets: SendTargets::Single(ClientId::Client(client)),
+                message: ServerMsg::Refused(refusal),
+            });
+            if player.strikes > settings.abuse_limit {
+                log.line(game.0.elapsed_s, format!("{} disconnected for abuse", player.role));
+                refuse_and_disconnect(client, DisconnectReason::Abuse, &mut messages, &mut disconnects);
+            }
+        }
+    }
+}

@@ -1,0 +1,314 @@
+//! The Vive bot: plans routes over the room graph, keeps out of guards' sight, breaks cases, carries
+//! copies to the workbench and throws a prop to lure a guard that blocks the way.
+
+use bevy::prelude::*;
+use glam::Vec2;
+use heist_client::Inbox;
+use heist_shared::level::{NavGraph, WallSet};
+use heist_shared::protocol::{
+    CaseView, ClientMsg, Gait, GuardAlert, GuardView, ItemId, ItemKind, ItemPlace, ItemView, LobbyMsg, Phase,
+    SessionView, ViveAvatar, ViveMsg,
+};
+use heist_shared::rules;
+
+use crate::vision::could_see;
+
+/// How the Vive bot plays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ViveStyle {
+    /// Sneaks: avoids sight, waits, lures guards away.
+    #[default]
+    Careful,
+    /// Runs straight for the copies, ignoring guards (gets caught).
+    Reckless,
+    /// Readies up, then stands still at the spawn (lets the timer run out).
+    Idle,
+}
+
+/// Seconds the bot waits for a guard to move before throwing something to lure it away.
+const LURE_AFTER_S: f32 = 4.0;
+/// Seconds the bot waits for guards to leave earshot before breaking a case anyway.
+const BREAK_PATIENCE_S: f32 = 12.0;
+
+/// The Vive bot's memory.
+#[derive(Resource, Default)]
+pub struct ViveBrain {
+    style: ViveStyle,
+    ready_sent: bool,
+    seq: u32,
+    map: Option<(NavGraph, WallSet, Vec2)>,
+    route: Vec<Vec2>,
+    route_goal: Option<Vec2>,
+    waited_s: f32,
+    break_wait_s: f32,
+    trail: Vec<Vec2>,
+    /// Actions taken, for tests and logs.
+    pub actions: Vec<String>,
+}
+
+/// Plays Vive with a given style.
+pub struct ViveBotPlugin {
+    /// Play style.
+    pub style: ViveStyle,
+}
+
+impl Plugin for ViveBotPlugin {
+    fn build(&self, app: &mut App) {
+        app.insert_resource(ViveBrain { style: self.style, ..Default::default() }).add_systems(Update, play);
+    }
+}
+
+/// Everything the bot sees this frame.
+struct View<'a> {
+    me: &'a ViveAvatar,
+    alarm: u8,
+    guards: Vec<&'a GuardView>,
+    cases: Vec<&'a CaseView>,
+    items: Vec<&'a ItemView>,
+    secured: Vec<heist_shared::artifact::ArtifactKind>,
+}
+
+enum Goal {
+    /// Walk towards a point, then do nothing.
+    Go(Vec2),
+    /// Break this case once in reach.
+    Break(Vec2, heist_shared::protocol::CaseId),
+    /// Pick this item up once in reach.
+    Take(Vec2, ItemId),
+    /// Put this copy on the workbench once in reach.
+    Deliver(Vec2, ItemId),
+    /// Nothing to do.
+    Rest,
+}
+
+#[allow(clippy::too_many_arguments)]
+fn play(
+    mut brain: ResMut<ViveBrain>,
+    inbox: Res<Inbox>,
+    time: Res<Time>,
+    session: Query<&SessionView>,
+    avatar: Query<&ViveAvatar>,
+    guards: Query<&GuardView>,
+    cases: Query<&CaseView>,
+    items: Query<&ItemView>,
+    mut out: MessageWriter<ClientMsg>,
+) {
+    let (Ok(session), Ok(me)) = (session.single(), avatar.single()) else { return };
+    if brain.map.is_none()
+        && let Some(level) = &inbox.level
+    {
+        brain.map = Some((NavGraph::new(level), WallSet::new(level), level.workbench));
+    }
+    if session.phase == Phase::Lobby && !brain.ready_sent && inbox.role.is_some() {
+        out.write(ClientMsg::Lobby(LobbyMsg::Ready));
+        brain.ready_sent = true;
+    }
+    if session.phase != Phase::Heist || brain.style == ViveStyle::Idle || brain.map.is_none() {
+        return;
+    }
+    let view = View {
+        me,
+        alarm: session.alarm,
+        guards: guards.iter().collect(),
+        cases: cases.iter().collect(),
+        items: items.iter().collect(),
+        secured: session.targets.iter().filter(|t| t.1).map(|t| t.0).collect(),
+    };
+    let dt = time.delta_secs();
+    let goal = choose_goal(&brain, &view);
+    let (direction, gait, action) = steer(&mut brain, &view, goal, dt);
+    if let Some(action) = action {
+        brain.actions.push(format!("{action:?}"));
+        out.write(ClientMsg::Vive(action));
+    }
+    brain.seq += 1;
+    let facing = if direction.length_squared() > 0.0 { direction.y.atan2(direction.x) } else { me.facing };
+    out.write(ClientMsg::Vive(ViveMsg::Move { seq: brain.seq, direction, gait, facing }));
+}
+
+fn is_copy(view: &View<'_>, id: ItemId) -> bool {
+    view.items.iter().any(|i| i.id == id && matches!(i.kind, ItemKind::Copy { .. }))
+}
+
+fn choose_goal(brain: &ViveBrain, view: &View<'_>) -> Goal {
+    let Some((_, _, workbench)) = &brain.map else { return Goal::Rest };
+    let me = view.me.position;
+    let carried_copy = view.me.carrying.iter().copied().find(|&i| is_copy(view, i));
+    let carrying_prop = view.me.carrying.iter().any(|&i| !is_copy(view, i));
+    let hands_full = view.me.carrying.len() >= rules::CARRY_LIMIT;
+
+    // Copies still worth fetching: their artifact is not secured yet.
+    let wanted = view.items.iter().filter(|i| match &i.kind {
+        ItemKind::Copy { artifact, .. } => !view.secured.contains(artifact),
+        ItemKind::Prop => false,
+    });
+    let fetchable: Vec<(Vec2, &ItemView)> = wanted
+        .filter_map(|i| match i.place {
+            ItemPlace::Floor(p) => Some((p, *i)),
+            ItemPlace::InCase(c) => view.cases.iter().find(|cv| cv.id == c).map(|cv| (cv.position, *i)),
+            _ => None,
+        })
+        .collect();
+    let nearest = fetchable.iter().min_by(|a, b| me.distance(a.0).total_cmp(&me.distance(b.0)));
+
+    if let Some(copy) = carried_copy {
+        // A second copy close by is worth the detour when hands allow.
+        if !hands_full
+            && let Some((p, item)) = nearest
+            && me.distance(*p) < 6.0
+        {
+            return goal_for(view, *p, item);
+        }
+        return Goal::Deliver(*workbench, copy);
+    }
+    if !carrying_prop
+        && !hands_full
+        && let Some((p, prop)) = view
+            .items
+            .iter()
+            .filter(|i| matches!(i.kind, ItemKind::Prop))
+            .filter_map(|i| match i.place {
+                ItemPlace::Floor(p) => Some((p, *i)),
+                _ => None,
+            })
+            .min_by(|a, b| me.distance(a.0).total_cmp(&me.distance(b.0)))
+        && me.distance(p) < 5.0
+    {
+        return Goal::Take(p, prop.id);
+    }
+    match nearest {
+        Some((p, item)) => goal_for(view, *p, item),
+        None => Goal::Go(*workbench),
+    }
+}
+
+fn goal_for(view: &View<'_>, at: Vec2, item: &ItemView) -> Goal {
+    match item.place {
+        ItemPlace::InCase(c) if view.cases.iter().any(|cv| cv.id == c && !cv.broken) => Goal::Break(at, c),
+        _ => Goal::Take(at, item.id),
+    }
+}
+
+/// Turns a goal into a movement and maybe an action, keeping out of sight.
+fn steer(brain: &mut ViveBrain, view: &View<'_>, goal: Goal, dt: f32) -> (Vec2, Gait, Option<ViveMsg>) {
+    let me = view.me.position;
+    let (target, in_reach_action) = match goal {
+        Goal::Rest => return (Vec2::ZERO, Gait::Crouch, None),
+        Goal::Go(p) => (p, None),
+        Goal::Break(p, c) => (p, Some(ViveMsg::Break(c))),
+        Goal::Take(p, i) => (p, Some(ViveMsg::PickUp(i))),
+        Goal::Deliver(p, i) => {
+            let busy = view.items.iter().any(|it| it.place == ItemPlace::Workbench);
+            (p, (!busy).then_some(ViveMsg::PlaceOnWorkbench(i)))
+        }
+    };
+    let reckless = brain.style == ViveStyle::Reckless;
+    let Some((nav, walls, home)) = brain.map.clone() else { return (Vec2::ZERO, Gait::Walk, None) };
+
+    // Chased: run for the place we reach furthest ahead of the guard, and hope it loses sight.
+    if !reckless && let Some(g) = view.guards.iter().find(|g| g.alert == GuardAlert::Chasing) {
+        let lead = |p: Vec2| nav.route_length(g.position, p) - nav.route_length(me, p);
+        let refuge = nav.room_centres().chain([home]).max_by(|a, b| lead(*a).total_cmp(&lead(*b))).unwrap_or(home);
+        let first = nav.route(me, refuge).and_then(|r| r.first().copied()).unwrap_or(refuge);
+        brain.route_goal = None;
+        return ((first - me).normalize_or_zero(), Gait::Run, None);
+    }
+    let exposed = !reckless && view.guards.iter().any(|g| could_see(g, me, true, view.alarm, &walls));
+
+    if me.distance(target) <= rules::REACH * 0.8 {
+        let Some(action) = in_reach_action else { return (Vec2::ZERO, Gait::Crouch, None) };
+        if let ViveMsg::Break(_) = action
+            && !reckless
+            && !safe_to_break(&nav, view, target)
+        {
+            brain.break_wait_s += dt;
+            if exposed {
+                return retreat(brain, view, me, &walls);
+            }
+            if brain.break_wait_s < BREAK_PATIENCE_S {
+                return (Vec2::ZERO, Gait::Crouch, None);
+            }
+        }
+        brain.break_wait_s = 0.0;
+        return (Vec2::ZERO, Gait::Walk, Some(action));
+    }
+
+    if brain.route_goal.is_none_or(|g| g.distance(target) > 0.3) || brain.route.is_empty() {
+        let guard_rooms: Vec<usize> = view.guards.iter().filter_map(|g| nav.room_at(g.position)).collect();
+        let cost = |room: usize| 1.0 + 3.0 * guard_rooms.iter().filter(|&&r| r == room).count() as f32;
+        brain.route = if reckless { nav.route(me, target) } else { nav.route_avoiding(me, target, cost) }
+            .unwrap_or_else(|| vec![target]);
+        brain.route.reverse();
+        brain.route_goal = Some(target);
+    }
+    while brain.route.len() > 1 && brain.route.last().is_some_and(|w| w.distance(me) < 0.25) {
+        brain.route.pop();
+    }
+    let Some(&waypoint) = brain.route.last() else { return (Vec2::ZERO, Gait::Walk, None) };
+    let direction = (waypoint - me).normalize_or_zero();
+    if reckless {
+        return (direction, Gait::Run, None);
+    }
+
+    let next = me + direction * 0.8;
+    let seen_standing = view.guards.iter().any(|g| could_see(g, next, false, view.alarm, &walls));
+    let seen_crouching = view.guards.iter().any(|g| could_see(g, next, true, view.alarm, &walls));
+    if !seen_standing {
+        brain.waited_s = 0.0;
+        brain.trail.push(me);
+        if brain.trail.len() > 600 {
+            brain.trail.remove(0);
+        }
+        // Walking is quiet; running only when no guard could hear the footsteps.
+        let far = view.guards.iter().all(|g| nav.heard_margin(me, g.position, rules::RUN_LOUDNESS * 1.5) < 0.0);
+        return (direction, if far { Gait::Run } else { Gait::Walk }, None);
+    }
+    if !seen_crouching {
+        brain.waited_s = 0.0;
+        return (direction, Gait::Crouch, None);
+    }
+    // Blocked: wait, back off if we could be seen where we stand, and lure the guard after a while.
+    brain.waited_s += dt;
+    let blocker = view
+        .guards
+        .iter()
+        .filter(|g| could_see(g, next, true, view.alarm, &walls))
+        .min_by(|a, b| a.position.distance(me).total_cmp(&b.position.distance(me)));
+    if brain.waited_s > LURE_AFTER_S
+        && let Some(g) = blocker
+        && let Some(&prop) = view.me.carrying.iter().find(|&&i| !is_copy(view, i))
+    {
+        brain.waited_s = 0.0;
+        let beyond = g.position + (g.position - me).normalize_or_zero() * 7.0;
+        return (Vec2::ZERO, Gait::Crouch, Some(ViveMsg::Throw { item: prop, target: beyond }));
+    }
+    if exposed {
+        return retreat(brain, view, me, &walls);
+    }
+    (Vec2::ZERO, Gait::Crouch, None)
+}
+
+/// Backs off along the way we came, walking (quiet, and faster than a patrolling guard); with no
+/// trail left, steps straight away from the nearest guard that could see us.
+fn retreat(brain: &mut ViveBrain, view: &View<'_>, me: Vec2, walls: &WallSet) -> (Vec2, Gait, Option<ViveMsg>) {
+    brain.route_goal = None;
+    while let Some(back) = brain.trail.pop() {
+        if back.distance(me) > 0.05 {
+            return ((back - me).normalize_or_zero(), Gait::Walk, None);
+        }
+    }
+    let watcher = view
+        .guards
+        .iter()
+        .filter(|g| could_see(g, me, true, view.alarm, walls))
+        .min_by(|a, b| a.position.distance(me).total_cmp(&b.position.distance(me)));
+    match watcher {
+        Some(g) => ((me - g.position).normalize_or_zero(), Gait::Walk, None),
+        None => (Vec2::ZERO, Gait::Crouch, None),
+    }
+}
+
+fn safe_to_break(nav: &NavGraph, view: &View<'_>, at: Vec2) -> bool {
+    let hearing = 1.0 + 0.25 * f32::from(view.alarm);
+    view.guards.iter().all(|g| nav.heard_margin(at, g.position, rules::GLASS_LOUDNESS * hearing) < -2.0)
+}

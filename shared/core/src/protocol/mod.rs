@@ -1,0 +1,65 @@
+//! The network protocol: one message enum per direction, the rule of who may send what when,
+//! the channels, the replicated components, and the plugin that registers all of it.
+//!
+//! Server and clients must add [`ProtocolPlugin`] in the same order so their protocol hashes match.
+
+mod client_msg;
+mod ids;
+mod replicated;
+mod server_msg;
+mod token;
+mod verify;
+
+pub use client_msg::{ClientMsg, Gait, LobbyMsg, PhantomMsg, ViveMsg, WarningKind};
+pub use ids::{CaseId, GuardId, ItemId, Role};
+pub use replicated::{
+    Audience, CaseView, ClientRole, GuardAlert, GuardView, ItemKind, ItemPlace, ItemView, LossReason, Phase, PhantomTool,
+    SessionView, Stance, ViveAvatar, REPLICATED,
+};
+pub use server_msg::{
+    DisconnectReason, GameEvent, NoiseKind, Refusal, ServerMsg, VerdictOutcome, WorkbenchCopy,
+};
+pub use token::{JoinRequest, JoinResponse, TokenUserData, USER_DATA_MAGIC};
+pub use verify::verify;
+
+use bevy::prelude::*;
+use bevy_replicon::prelude::*;
+
+/// Netcode protocol id: bumps whenever the wire format changes.
+pub const PROTOCOL_ID: u64 = 0x5048_4549_5354_0001;
+
+/// Server simulation rate (FixedUpdate), Hz.
+pub const TICK_HZ: f64 = 60.0;
+
+/// The transport channels the game uses, and what travels on each.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GameChannel {
+    /// Client intents and actions, server replies and events: reliable and ordered, so an action is
+    /// never lost or applied before the movement that brought the player in reach.
+    Commands,
+}
+
+impl GameChannel {
+    /// The replicon channel this maps to.
+    pub const fn replicon(self) -> Channel {
+        match self {
+            GameChannel::Commands => Channel::Ordered,
+        }
+    }
+}
+
+/// Registers every replicated component and remote message, in a fixed order.
+pub struct ProtocolPlugin;
+
+impl Plugin for ProtocolPlugin {
+    fn build(&self, app: &mut App) {
+        replicated::register(app);
+        app.add_client_message_with::<ClientMsg>(
+            GameChannel::Commands.replicon(),
+            client_msg::serialize,
+            client_msg::deserialize,
+        )
+        .add_server_message::<ServerMsg>(GameChannel::Commands.replicon())
+        .make_message_independent::<ServerMsg>();
+    }
+}

@@ -1,0 +1,155 @@
+//! Messages from the server to a client.
+
+use bevy::prelude::*;
+use glam::Vec2;
+use serde::{Deserialize, Serialize};
+
+use super::ids::{CaseId, GuardId, ItemId, Role};
+use super::replicated::{GuardAlert, Phase};
+use super::client_msg::WarningKind;
+use crate::artifact::{Briefing, HapticMesh, Material};
+
+/// Everything the server can say to one client.
+#[derive(Message, Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum ServerMsg {
+    /// Sent once after the connection is accepted.
+    Welcome {
+        /// The role the token granted.
+        role: Role,
+        /// The level being played (walls, doors, cases, routes).
+        level: Box<crate::level::Level>,
+    },
+    /// An input was refused; nothing changed.
+    Refused(Refusal),
+    /// The server is about to disconnect this client.
+    Disconnecting(DisconnectReason),
+    /// Phantom only: the spoken description of each target's real copy.
+    Briefings(Vec<Briefing>),
+    /// Phantom only: the copy now on the workbench, with its true geometry and material (no label).
+    Workbench(WorkbenchCopy),
+    /// Something happened that players should hear about.
+    Event(GameEvent),
+}
+
+/// A copy's touchable truth, sent only to Phantom and only while it lies on the workbench.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct WorkbenchCopy {
+    /// The copy.
+    pub item: ItemId,
+    /// Closed triangle mesh, metres, in the workbench frame.
+    pub mesh: HapticMesh,
+    /// What its surface feels like.
+    pub material: Material,
+}
+
+/// Result of a verdict.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum VerdictOutcome {
+    /// Real, declared real: the target is secured.
+    Secured,
+    /// Fake, declared fake: thrown away.
+    Discarded,
+    /// Wrong: the alarm rises and the copy stays on the workbench.
+    Wrong,
+}
+
+/// What makes a noise.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum NoiseKind {
+    /// Running footsteps.
+    Footsteps,
+    /// A display case shattering.
+    Glass,
+    /// A thrown object landing.
+    Thud,
+    /// The alarm bell.
+    Alarm,
+}
+
+/// Something that happened, for logs, speech and sound.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum GameEvent {
+    /// The phase changed.
+    PhaseChanged(Phase),
+    /// A guard's alert state changed.
+    GuardAlert {
+        /// Which guard.
+        guard: GuardId,
+        /// New state.
+        alert: GuardAlert,
+        /// Where the guard is.
+        position: Vec2,
+    },
+    /// A noise was made.
+    Noise {
+        /// What made it.
+        kind: NoiseKind,
+        /// Where.
+        position: Vec2,
+        /// Audible radius, metres.
+        loudness: f32,
+    },
+    /// A case was broken.
+    CaseBroken(CaseId),
+    /// A copy was placed on the workbench.
+    Delivered(ItemId),
+    /// A verdict was given.
+    Verdict {
+        /// The copy.
+        item: ItemId,
+        /// Declared real?
+        declared_real: bool,
+        /// What came of it.
+        outcome: VerdictOutcome,
+    },
+    /// The alarm level changed.
+    Alarm(u8),
+    /// Phantom warns Vive.
+    Warning(WarningKind),
+}
+
+/// Why an input was refused. Sent as data; the session goes on.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Refusal {
+    /// The bytes were not a valid message.
+    Malformed(String),
+    /// That message belongs to the other role.
+    WrongRole,
+    /// Not allowed in the current phase.
+    WrongPhase(Phase),
+    /// A movement faster than allowed (|direction| > 1).
+    TooFast,
+    /// A number was NaN or infinite.
+    NotFinite,
+    /// The target is too far away.
+    OutOfReach,
+    /// No such case, item or target.
+    Unknown,
+    /// The case is already broken.
+    AlreadyBroken,
+    /// The case is intact: break it first.
+    CaseIntact,
+    /// Vive already carries as much as allowed.
+    HandsFull,
+    /// Vive does not carry that item.
+    NotCarried,
+    /// Only artifact copies go on the workbench.
+    NotACopy,
+    /// Something already lies on the workbench.
+    WorkbenchBusy,
+    /// The verdict names something that is not on the workbench.
+    NotOnWorkbench,
+    /// Too many messages this second.
+    RateLimited,
+}
+
+/// Why the server disconnects a client.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum DisconnectReason {
+    /// The role in the token is already played by someone else.
+    RoleTaken(Role),
+    /// The token's user data is not ours or names another session.
+    BadToken,
+    /// Too many refused or malformed messages.
+    Abuse,
+}

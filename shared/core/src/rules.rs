@@ -1,0 +1,26 @@
+//! Game constants both sides must agree on (speeds, reach, limits). The full rule text is docs/rules.md.
+
+/// Vive's top speeds, m/s.
+pub const WALK_SPEED: f32 = 1.6;
+/// Running speed, m/s.
+pub const RUN_SPEED: f32 = 3.5;
+/// Crouching speed, m/s.
+pub const CROUCH_SPEED: f32 = 0.8;
+/// Vive's body radius for wall collision, metres.
+pub const BODY_RADIUS: f32 = 0.3;
+/// How far Vive reaches to break, pick up or place, metres.
+pub const REACH: f32 = 1.5;
+/// Most items Vive can carry at once.
+pub const CARRY_LIMIT: usize = 2;
+/// Farthest throw, metres.
+pub const THROW_RANGE: f32 = 9.0;
+/// Audible radius of breaking glass, metres.
+pub const GLASS_LOUDNESS: f32 = 16.0;
+/// Audible radius of a thrown object landing, metres.
+pub const THUD_LOUDNESS: f32 = 12.0;
+/// Audible radius of running footsteps, metres.
+pub const RUN_LOUDNESS: f32 = 6.0;
+/// Alarm level at which the museum locks down (the heist is lost).
+pub const ALARM_LOCKDOWN: u8 = 3;
+/// Distance at which a guard catches Vive, metres.
+pub const CATCH_DISTANCE: f32 = 0.9;
