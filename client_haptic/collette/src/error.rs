@@ -132,3 +132,26 @@ pub enum IstFileError {
     #[error("invalid .ist content: {0}")]
     Invalid(String),
 }
+
+/// Why a trajectory file could not be read or written.
+#[derive(Debug, thiserror::Error)]
+pub enum TrajectoryError {
+    /// Reading or writing the file failed.
+    #[error("I/O error on {path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// A line is not a valid sample.
+    #[error("{path}:{line}: {message}")]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+}

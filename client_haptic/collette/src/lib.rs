@@ -11,9 +11,10 @@ pub mod error;
 pub mod packing;
 pub mod partitioning;
 pub mod query;
+pub mod scene;
 pub mod shape;
 
-pub use error::{BuildError, IstFileError, MeshError};
+pub use error::{BuildError, IstFileError, MeshError, TrajectoryError};
 pub use packing::{BuildOptions, BuildProgress, BuildReport, build};
 pub use partitioning::{InnerSphereTree, Node};
 pub use shape::{Sphere, TriMesh};
