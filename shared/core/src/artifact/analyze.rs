@@ -72,10 +72,13 @@ fn rim_heights(mesh: &HapticMesh, axis: Vec3) -> Vec<f32> {
     let r_max = mesh.vertices.iter().map(|p| radius(Vec3::from_array(*p))).fold(0.0f32, f32::max);
     let r = (r_max - 0.004).max(0.0);
     let (_, hi) = mesh.bounds();
-    // Only triangles reaching out to the probe circle can be hit.
+    // Only triangles spanning the probe circle can be hit (1 mm margin covers the chords' sag).
     let near: Vec<[Vec3; 3]> = (0..mesh.triangle_count())
         .map(|t| mesh.corners(t))
-        .filter(|c| c.iter().any(|p| radius(*p) >= r - 0.01))
+        .filter(|c| {
+            let (a, b) = c.iter().fold((f32::INFINITY, 0.0f32), |(a, b), p| (a.min(radius(*p)), b.max(radius(*p))));
+            a - 0.001 <= r && r <= b + 0.001
+        })
         .collect();
     probe_angles()
         .map(|phi| {
