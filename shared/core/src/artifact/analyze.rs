@@ -73,8 +73,8 @@ fn rim_heights(mesh: &HapticMesh, axis: Vec3) -> Vec<f32> {
     let r = (r_max - 0.004).max(0.0);
     let (_, hi) = mesh.bounds();
     // Only triangles spanning the probe circle can be hit (1 mm margin covers the chords' sag).
-    let near: Vec<[Vec3; 3]> = (0..mesh.triangle_count())
-        .map(|t| mesh.corners(t))
+    let near: Vec<[Vec3; 3]> = mesh
+        .triangle_corners()
         .filter(|c| {
             let (a, b) = c.iter().fold((f32::INFINITY, 0.0f32), |(a, b), p| (a.min(radius(*p)), b.max(radius(*p))));
             a - 0.001 <= r && r <= b + 0.001
@@ -91,8 +91,8 @@ fn rim_heights(mesh: &HapticMesh, axis: Vec3) -> Vec<f32> {
 
 /// Outermost surface radius at height `y` around the vertical axis through `axis`, metres.
 fn radii_at(mesh: &HapticMesh, axis: Vec3, y: f32) -> Vec<f32> {
-    let near: Vec<[Vec3; 3]> = (0..mesh.triangle_count())
-        .map(|t| mesh.corners(t))
+    let near: Vec<[Vec3; 3]> = mesh
+        .triangle_corners()
         .filter(|c| {
             let (a, b) = c.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), p| (a.min(p.y), b.max(p.y)));
             a <= y && y <= b
@@ -243,8 +243,12 @@ mod tests {
     }
 
     #[test]
-    fn an_empty_mesh_has_no_features() {
+    fn an_empty_or_broken_mesh_has_no_features_and_does_not_panic() {
         assert_eq!(analyze(ArtifactKind::Amphora, &HapticMesh::default()).feature_count, 0);
+        let broken = HapticMesh { vertices: vec![[0.0, f32::NAN, 0.0]], triangles: vec![[0, 5, 9]] };
+        for kind in ArtifactKind::ALL {
+            assert_eq!(analyze(kind, &broken).feature_count, 0);
+        }
     }
 
     proptest::proptest! {

@@ -85,6 +85,14 @@ impl HapticMesh {
         self.triangles[t].map(|i| Vec3::from_array(self.vertices[i as usize]))
     }
 
+    /// Corners of every triangle, metres, skipping triangles with an index out of range.
+    pub fn triangle_corners(&self) -> impl Iterator<Item = [Vec3; 3]> + '_ {
+        self.triangles.iter().filter_map(|t| {
+            let p = |i: u32| self.vertices.get(i as usize).map(|p| Vec3::from_array(*p));
+            Some([p(t[0])?, p(t[1])?, p(t[2])?])
+        })
+    }
+
     /// Enclosed volume, m³; positive when the triangles face outwards.
     pub fn signed_volume(&self) -> f32 {
         // Summed in f64: thousands of small tetrahedra would lose digits in f32.
