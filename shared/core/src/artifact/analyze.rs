@@ -32,8 +32,9 @@ pub struct Observed {
     pub size_m: [f32; 3],
 }
 
-/// Measures the feature count of a copy of `kind` from its mesh alone. The mesh may be moved and
-/// turned about the vertical (+y) axis; it must stand upright.
+/// Measures the feature count of a copy of `kind` from its mesh alone.
+///
+/// The mesh may be moved and turned about the vertical (+y) axis; it must stand upright.
 pub fn analyze(kind: ArtifactKind, mesh: &HapticMesh) -> Observed {
     let (lo, hi) = mesh.bounds();
     // The features are spread evenly around the axis, so the solid's centroid lies on it.
@@ -52,15 +53,16 @@ pub fn analyze(kind: ArtifactKind, mesh: &HapticMesh) -> Observed {
     Observed { kind, feature_count, feature_size_m, size_m: (hi - lo).to_array() }
 }
 
-/// True when the observed copy fits the briefing: same kind, same feature count, and a material
-/// whose nearest class is the briefed one.
+/// True when the observed copy fits the briefing.
+///
+/// Same kind, same feature count, and a material whose [`MaterialClass::nearest`] is the briefed one.
 pub fn matches(briefing: &Briefing, observed: &Observed, material: &Material) -> bool {
     briefing.kind == observed.kind
         && briefing.feature_count == observed.feature_count
         && MaterialClass::nearest(material) == briefing.material
 }
 
-/// Judges a received copy: analyses `mesh` as the briefed kind and [`matches`] it with `briefing`.
+/// Judges a received copy: analyses `mesh` as the briefed kind and [`matches()`] it with `briefing`.
 pub fn judge(briefing: &Briefing, mesh: &HapticMesh, material: &Material) -> bool {
     matches(briefing, &analyze(briefing.kind, mesh), material)
 }

@@ -17,8 +17,9 @@ pub struct Briefing {
     pub text: String,
 }
 
-/// The briefing describing `real` ("The real crown has seven points. It feels hard and smooth,
-/// like polished gold.").
+/// The briefing describing the real copy `real`, with its spoken text.
+///
+/// For example: "The real crown has seven points. It feels hard and smooth, like polished gold."
 pub fn briefing(real: &CopyTraits) -> Briefing {
     let (one, many) = real.kind.feature_noun();
     let noun = if real.feature_count == 1 { one } else { many };

@@ -20,10 +20,11 @@ enum Forgery {
     Both,
 }
 
-/// Generates the traits of `count` copies (raised to [`MIN_COPIES`] if smaller) and the index of the
-/// real one. Every fake differs from the real copy in its feature count, its material or both; the
+/// Generates the traits of `count` copies and the index of the real one; deterministic for a seed.
+///
+/// `count` is raised to [`MIN_COPIES`] if smaller. Every fake differs from the real copy in its feature count, its material or both; the
 /// first two fakes share the material and the count of the real one respectively, so both must be
-/// checked. Copies are pairwise distinct while the kind allows it. Deterministic for a seed.
+/// checked. Copies are pairwise distinct while the kind allows it.
 pub fn generate_copies(kind: ArtifactKind, seed: u64, count: usize) -> (Vec<CopyTraits>, usize) {
     let count = count.max(MIN_COPIES);
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0xC0B1_E5C0_B1E5_0002);

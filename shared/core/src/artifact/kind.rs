@@ -121,8 +121,9 @@ impl MaterialClass {
         }
     }
 
-    /// The class whose [`material`](Self::material) is nearest to `m` (stiffness scaled by
-    /// 1000 N/m, friction by 0.5, damping by 5 N·s/m).
+    /// The class whose [`material`](Self::material) is nearest to `m`.
+    ///
+    /// Distances scale stiffness by 1000 N/m, friction by 0.5 and damping by 5 N·s/m.
     pub fn nearest(m: &Material) -> MaterialClass {
         let distance = |c: MaterialClass| {
             let r = c.material();

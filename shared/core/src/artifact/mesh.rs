@@ -49,8 +49,7 @@ pub enum MeshError {
         /// Its area, m².
         area_m2: f32,
     },
-    /// A directed edge is used twice: either more than two triangles meet there or two neighbours
-    /// disagree on orientation.
+    /// A directed edge is used twice: more than two triangles meet there, or neighbours disagree on winding.
     #[error("edge {edge:?} is used twice in the same direction (second time by triangle {triangle})")]
     NonManifoldEdge {
         /// The edge as (from, to) vertex indices.
@@ -105,8 +104,9 @@ impl HapticMesh {
         (v / 6.0) as f32
     }
 
-    /// Centre of mass of the enclosed solid (uniform density), metres; the bounds' centre when the
-    /// mesh encloses no volume.
+    /// Centre of mass of the enclosed solid (uniform density), metres.
+    ///
+    /// Falls back to the centre of the bounds when the mesh encloses no volume.
     pub fn centroid(&self) -> Vec3 {
         let mut weighted = glam::DVec3::ZERO;
         let mut volume = 0.0f64;
@@ -137,8 +137,10 @@ impl HapticMesh {
         it.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p)))
     }
 
-    /// Checks that the mesh is a closed, manifold, consistently outward-wound surface with finite
-    /// vertices and no degenerate triangle.
+    /// Checks that the mesh is a valid haptic surface, naming the first offender.
+    ///
+    /// Valid means: finite vertices, indices in range, no triangle below [`MIN_TRIANGLE_AREA_M2`],
+    /// closed, manifold, consistently wound, and a positive enclosed volume (outward).
     pub fn validate(&self) -> Result<(), MeshError> {
         if self.triangles.is_empty() {
             return Err(MeshError::Empty);

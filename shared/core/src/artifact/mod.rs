@@ -4,7 +4,7 @@
 //! You need this module to set up a heist (server: [`generate_copies`], [`build_mesh`],
 //! [`briefing`]), to show an artifact to the sighted player ([`look`], which carries no trait), to
 //! render a copy haptically ([`HapticMesh`], [`Material`]), or to judge a copy from its geometry
-//! like the Phantom bot does ([`analyze`], [`matches`], [`judge`]). Everything here is pure and deterministic
+//! like the Phantom bot does ([`analyze`], [`matches()`], [`judge`]). Everything here is pure and deterministic
 //! for a seed. Coordinates are metres, +y up; see `docs/artifacts.md`.
 
 mod analyze;

@@ -28,8 +28,10 @@ const _: () = assert!(
         && IDOL_NOTCH_WIDTH_M >= 0.012
 );
 
-/// Builds the closed haptic mesh of one copy. `seed` only turns the features around the axis and
-/// varies each feature's size by ±10 %; the count and the outline come from `traits`.
+/// Builds the closed haptic mesh of one copy, metres, +y up, centred near the origin.
+///
+/// `seed` only turns the features around the axis and varies each feature's size by ±10 %; the
+/// count and the outline come from `traits`.
 pub fn build_mesh(traits: &CopyTraits, seed: u64) -> HapticMesh {
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5EED_A27F_AC75_0001);
     let n = traits.feature_count as usize;
