@@ -37,8 +37,26 @@ pub fn briefing(real: &CopyTraits) -> Briefing {
 /// `n` in English words ("seven", "twenty-one"); digits from one thousand up.
 pub fn number_in_words(n: u32) -> String {
     const SMALL: [&str; 20] = [
-        "no", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine", "ten", "eleven", "twelve",
-        "thirteen", "fourteen", "fifteen", "sixteen", "seventeen", "eighteen", "nineteen",
+        "no",
+        "one",
+        "two",
+        "three",
+        "four",
+        "five",
+        "six",
+        "seven",
+        "eight",
+        "nine",
+        "ten",
+        "eleven",
+        "twelve",
+        "thirteen",
+        "fourteen",
+        "fifteen",
+        "sixteen",
+        "seventeen",
+        "eighteen",
+        "nineteen",
     ];
     const TENS: [&str; 10] = ["", "", "twenty", "thirty", "forty", "fifty", "sixty", "seventy", "eighty", "ninety"];
     match n {
@@ -57,11 +75,8 @@ mod tests {
 
     #[test]
     fn a_crown_briefing_reads_naturally() {
-        let b = briefing(&CopyTraits {
-            kind: ArtifactKind::Crown,
-            feature_count: 7,
-            material: MaterialClass::HardSmooth,
-        });
+        let b =
+            briefing(&CopyTraits { kind: ArtifactKind::Crown, feature_count: 7, material: MaterialClass::HardSmooth });
         assert_eq!(b.text, "The real crown has seven points. It feels hard and smooth, like polished gold.");
         assert_eq!((b.kind, b.feature_count, b.material), (ArtifactKind::Crown, 7, MaterialClass::HardSmooth));
     }

@@ -58,10 +58,8 @@ mod tests {
     #[test]
     fn a_swept_cylinder_is_closed_and_outward() {
         let phis = meridians(24, 0.3);
-        let rings: Vec<Vec<Vec3>> = [-0.05, 0.0, 0.05]
-            .iter()
-            .map(|&y| phis.iter().map(|&p| on_meridian(p, 0.04, y)).collect())
-            .collect();
+        let rings: Vec<Vec<Vec3>> =
+            [-0.05, 0.0, 0.05].iter().map(|&y| phis.iter().map(|&p| on_meridian(p, 0.04, y)).collect()).collect();
         let mesh = close_rings(Vec3::new(0.0, -0.05, 0.0), &rings, Vec3::new(0.0, 0.05, 0.0));
         assert_eq!(mesh.validate(), Ok(()));
         assert_eq!(mesh.triangle_count(), 2 * 24 * 3);
