@@ -1,1 +1,28 @@
-//! haptic_rig (being built).
+//! haptic_rig: the wiring of haptico, collette and forcecomp (the paper's EventHandler, §3.6).
+//!
+//! Three threads: the game thread steers a [`HapticRig`]; the haptic thread (haptico, 1 kHz) reads the
+//! device and runs the [`force::ForceStage`] on `ForceOnHapticTick` (penalty force, virtual coupling,
+//! safety); the collision thread ([`collision`], collette's budgeted queries, 1 kHz) turns the latest
+//! tool pose into contacts. The threads exchange latest values through triple buffers and commands
+//! through fixed-capacity ring buffers; nothing on either real-time thread allocates, locks or logs in
+//! steady state.
+//!
+//! You need this crate to run the whole loop, or as the example to copy when you swap one part.
+//! [`bench`] holds the pieces of the `haptic-bench` binary (windowed rates, CSV, the Fig. 9 plot).
+#![warn(missing_docs)]
+
+pub mod bench;
+pub mod collision;
+pub mod error;
+pub mod force;
+pub mod frame;
+pub mod lockstep;
+pub mod rig;
+pub mod workspace;
+
+pub use collision::{CollisionConfig, StepTiming};
+pub use error::{Result, RigError};
+pub use force::{ForceSample, Rendering, RigTelemetry};
+pub use frame::{CollisionFrame, MAX_OBJECTS, ObjectContacts, ObjectSpec, ToolPoseMsg, ToolSpec};
+pub use rig::{HapticRig, RigConfig};
+pub use workspace::WorkspaceMap;

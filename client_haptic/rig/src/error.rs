@@ -1,0 +1,24 @@
+//! Errors of the rig (start-up and control only; the threads' hot paths return none).
+
+/// What can go wrong when starting or steering the rig.
+#[derive(Debug, thiserror::Error)]
+pub enum RigError {
+    /// The device layer refused.
+    #[error(transparent)]
+    Haptico(#[from] haptico::HapticoError),
+    /// A force parameter is out of range.
+    #[error(transparent)]
+    ForceComp(#[from] forcecomp::ForceCompError),
+    /// A command could not be queued: the thread is stopped or not keeping up.
+    #[error("the {0} thread's command queue is full (is it running?)")]
+    QueueFull(&'static str),
+    /// No room for another object.
+    #[error("at most {0} objects can be watched at once")]
+    TooManyObjects(usize),
+    /// The operating system refused to start the collision thread.
+    #[error("cannot start the collision thread: {0}")]
+    Spawn(std::io::Error),
+}
+
+/// `Result` with [`RigError`].
+pub type Result<T, E = RigError> = std::result::Result<T, E>;

@@ -1,0 +1,172 @@
+//! The force stage bound to the haptic thread's ForceOnHapticTick: contacts → volumetric penalty →
+//! virtual coupling → safety layer → device, then the tool pose goes back to the collision thread.
+//!
+//! You need this module to assemble the loop yourself (the rig binds it for you). Everything it touches
+//! per tick is preallocated: the triple buffers' frames, the force-sample ring, the coupling and safety
+//! state.
+
+use forcecomp::{BodyMotion, SafetyLayer, SafetyPhase, SafetyStats, VirtualCoupling, volumetric_penalty};
+use glam::Vec3;
+use haptic_common::{DeviceState, ForceOnHapticTick, ForceTorque, Pose};
+
+use crate::WorkspaceMap;
+use crate::frame::{CollisionFrame, ToolPoseMsg};
+
+/// One tick's forces, recorded for plots (preallocated ring; lost when full).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ForceSample {
+    /// Device timestamp, µs.
+    pub t_us: u64,
+    /// Force sent to the device, N.
+    pub force: Vec3,
+    /// Torque sent to the device, N·m.
+    pub torque: Vec3,
+    /// Contact force on the simulated tool before coupling and safety (device frame), N.
+    pub contact_force: Vec3,
+    /// Contacts used.
+    pub contacts: u32,
+    /// Age of the contact data, µs.
+    pub data_age_us: u32,
+}
+
+/// Latest state of the force stage, for the game thread.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RigTelemetry {
+    /// The device sample of the last tick.
+    pub device: DeviceState,
+    /// The simulated tool in the scene.
+    pub tool_pose: Pose,
+    /// Force and torque sent to the device on the last tick.
+    pub output: ForceTorque,
+    /// Contacts in the frame used.
+    pub contacts: u32,
+    /// Sequence of the collision frame used.
+    pub collision_sequence: u64,
+    /// Age of that frame's data, µs.
+    pub data_age_us: u64,
+    /// Safety phase.
+    pub safety_phase: SafetyPhase,
+    /// Safety gain (engagement × watchdog).
+    pub safety_gain: f32,
+    /// Safety counters.
+    pub safety: SafetyStats,
+}
+
+impl Default for RigTelemetry {
+    fn default() -> Self {
+        Self {
+            device: DeviceState::default(),
+            tool_pose: Pose::IDENTITY,
+            output: ForceTorque::ZERO,
+            contacts: 0,
+            collision_sequence: 0,
+            data_age_us: 0,
+            safety_phase: SafetyPhase::WaitingForSmallForce,
+            safety_gain: 0.0,
+            safety: SafetyStats::default(),
+        }
+    }
+}
+
+/// Whether the device feels the contact force through a virtual coupling or directly.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Rendering {
+    /// Virtual coupling (6-DOF, stable for stiff contacts).
+    Coupled,
+    /// The contact force straight to the device (for comparison; unstable when stiff).
+    Direct,
+}
+
+/// The force stage's state (lives on the haptic thread).
+pub struct ForceStage {
+    pub(crate) map: WorkspaceMap,
+    pub(crate) rendering: Rendering,
+    pub(crate) coupling: VirtualCoupling,
+    pub(crate) safety: SafetyLayer,
+    pub(crate) frames: triple_buffer::Output<CollisionFrame>,
+    pub(crate) poses: triple_buffer::Input<ToolPoseMsg>,
+    pub(crate) telemetry: triple_buffer::Input<RigTelemetry>,
+    pub(crate) samples: rtrb::Producer<ForceSample>,
+}
+
+impl ForceStage {
+    /// One tick: adds the safe contact force to whatever earlier delegates added, then replaces the
+    /// tick's total with the safety layer's output. Allocation-free.
+    pub fn on_tick(&mut self, tick: &ForceOnHapticTick) {
+        let device = tick.device;
+        let frame = self.frames.read();
+
+        // The tool as the force law sees it: the simulated tool (or the device itself when direct).
+        let tool_device = match self.rendering {
+            Rendering::Coupled => self.coupling.tool_pose(),
+            Rendering::Direct => device.pose,
+        };
+        let (v, w) = match self.rendering {
+            Rendering::Coupled => (self.coupling.tool_velocity(), self.coupling.tool_angular_velocity()),
+            Rendering::Direct => (device.linear_velocity, device.angular_velocity),
+        };
+        let tool_scene = self.map.to_scene(&tool_device);
+        let com = tool_scene.transform_point(frame.tool_center_of_mass);
+        let tool_motion = BodyMotion {
+            center_of_mass: com,
+            linear_velocity: self.map.velocity_to_scene(v),
+            angular_velocity: self.map.angular_velocity_to_scene(w),
+        };
+        let mut contact = ForceTorque::ZERO;
+        let mut contacts = 0u32;
+        for object in frame.touched() {
+            let material = frame.tool_material.combine(&object.material);
+            let ft = volumetric_penalty(&object.contacts, &tool_motion, &object.motion, &material);
+            contact.force += ft.force;
+            contact.torque += ft.torque;
+            contacts += object.contacts.len() as u32;
+        }
+        // Torque about the tool frame's origin (where the coupling acts) instead of the centre of mass.
+        contact.torque += (com - tool_scene.translation).cross(contact.force);
+        let contact_device = self.map.wrench_to_device(contact);
+
+        let dt = tick.dt_s;
+        let wanted = match self.rendering {
+            Rendering::Coupled => self.coupling.step(&device, contact_device, dt),
+            Rendering::Direct => contact_device,
+        };
+        let age_us = if frame.sequence == 0 { u64::MAX } else { device.timestamp_us.saturating_sub(frame.pose_timestamp_us) };
+        let age_s = if age_us == u64::MAX { f32::INFINITY } else { age_us as f32 * 1e-6 };
+        let before = tick.total();
+        let requested = ForceTorque { force: before.force + wanted.force, torque: before.torque + wanted.torque };
+        let out = self.safety.apply(requested, dt, age_s);
+        tick.set(out);
+
+        let tool_now = match self.rendering {
+            Rendering::Coupled => self.map.to_scene(&self.coupling.tool_pose()),
+            Rendering::Direct => self.map.to_scene(&device.pose),
+        };
+        self.poses.write(ToolPoseMsg {
+            tick: tick.tick,
+            pose: tool_now,
+            linear_velocity: tool_motion.linear_velocity,
+            angular_velocity: tool_motion.angular_velocity,
+            timestamp_us: device.timestamp_us,
+        });
+        let sequence = frame.sequence;
+        let _ = self.samples.push(ForceSample {
+            t_us: device.timestamp_us,
+            force: out.force,
+            torque: out.torque,
+            contact_force: contact_device.force,
+            contacts,
+            data_age_us: age_us.min(u32::MAX as u64) as u32,
+        });
+        self.telemetry.write(RigTelemetry {
+            device,
+            tool_pose: tool_now,
+            output: out,
+            contacts,
+            collision_sequence: sequence,
+            data_age_us: age_us,
+            safety_phase: self.safety.phase(),
+            safety_gain: self.safety.gain(),
+            safety: self.safety.stats(),
+        });
+    }
+}

@@ -1,0 +1,32 @@
+//! Shared helpers of the rig's integration tests: small trees built once per test binary.
+#![allow(dead_code)]
+
+use std::sync::{Arc, OnceLock};
+
+use collette::shape::{box_buffers, uv_sphere_buffers};
+use collette::{BuildOptions, InnerSphereTree, TriMesh};
+
+fn build(mesh: &TriMesh, spheres: usize) -> Arc<InnerSphereTree> {
+    let (tree, _) = collette::build(mesh, &BuildOptions::spheres(spheres), &mut |_| {}).expect("tree builds");
+    Arc::new(tree)
+}
+
+/// A 5 mm-radius ball tool.
+pub fn ball_tool() -> Arc<InnerSphereTree> {
+    static T: OnceLock<Arc<InnerSphereTree>> = OnceLock::new();
+    T.get_or_init(|| {
+        let (v, t) = uv_sphere_buffers(0.005, 16, 24);
+        build(&TriMesh::new(v, t).expect("sphere mesh"), 200)
+    })
+    .clone()
+}
+
+/// A 10 x 2 x 10 cm slab whose top face is at y = 0 (place it with a pose of y = -0.01).
+pub fn slab() -> Arc<InnerSphereTree> {
+    static T: OnceLock<Arc<InnerSphereTree>> = OnceLock::new();
+    T.get_or_init(|| {
+        let (v, t) = box_buffers(glam::Vec3::new(0.05, 0.01, 0.05));
+        build(&TriMesh::new(v, t).expect("box mesh"), 1500)
+    })
+    .clone()
+}
