@@ -4,17 +4,34 @@
 //! wraps them in a hierarchy of bounding spheres. Two ISTs report the overlap volume of the objects
 //! (a lower bound of the true intersection), every overlapping sphere pair with its exact lens volume,
 //! normal and contact point: the input of volumetric penalty forces.
+//!
+//! - Build: [`TriMesh::from_obj`] / [`TriMesh::from_buffers`], then [`build`] with [`BuildOptions`].
+//! - Store: [`InnerSphereTree::save`] / [`InnerSphereTree::load`] (the `.ist` format, see [`io`]).
+//! - Query: [`overlap`], [`overlap_budgeted`], [`overlap_volume`], [`probe`], [`separation`], each with a
+//!   caller-owned [`QueryWorkspace`] and (for contacts) a [`ContactSet`].
+//! - Run: [`CollisionThread::spawn`] gives a [`CollisionHandle`]; poses in through [`PoseWriter`],
+//!   contacts out through [`ContactReader`].
+//! - Benchmark scene (gemstone tool, bunny, scripted trajectory): [`scene`].
 #![warn(missing_docs)]
 
 pub mod bounding_volume;
+pub mod cli;
 pub mod error;
+pub mod io;
 pub mod packing;
 pub mod partitioning;
+pub mod pipeline;
 pub mod query;
+pub mod render;
 pub mod scene;
 pub mod shape;
 
 pub use error::{BuildError, IstFileError, MeshError, TrajectoryError};
 pub use packing::{BuildOptions, BuildProgress, BuildReport, build};
 pub use partitioning::{InnerSphereTree, Node};
+pub use pipeline::{CollisionConfig, CollisionHandle, CollisionThread, ContactReader, ObjectId, PoseWriter, WatcherId};
+pub use query::{Budget, OverlapResult, ProbeHit, QueryWorkspace, Separation, overlap, overlap_budgeted, overlap_volume, probe, separation};
 pub use shape::{Sphere, TriMesh};
+
+/// Types shared with the other haptic crates, re-exported for convenience.
+pub use haptic_common::{Contact, ContactSet, MAX_CONTACTS, Pose};

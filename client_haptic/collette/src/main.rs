@@ -1,1 +1,5 @@
-fn main() {}
+//! The `collette` command: see `collette --help` and [`collette::cli`].
+
+fn main() -> anyhow::Result<()> {
+    collette::cli::run()
+}

@@ -51,7 +51,7 @@ impl BuildOptions {
             (None, Some(c)) => (1000.0 * (1.0 / (1.0 - c.clamp(0.0, 0.99) as f64)).powf(2.0)) as usize,
             (None, None) => Self::DEFAULT_SPHERES,
         };
-        ((n as f64).cbrt() * 7.0).clamp(48.0, 400.0) as usize
+        ((n as f64).cbrt() * 9.3).clamp(48.0, 400.0) as usize
     }
 }
 

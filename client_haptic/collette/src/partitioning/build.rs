@@ -1,4 +1,4 @@
-//! Top-down hierarchy construction: clustering weighted by sphere volume.
+//! Top-down hierarchy construction: clustering weighted by sphere volume (at most 4 children per node).
 
 use super::{InnerSphereTree, Node};
 use crate::bounding_volume::enclosing_sphere;

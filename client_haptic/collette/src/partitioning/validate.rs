@@ -49,8 +49,8 @@ impl InnerSphereTree {
                     return Err(format!("leaf {n} volume {} differs from its spheres' {sum}", node.volume));
                 }
             } else {
-                if node.count == 0 || end > self.nodes.len() as u64 || (node.first as usize) <= n {
-                    return Err(format!("inner node {n} has a bad child range"));
+                if node.count == 0 || node.count > 4 || end > self.nodes.len() as u64 || (node.first as usize) <= n {
+                    return Err(format!("inner node {n} has a bad child range (1 to 4 children after it)"));
                 }
                 let sum: f64 = node.range().map(|c| self.nodes[c].volume as f64).sum();
                 if (sum as f32 - node.volume).abs() > 1e-3 * node.volume.max(1e-30) + 1e-30 {

@@ -51,19 +51,18 @@ fn the_tree_traversal_finds_every_overlapping_pair() {
 }
 
 #[test]
-fn two_ball_trees_approach_the_analytic_lens_from_below() {
-    let mut previous_error = f64::INFINITY;
-    for n in [100, 1000, 5000] {
+fn two_ball_trees_match_the_analytic_lens_from_below() {
+    // Greedy packing of a ball is (nearly) its inscribed ball, so the overlap is the lens of the balls.
+    for (n, tolerance) in [(100, 0.2), (2000, 0.06)] {
         let t = ball(n);
-        let d = 1.0;
-        let analytic = lens_volume(1.0, 1.0, d) as f64;
-        let got = volume(&t, &Pose::IDENTITY, &t, &Pose::from_translation(Vec3::X * d)) as f64;
-        let error = (analytic - got) / analytic;
-        assert!(got <= analytic * 1.0001, "a packing overlap never exceeds the true overlap");
-        assert!(error < previous_error, "n={n}: error {error} did not shrink from {previous_error}");
-        previous_error = error;
+        for d in [0.3f32, 0.7, 1.0] {
+            let analytic = lens_volume(1.0, 1.0, d) as f64;
+            let got = volume(&t, &Pose::IDENTITY, &t, &Pose::from_translation(Vec3::X * d)) as f64;
+            let error = (analytic - got) / analytic;
+            assert!(got <= analytic * 1.0001, "a packing overlap never exceeds the true overlap");
+            assert!(error < tolerance, "n={n} d={d}: relative error {error}");
+        }
     }
-    assert!(previous_error < 0.35, "5000 spheres: relative error {previous_error}");
 }
 
 #[test]

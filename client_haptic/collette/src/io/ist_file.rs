@@ -1,0 +1,202 @@
+//! Reading and writing `.ist` files.
+//!
+//! Layout (all little-endian):
+//!
+//! | offset | size | field |
+//! |---|---|---|
+//! | 0 | 8 | magic `COLLIST\0` |
+//! | 8 | 4 | format version (u32, currently 1) |
+//! | 12 | 4 | header size in bytes (u32, 64) |
+//! | 16 | 4 | sphere count S (u32) |
+//! | 20 | 4 | node count N (u32) |
+//! | 24 | 4 | exact mesh volume (f32) |
+//! | 28 | 36 | reserved, zero |
+//! | 64 | 16·S | spheres: centre x, y, z, radius (f32) |
+//! | 64+16·S | 28·N | nodes: bound centre x, y, z, radius, summed leaf volume (f32), first (u32), count with bit 31 set for leaves (u32) |
+//! | end−4 | 4 | CRC-32 (IEEE) of every preceding byte |
+
+use crate::error::IstFileError;
+use crate::partitioning::{InnerSphereTree, Node};
+use crate::shape::Sphere;
+use glam::Vec3;
+use std::path::Path;
+
+/// First bytes of every `.ist` file.
+pub const MAGIC: [u8; 8] = *b"COLLIST\0";
+/// Version written by this library (and the only one it reads).
+pub const FORMAT_VERSION: u32 = 1;
+/// Size of the fixed header.
+pub const HEADER_SIZE: usize = 64;
+const SPHERE_SIZE: usize = 16;
+const NODE_SIZE: usize = 28;
+const LEAF_BIT: u32 = 1 << 31;
+
+impl InnerSphereTree {
+    /// Serializes the tree in the `.ist` format.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut b = Vec::with_capacity(HEADER_SIZE + SPHERE_SIZE * self.spheres.len() + NODE_SIZE * self.nodes.len() + 4);
+        b.extend_from_slice(&MAGIC);
+        for v in [FORMAT_VERSION, HEADER_SIZE as u32, self.spheres.len() as u32, self.nodes.len() as u32] {
+            b.extend_from_slice(&v.to_le_bytes());
+        }
+        b.extend_from_slice(&self.mesh_volume.to_le_bytes());
+        b.resize(HEADER_SIZE, 0);
+        let f = |b: &mut Vec<u8>, x: f32| b.extend_from_slice(&x.to_le_bytes());
+        for s in &self.spheres {
+            for x in [s.center.x, s.center.y, s.center.z, s.radius] {
+                f(&mut b, x);
+            }
+        }
+        for n in &self.nodes {
+            for x in [n.bound.center.x, n.bound.center.y, n.bound.center.z, n.bound.radius, n.volume] {
+                f(&mut b, x);
+            }
+            b.extend_from_slice(&n.first.to_le_bytes());
+            b.extend_from_slice(&(n.count | if n.leaf { LEAF_BIT } else { 0 }).to_le_bytes());
+        }
+        let crc = crc32fast::hash(&b);
+        b.extend_from_slice(&crc.to_le_bytes());
+        b
+    }
+
+    /// Parses an `.ist` image; a truncated, corrupt or foreign input is an error, never a panic.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self, IstFileError> {
+        let magic_len = bytes.len().min(MAGIC.len());
+        if bytes[..magic_len] != MAGIC[..magic_len] {
+            return Err(IstFileError::NotAnIstFile);
+        }
+        if bytes.len() < HEADER_SIZE + 4 {
+            return Err(IstFileError::Truncated { expected: HEADER_SIZE + 4, found: bytes.len() });
+        }
+        let u = |at: usize| u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]);
+        let version = u(8);
+        if version != FORMAT_VERSION {
+            return Err(IstFileError::UnsupportedVersion { found: version, supported: FORMAT_VERSION });
+        }
+        if u(12) as usize != HEADER_SIZE {
+            return Err(IstFileError::Invalid(format!("header size {} (expected {HEADER_SIZE})", u(12))));
+        }
+        let (spheres, nodes) = (u(16) as usize, u(20) as usize);
+        let expected = HEADER_SIZE + SPHERE_SIZE * spheres + NODE_SIZE * nodes + 4;
+        if bytes.len() < expected {
+            return Err(IstFileError::Truncated { expected, found: bytes.len() });
+        }
+        if bytes.len() > expected {
+            return Err(IstFileError::Invalid(format!("{} bytes after the announced end", bytes.len() - expected)));
+        }
+        let computed = crc32fast::hash(&bytes[..expected - 4]);
+        let found = u(expected - 4);
+        if computed != found {
+            return Err(IstFileError::ChecksumMismatch { found, computed });
+        }
+        let f = |at: usize| f32::from_bits(u(at));
+        let v3 = |at: usize| Vec3::new(f(at), f(at + 4), f(at + 8));
+        let sphere_at = |at: usize| Sphere::new(v3(at), f(at + 12));
+        let tree = InnerSphereTree {
+            spheres: (0..spheres).map(|i| sphere_at(HEADER_SIZE + SPHERE_SIZE * i)).collect(),
+            nodes: (0..nodes)
+                .map(|i| {
+                    let at = HEADER_SIZE + SPHERE_SIZE * spheres + NODE_SIZE * i;
+                    let count = u(at + 24);
+                    Node { bound: sphere_at(at), volume: f(at + 16), first: u(at + 20), count: count & !LEAF_BIT, leaf: count & LEAF_BIT != 0 }
+                })
+                .collect(),
+            mesh_volume: f(24),
+        };
+        tree.validate().map_err(IstFileError::Invalid)?;
+        Ok(tree)
+    }
+
+    /// Writes the tree to `path`.
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<(), IstFileError> {
+        let path = path.as_ref();
+        std::fs::write(path, self.to_bytes()).map_err(|source| IstFileError::Io { path: path.to_owned(), source })
+    }
+
+    /// Reads a tree from `path`.
+    pub fn load(path: impl AsRef<Path>) -> Result<Self, IstFileError> {
+        let path = path.as_ref();
+        let bytes = std::fs::read(path).map_err(|source| IstFileError::Io { path: path.to_owned(), source })?;
+        Self::from_bytes(&bytes)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shape::box_buffers;
+    use crate::{BuildOptions, TriMesh, build};
+
+    fn sample() -> InnerSphereTree {
+        let (v, t) = box_buffers(Vec3::new(1.0, 0.5, 0.25));
+        build(&TriMesh::new(v, t).expect("valid"), &BuildOptions::spheres(300), &mut |_| {}).expect("builds").0
+    }
+
+    #[test]
+    fn a_saved_tree_loads_back_identically_and_faster_than_it_builds() {
+        let t0 = std::time::Instant::now();
+        let tree = sample();
+        let build_time = t0.elapsed();
+        let path = std::env::temp_dir().join(format!("collette-{}.ist", std::process::id()));
+        tree.save(&path).expect("save");
+        let t1 = std::time::Instant::now();
+        let back = InnerSphereTree::load(&path).expect("load");
+        let load_time = t1.elapsed();
+        std::fs::remove_file(&path).ok();
+        assert_eq!(back, tree);
+        assert!(load_time * 10 < build_time, "load {load_time:?} vs build {build_time:?}");
+    }
+
+    #[test]
+    fn truncated_corrupt_and_foreign_data_are_clear_errors() {
+        let bytes = sample().to_bytes();
+        for cut in [0, 3, 20, HEADER_SIZE, bytes.len() / 2, bytes.len() - 1] {
+            let e = InnerSphereTree::from_bytes(&bytes[..cut]).expect_err("truncated");
+            assert!(matches!(e, IstFileError::Truncated { .. }), "cut at {cut}: {e}");
+        }
+        let mut corrupt = bytes.clone();
+        corrupt[HEADER_SIZE + 5] ^= 0x40;
+        assert!(matches!(InnerSphereTree::from_bytes(&corrupt), Err(IstFileError::ChecksumMismatch { .. })));
+        assert!(matches!(InnerSphereTree::from_bytes(b"# OBJ file\nv 0 0 0\n"), Err(IstFileError::NotAnIstFile)));
+        let mut future = bytes.clone();
+        future[8] = 9;
+        assert!(matches!(InnerSphereTree::from_bytes(&future), Err(IstFileError::UnsupportedVersion { found: 9, .. })));
+        let mut longer = bytes;
+        longer.push(0);
+        assert!(matches!(InnerSphereTree::from_bytes(&longer), Err(IstFileError::Invalid(_))));
+    }
+
+    #[test]
+    fn a_well_checksummed_but_inconsistent_tree_is_refused() {
+        let mut bytes = sample().to_bytes();
+        // Point the root past the node array, then fix the checksum so only validation can catch it.
+        let root_first = HEADER_SIZE + SPHERE_SIZE * sample().spheres.len() + 20;
+        bytes[root_first..root_first + 4].copy_from_slice(&9_999_999u32.to_le_bytes());
+        let n = bytes.len() - 4;
+        let crc = crc32fast::hash(&bytes[..n]);
+        bytes[n..].copy_from_slice(&crc.to_le_bytes());
+        assert!(matches!(InnerSphereTree::from_bytes(&bytes), Err(IstFileError::Invalid(_))));
+    }
+
+    mod fuzz {
+        use super::*;
+        use proptest::prelude::*;
+
+        proptest! {
+            #![proptest_config(ProptestConfig::with_cases(256))]
+            #[test]
+            fn no_byte_flip_makes_loading_panic(pos in 0usize..4096, value in any::<u8>(), fix_crc in any::<bool>()) {
+                static BYTES: std::sync::OnceLock<Vec<u8>> = std::sync::OnceLock::new();
+                let mut b = BYTES.get_or_init(|| sample().to_bytes()).clone();
+                let pos = pos % b.len();
+                b[pos] = value;
+                if fix_crc {
+                    let n = b.len() - 4;
+                    let crc = crc32fast::hash(&b[..n]);
+                    b[n..].copy_from_slice(&crc.to_le_bytes());
+                }
+                let _ = InnerSphereTree::from_bytes(&b);
+            }
+        }
+    }
+}
