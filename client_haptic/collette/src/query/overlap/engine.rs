@@ -9,13 +9,14 @@ use haptic_common::Pose;
 use std::time::Instant;
 
 /// How many node pairs are tested between two clock reads.
-const CLOCK_STRIDE: u32 = 16;
+const CLOCK_STRIDE: u32 = 8;
 
 pub(super) struct Engine<'a, S> {
     a: &'a InnerSphereTree,
     b: &'a InnerSphereTree,
     pos12: Pose,
     budget: Budget,
+    aggregate: bool,
     sink: S,
     until_clock: u32,
     exhausted: bool,
@@ -23,9 +24,11 @@ pub(super) struct Engine<'a, S> {
 }
 
 impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
-    pub(super) fn new(a: &'a InnerSphereTree, b: &'a InnerSphereTree, pos12: Pose, budget: Budget, sink: S) -> Self {
+    /// `aggregate`: a node lying wholly inside one leaf sphere of the other tree contributes its summed
+    /// volume as one contact (exact volume, far fewer pairs) instead of one contact per leaf pair.
+    pub(super) fn new(a: &'a InnerSphereTree, b: &'a InnerSphereTree, pos12: Pose, budget: Budget, aggregate: bool, sink: S) -> Self {
         let result = OverlapResult { complete: true, ..OverlapResult::default() };
-        Self { a, b, pos12, budget, sink, until_clock: 0, exhausted: false, result }
+        Self { a, b, pos12, budget, aggregate, sink, until_clock: 0, exhausted: false, result }
     }
 
     /// Exact depth-first descent.
@@ -42,7 +45,7 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
         ws.ring[0] = (0, 0);
         ws.stack.clear();
         while len > 0 {
-            if self.out_of_budget() {
+            if self.out_of_budget(len as f32 * ws.estimate_ns) {
                 break;
             }
             let (ia, ib) = ws.ring[head];
@@ -61,15 +64,23 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
                 self.drain_stack(ws);
             }
         }
-        for k in 0..len {
-            let (ia, ib) = ws.ring[(head + k) % cap];
-            self.estimate(ia, ib);
+        if len > 0 {
+            let start = Instant::now();
+            for k in 0..len {
+                let (ia, ib) = ws.ring[(head + k) % cap];
+                self.estimate(ia, ib);
+            }
+            if len >= 32 {
+                // Keep the reserve calibrated to this machine (slow to shrink, quick to grow).
+                let per = start.elapsed().as_nanos() as f32 / len as f32;
+                ws.estimate_ns = if per > ws.estimate_ns { per } else { 0.9 * ws.estimate_ns + 0.1 * per }.clamp(5.0, 1000.0);
+            }
         }
     }
 
     fn drain_stack(&mut self, ws: &mut QueryWorkspace) {
         while let Some((ia, ib)) = ws.stack.pop() {
-            if self.out_of_budget() {
+            if self.out_of_budget(0.0) {
                 self.estimate(ia, ib);
                 while let Some((ia, ib)) = ws.stack.pop() {
                     self.estimate(ia, ib);
@@ -81,7 +92,8 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
         }
     }
 
-    fn out_of_budget(&mut self) -> bool {
+    /// True once the budget is spent; `reserve_ns` is kept back for estimating what is still queued.
+    fn out_of_budget(&mut self, reserve_ns: f32) -> bool {
         if self.exhausted {
             return true;
         }
@@ -91,7 +103,7 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
             Budget::Deadline(deadline) => {
                 if self.until_clock == 0 {
                     self.until_clock = CLOCK_STRIDE;
-                    Instant::now() >= deadline
+                    Instant::now() + std::time::Duration::from_nanos(reserve_ns as u64) >= deadline
                 } else {
                     self.until_clock -= 1;
                     false
@@ -118,6 +130,9 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
         }
         if na.leaf && nb.leaf {
             self.leaf_pairs(na, nb);
+            return (children, 0);
+        }
+        if self.aggregate && self.contained(na, nb, cb) {
             return (children, 0);
         }
         let descend_a = nb.leaf || (!na.leaf && na.bound.radius >= nb.bound.radius);
@@ -148,6 +163,42 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
                     }
                 }
             }
+        }
+    }
+
+    /// If one node lies wholly inside a single leaf sphere of the other tree, adds the node's volume.
+    ///
+    /// Exact: spheres of one tree are disjoint, so spheres inside one of them overlap no other.
+    #[inline]
+    fn contained(&mut self, na: &Node, nb: &Node, cb: Vec3) -> bool {
+        if nb.leaf {
+            for sb in &self.b.spheres[nb.range()] {
+                let c = self.pos12.transform_point(sb.center);
+                let d = na.bound.center.distance(c);
+                if d + na.bound.radius <= sb.radius {
+                    let l = Lens { volume: na.volume, centroid: na.bound.center, depth: sb.radius + na.bound.radius - d };
+                    self.emit_aggregate(&l, na.bound.center, c);
+                    return true;
+                }
+            }
+        } else if na.leaf {
+            for sa in &self.a.spheres[na.range()] {
+                let d = sa.center.distance(cb);
+                if d + nb.bound.radius <= sa.radius {
+                    let l = Lens { volume: nb.volume, centroid: cb, depth: sa.radius + nb.bound.radius - d };
+                    self.emit_aggregate(&l, sa.center, cb);
+                    return true;
+                }
+            }
+        }
+        false
+    }
+
+    fn emit_aggregate(&mut self, l: &Lens, ca: Vec3, cb: Vec3) {
+        if l.volume > 0.0 {
+            self.result.total_volume += l.volume;
+            self.result.aggregated_pairs += 1;
+            (self.sink)(l, ca, cb);
         }
     }
 

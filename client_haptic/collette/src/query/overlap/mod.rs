@@ -33,6 +33,8 @@ pub struct OverlapResult {
     pub estimated_volume: f32,
     /// Overlapping leaf-sphere pairs found exactly.
     pub leaf_pairs: u32,
+    /// Contacts standing for a whole node inside one leaf sphere (aggregated queries only).
+    pub aggregated_pairs: u32,
     /// Node pairs estimated instead of refined.
     pub estimated_pairs: u32,
     /// Node pairs tested.
@@ -43,7 +45,7 @@ pub struct OverlapResult {
 
 /// Total overlap volume of `a` at `pose_a` and `b` at `pose_b` (exact, no contacts reported).
 pub fn overlap_volume(a: &InnerSphereTree, pose_a: &Pose, b: &InnerSphereTree, pose_b: &Pose, ws: &mut QueryWorkspace) -> OverlapResult {
-    let mut engine = Engine::new(a, b, pose_a.relative_to(pose_b), Budget::Unlimited, |_: &Lens, _: Vec3, _: Vec3| {});
+    let mut engine = Engine::new(a, b, pose_a.relative_to(pose_b), Budget::Unlimited, true, |_: &Lens, _: Vec3, _: Vec3| {});
     engine.run_depth_first(ws);
     engine.result
 }
@@ -60,18 +62,36 @@ pub fn overlap(
     ws: &mut QueryWorkspace,
     out: &mut ContactSet,
 ) -> OverlapResult {
-    overlap_budgeted(a, pose_a, b, pose_b, Budget::Unlimited, ws, out)
+    run(a, pose_a, b, pose_b, Budget::Unlimited, false, ws, out)
 }
 
 /// Anytime overlap: refines breadth-first until `budget` runs out, then estimates every node pair not
 /// yet refined from its bounding spheres' lens scaled by both nodes' fill ratios (summed leaf volume /
 /// bound volume). Estimated pairs are reported as contacts too, so forces stay continuous.
+///
+/// A node lying wholly inside one leaf sphere of the other tree is reported as one contact carrying
+/// the node's summed volume (exact volume, centroid at the node's bound centre, normal from the sphere
+/// centre to it): with `Budget::Unlimited` the total volume is exact, with far fewer pairs to visit.
 pub fn overlap_budgeted(
     a: &InnerSphereTree,
     pose_a: &Pose,
     b: &InnerSphereTree,
     pose_b: &Pose,
     budget: Budget,
+    ws: &mut QueryWorkspace,
+    out: &mut ContactSet,
+) -> OverlapResult {
+    run(a, pose_a, b, pose_b, budget, true, ws, out)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn run(
+    a: &InnerSphereTree,
+    pose_a: &Pose,
+    b: &InnerSphereTree,
+    pose_b: &Pose,
+    budget: Budget,
+    aggregate: bool,
     ws: &mut QueryWorkspace,
     out: &mut ContactSet,
 ) -> OverlapResult {
@@ -84,7 +104,7 @@ pub fn overlap_budgeted(
         let normal = if len > 1e-12 { rot * (delta / len) } else { fallback };
         out.push(Contact { point: pose_a.transform_point(lens.centroid), normal, volume: lens.volume, depth: lens.depth });
     };
-    let mut engine = Engine::new(a, b, pose_a.relative_to(pose_b), budget, sink);
+    let mut engine = Engine::new(a, b, pose_a.relative_to(pose_b), budget, aggregate, sink);
     match budget {
         Budget::Unlimited => engine.run_depth_first(ws),
         _ => engine.run_breadth_first(ws),
