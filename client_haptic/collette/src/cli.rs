@@ -75,7 +75,7 @@ pub fn run() -> anyhow::Result<()> {
         Command::Build { mesh, output, spheres, coverage, resolution, min_radius, scale, json } => {
             let raw = TriMesh::from_obj(&mesh).with_context(|| format!("loading {}", mesh.display()))?;
             let mesh_data = if scale == 1.0 { raw } else { raw.map_vertices(|v| v * scale)? };
-            let options = BuildOptions { target_spheres: spheres, target_coverage: coverage, min_radius, grid_resolution: resolution };
+            let options = BuildOptions { target_spheres: spheres, target_coverage: coverage, min_radius, grid_resolution: resolution, ..BuildOptions::default() };
             let bar = if json { indicatif::ProgressBar::hidden() } else { indicatif::ProgressBar::new(1000) };
             bar.set_style(
                 indicatif::ProgressStyle::with_template("{spinner} [{elapsed_precise}] {wide_bar} {msg}")

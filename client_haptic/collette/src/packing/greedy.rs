@@ -1,6 +1,7 @@
 //! Greedy largest-free-sphere packing on a voxel distance field (the IST method).
 
 use super::distance_field::DistanceField;
+use super::refine::Refiner;
 use crate::shape::Sphere;
 use glam::Vec3;
 use rayon::prelude::*;
@@ -24,7 +25,12 @@ fn key(radius: f32, index: usize) -> u64 {
 ///
 /// Each voxel keeps its free radius: the distance to the surface minus nothing, then minus every placed
 /// sphere (`|p − c| − r`). Stale heap entries are re-queued lazily, so the result is deterministic.
-pub(crate) fn pack(field: &DistanceField, stop: StopRule, progress: &mut dyn FnMut(usize, f64)) -> Vec<Sphere> {
+pub(crate) fn pack(
+    field: &DistanceField,
+    stop: StopRule,
+    mut refiner: Option<&mut Refiner>,
+    progress: &mut dyn FnMut(usize, f64),
+) -> Vec<Sphere> {
     let mut free = field.distance.clone();
     let mut heap: BinaryHeap<u64> = free
         .iter()
@@ -47,10 +53,17 @@ pub(crate) fn pack(field: &DistanceField, stop: StopRule, progress: &mut dyn FnM
             continue;
         }
         let center = field.voxel_center(index);
-        let sphere = Sphere::new(center, current);
+        let sphere = match refiner.as_deref_mut() {
+            Some(r) => {
+                let s = r.refine(center, current);
+                r.insert(s);
+                s
+            }
+            None => Sphere::new(center, current),
+        };
         spheres.push(sphere);
         packed += sphere.volume() as f64;
-        shrink_free_radii(field, &mut free, center, current);
+        shrink_free_radii(field, &mut free, sphere.center, sphere.radius);
         if spheres.len() % report_every == 0 {
             progress(spheres.len(), packed);
         }

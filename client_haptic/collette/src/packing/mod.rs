@@ -5,6 +5,7 @@
 
 mod distance_field;
 mod greedy;
+mod refine;
 
 pub use distance_field::{DistanceField, to_parry};
 
@@ -14,7 +15,7 @@ use crate::shape::TriMesh;
 use std::time::Instant;
 
 /// Options of the builder. With neither target set, packs [`BuildOptions::DEFAULT_SPHERES`] spheres.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct BuildOptions {
     /// Stop after this many spheres. Default: 10,000 when `target_coverage` is also unset.
     pub target_spheres: Option<usize>,
@@ -25,6 +26,15 @@ pub struct BuildOptions {
     /// Voxels along the longest side of the mesh's box. Default: chosen from the sphere target (see
     /// [`BuildOptions::resolution`]).
     pub grid_resolution: Option<usize>,
+    /// Move each centre within its voxel to the point of largest free radius (slower, denser).
+    /// Default: true.
+    pub refine_centers: bool,
+}
+
+impl Default for BuildOptions {
+    fn default() -> Self {
+        Self { target_spheres: None, target_coverage: None, min_radius: None, grid_resolution: None, refine_centers: true }
+    }
 }
 
 impl BuildOptions {
@@ -51,7 +61,7 @@ impl BuildOptions {
             (None, Some(c)) => (1000.0 * (1.0 / (1.0 - c.clamp(0.0, 0.99) as f64)).powf(2.0)) as usize,
             (None, None) => Self::DEFAULT_SPHERES,
         };
-        ((n as f64).cbrt() * 9.3).clamp(48.0, 400.0) as usize
+        ((n as f64).cbrt() * 7.0).clamp(48.0, 400.0) as usize
     }
 }
 
@@ -130,7 +140,8 @@ pub fn build(
         target_volume: options.target_coverage.map_or(f64::INFINITY, |c| c as f64 * mesh_volume),
         min_radius: options.min_radius.unwrap_or(field.voxel_size * 0.25).max(f32::MIN_POSITIVE),
     };
-    let spheres = greedy::pack(&field, stop, &mut |placed, packed| {
+    let mut refiner = options.refine_centers.then(|| refine::Refiner::new(mesh, field.voxel_size * 0.5));
+    let spheres = greedy::pack(&field, stop, refiner.as_mut(), &mut |placed, packed| {
         progress(BuildProgress::Packing { placed, target: max_spheres, coverage: packed / mesh_volume })
     });
     progress(BuildProgress::Hierarchy);
@@ -147,4 +158,48 @@ pub fn build(
         interior_voxels,
     };
     Ok((tree, report))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shape::box_buffers;
+    use glam::Vec3;
+
+    fn slab() -> TriMesh {
+        let (v, t) = box_buffers(Vec3::new(1.0, 0.5, 0.3));
+        TriMesh::new(v, t).expect("valid")
+    }
+
+    #[test]
+    fn every_sphere_lies_inside_the_mesh_and_none_overlap() {
+        let (tree, report) = build(&slab(), &BuildOptions::spheres(400), &mut |_| {}).expect("builds");
+        assert_eq!(report.spheres, 400);
+        let half = Vec3::new(1.0, 0.5, 0.3);
+        for s in tree.spheres() {
+            assert!((s.center.abs() + s.radius).cmple(half * 1.0001).all(), "{s:?} leaves the box");
+        }
+        let sp = tree.spheres();
+        for i in 0..sp.len() {
+            for j in i + 1..sp.len() {
+                assert!(sp[i].center.distance(sp[j].center) >= (sp[i].radius + sp[j].radius) * (1.0 - 1e-4), "{i} and {j} overlap");
+            }
+        }
+        assert!((report.coverage - tree.coverage() as f64).abs() < 1e-3);
+    }
+
+    #[test]
+    fn the_same_input_gives_the_same_tree() {
+        let a = build(&slab(), &BuildOptions::spheres(300), &mut |_| {}).expect("builds").0;
+        let b = build(&slab(), &BuildOptions::spheres(300), &mut |_| {}).expect("builds").0;
+        assert_eq!(a, b);
+    }
+
+    #[test]
+    fn a_coverage_target_stops_the_packing_and_bad_options_are_refused() {
+        let (_, report) = build(&slab(), &BuildOptions::coverage(0.6), &mut |_| {}).expect("builds");
+        assert!(report.coverage >= 0.6 && report.coverage < 0.7, "{}", report.coverage);
+        assert!(matches!(build(&slab(), &BuildOptions::coverage(1.5), &mut |_| {}), Err(BuildError::InvalidOption(_))));
+        assert!(matches!(build(&slab(), &BuildOptions::spheres(0), &mut |_| {}), Err(BuildError::InvalidOption(_))));
+    }
 }
