@@ -5,7 +5,7 @@ use crate::bounding_volume::enclosing_sphere;
 use crate::shape::Sphere;
 
 /// Maximum number of spheres in a leaf node.
-pub const LEAF_SIZE: usize = 2;
+pub const LEAF_SIZE: usize = 1;
 
 impl InnerSphereTree {
     /// Builds the hierarchy over packed spheres (reordered so each leaf holds a contiguous range).

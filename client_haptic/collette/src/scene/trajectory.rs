@@ -15,7 +15,7 @@ pub const TRAJECTORY_RATE_HZ: u32 = 1000;
 pub enum Phase {
     /// The tool is away from the bunny (about 3 cm out).
     Free,
-    /// The tool slides along the surface, penetrating a few millimetres at most.
+    /// The tool slides along the surface, penetrating up to about 2 mm.
     Grazing,
     /// The tool is pushed 1–3 cm into the bunny.
     Deep,
@@ -61,7 +61,8 @@ fn smoothstep(a: f32, b: f32, x: f32) -> f32 {
 /// Scripted distance of the tool centre beyond the surface (metres) and phase at time `t` (seconds).
 fn offset(t: f32) -> (f32, Phase) {
     const FREE: f32 = 0.03;
-    let graze = 0.002 + 0.001 * (TAU * t / 1.7).sin();
+    // The gem reaches 3.6-5 mm from its centre, so this keeps 0 to about 2 mm of penetration.
+    let graze = 0.0042 + 0.001 * (TAU * t / 1.7).sin();
     let deep = -0.02 - 0.01 * (TAU * t / 3.1).sin();
     let mix = |a: f32, b: f32, s: f32| a + (b - a) * s;
     match t {
