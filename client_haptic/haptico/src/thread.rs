@@ -30,6 +30,12 @@ pub struct HapticConfig {
     pub command_capacity: usize,
     /// Room for delegates bound while running, per event (default 16).
     pub delegate_capacity: usize,
+    /// Periods a late loop may fall behind and still run every missed tick (default 5); beyond, it
+    /// skips them and starts afresh (counted in telemetry).
+    pub catch_up_periods: u32,
+    /// Real-time FIFO priority for the thread, 1..=99 (default None: normal scheduling). Needs
+    /// CAP_SYS_NICE or an rtprio limit; when refused the thread runs normally and telemetry says so.
+    pub realtime_priority: Option<i32>,
 }
 
 impl Default for HapticConfig {
@@ -40,6 +46,8 @@ impl Default for HapticConfig {
             timing_capacity: 1 << 16,
             command_capacity: 64,
             delegate_capacity: 16,
+            catch_up_periods: 5,
+            realtime_priority: None,
         }
     }
 }
@@ -57,6 +65,8 @@ pub struct HapticTelemetry {
     pub skipped_ticks: u64,
     /// Tick timings lost because the timing ring buffer was full.
     pub dropped_timings: u64,
+    /// True when the thread got the real-time priority it asked for.
+    pub realtime: bool,
 }
 
 enum Command {
@@ -86,6 +96,7 @@ struct ThreadState<D> {
     last_start_us: Option<u64>,
     skipped: u64,
     dropped_timings: u64,
+    realtime: bool,
 }
 
 impl<D: Device> ThreadState<D> {
@@ -138,6 +149,7 @@ impl<D: Device> ThreadState<D> {
             command: self.core.last_command(),
             skipped_ticks: self.skipped,
             dropped_timings: self.dropped_timings,
+            realtime: self.realtime,
         });
         true
     }
@@ -192,19 +204,23 @@ impl<D: Device + 'static> HapticHandle<D> {
             last_start_us: None,
             skipped: 0,
             dropped_timings: 0,
+            realtime: false,
         };
+        let priority = config.realtime_priority;
+        let catch_up = config.catch_up_periods as u64;
         let period_ns = (1e9 / config.rate_hz as f64) as u64;
         let spin_ns = config.spin_margin_us as u64 * 1000;
         let join = std::thread::Builder::new()
             .name("haptic".into())
             .spawn(move || {
+                state.realtime = priority.is_some_and(crate::timing::make_current_thread_realtime);
                 let mut deadline = clock.now_ns() + period_ns;
                 loop {
                     wait_until(&clock, deadline, spin_ns);
                     if !state.run_tick(&clock, clock.now_us()) {
                         break;
                     }
-                    let (next, skipped) = next_deadline(deadline, clock.now_ns(), period_ns);
+                    let (next, skipped) = next_deadline(deadline, clock.now_ns(), period_ns, catch_up);
                     deadline = next;
                     state.skipped += skipped;
                 }
@@ -357,6 +373,7 @@ mod tests {
             last_start_us: None,
             skipped: 0,
             dropped_timings: 0,
+            realtime: false,
         };
         (state, ctx, trx, tout)
     }

@@ -59,12 +59,13 @@ pub fn plan_wait(now_ns: u64, deadline_ns: u64, spin_margin_ns: u64) -> Wait {
     }
 }
 
-/// The deadline after `deadline_ns` for a loop of `period_ns`; a loop more than one period late starts
-/// afresh from `now_ns` instead of running a burst of catch-up ticks. Returns (deadline, ticks skipped).
+/// The deadline after `deadline_ns` for a loop of `period_ns`. A loop that fell behind by at most
+/// `catch_up` periods runs its missed ticks back to back (so short hiccups cost no ticks, only jitter);
+/// one further behind starts afresh from `now_ns`. Returns (deadline, ticks skipped).
 #[inline]
-pub fn next_deadline(deadline_ns: u64, now_ns: u64, period_ns: u64) -> (u64, u64) {
+pub fn next_deadline(deadline_ns: u64, now_ns: u64, period_ns: u64, catch_up: u64) -> (u64, u64) {
     let next = deadline_ns + period_ns;
-    if now_ns > next + period_ns {
+    if now_ns > next + period_ns * catch_up.max(1) {
         let skipped = (now_ns - next) / period_ns;
         (now_ns + period_ns, skipped)
     } else {
@@ -80,6 +81,40 @@ pub fn wait_until(clock: &HapticClock, deadline_ns: u64, spin_margin_ns: u64) {
             Wait::Spin => std::hint::spin_loop(),
             Wait::Sleep(d) => std::thread::sleep(d),
         }
+    }
+}
+
+/// Asks the OS to run the calling thread under a real-time FIFO policy at `priority` (1..=99) and to
+/// wake it from sleeps with 1 µs timer slack. Returns false when refused (no privilege, not Linux):
+/// the thread then runs as before. Call it once at the start of a real-time thread.
+pub fn make_current_thread_realtime(priority: i32) -> bool {
+    #[cfg(target_os = "linux")]
+    {
+        let param = libc::sched_param { sched_priority: priority.clamp(1, 99) };
+        // SAFETY: plain system calls on the calling thread (id 0) with a valid, initialized argument.
+        let ok = unsafe { libc::sched_setscheduler(0, libc::SCHED_FIFO, &param) } == 0;
+        // SAFETY: PR_SET_TIMERSLACK takes one integer argument (nanoseconds).
+        unsafe { libc::prctl(libc::PR_SET_TIMERSLACK, 1 as libc::c_ulong) };
+        ok
+    }
+    #[cfg(not(target_os = "linux"))]
+    {
+        let _ = priority;
+        false
+    }
+}
+
+/// Locks the process's current and future memory in RAM (`mlockall`), so real-time threads never wait
+/// on a page fault. Returns false when refused. Call it early in a benchmark or real-time program.
+pub fn lock_memory() -> bool {
+    #[cfg(target_os = "linux")]
+    {
+        // SAFETY: plain system call with constant flags.
+        unsafe { libc::mlockall(libc::MCL_CURRENT | libc::MCL_FUTURE) == 0 }
+    }
+    #[cfg(not(target_os = "linux"))]
+    {
+        false
     }
 }
 
@@ -153,10 +188,16 @@ mod tests {
 
     #[test]
     fn deadlines_advance_by_one_period_and_a_long_stall_resynchronizes() {
-        assert_eq!(next_deadline(1_000, 1_500, 1_000), (2_000, 0));
-        assert_eq!(next_deadline(1_000, 2_100, 1_000), (2_000, 0));
-        let (d, skipped) = next_deadline(1_000, 10_500, 1_000);
+        assert_eq!(next_deadline(1_000, 1_500, 1_000, 1), (2_000, 0));
+        assert_eq!(next_deadline(1_000, 2_100, 1_000, 1), (2_000, 0));
+        let (d, skipped) = next_deadline(1_000, 10_500, 1_000, 1);
         assert_eq!((d, skipped), (11_500, 8));
+    }
+
+    #[test]
+    fn a_short_hiccup_is_caught_up_instead_of_skipped() {
+        assert_eq!(next_deadline(1_000, 5_500, 1_000, 5), (2_000, 0));
+        assert_eq!(next_deadline(1_000, 20_500, 1_000, 5).1, 18);
     }
 
     #[test]

@@ -27,11 +27,15 @@ pub struct CollisionConfig {
     pub spin_margin_us: u32,
     /// Capacity of the step-timing ring buffer (default 65 536).
     pub timing_capacity: usize,
+    /// Periods a late loop may fall behind and still run every missed step (default 5).
+    pub catch_up_periods: u32,
+    /// Real-time FIFO priority, 1..=99 (default None); keep it below the haptic thread's.
+    pub realtime_priority: Option<i32>,
 }
 
 impl Default for CollisionConfig {
     fn default() -> Self {
-        Self { rate_hz: 1000.0, budget_us: 500, spin_margin_us: 300, timing_capacity: 1 << 16 }
+        Self { rate_hz: 1000.0, budget_us: 500, spin_margin_us: 300, timing_capacity: 1 << 16, catch_up_periods: 5, realtime_priority: None }
     }
 }
 
@@ -191,6 +195,9 @@ impl CollisionWorld {
 
     /// Runs the fixed-rate loop until Stop.
     pub(crate) fn run(mut self, clock: HapticClock, config: CollisionConfig) -> Self {
+        if let Some(priority) = config.realtime_priority {
+            haptico::timing::make_current_thread_realtime(priority);
+        }
         let period_ns = (1e9 / config.rate_hz.max(1.0) as f64) as u64;
         let spin_ns = config.spin_margin_us as u64 * 1000;
         let mut deadline = clock.now_ns() + period_ns;
@@ -202,7 +209,7 @@ impl CollisionWorld {
             let start = Instant::now();
             let start_us = clock.now_us();
             self.step(&clock, start_us, Some(start + Duration::from_micros(config.budget_us as u64)));
-            let (next, _) = next_deadline(deadline, clock.now_ns(), period_ns);
+            let (next, _) = next_deadline(deadline, clock.now_ns(), period_ns, config.catch_up_periods as u64);
             deadline = next;
         }
         self

@@ -1,1 +1,213 @@
-fn main() {}
+//! haptic-bench: the gemstone-over-bunny trajectory through the full loop (simulated device, haptic and
+//! collision threads, collette's budgeted queries, forcecomp) for 35 s; per-100 ms window rates and
+//! forces as CSV and a Fig. 9-style PNG, a summary line, and with `--json` a JSON object printed last.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use anyhow::Context;
+use clap::Parser;
+use collette::scene;
+use forcecomp::Material;
+use haptic_common::{Delegator, Pose};
+use haptic_rig::{CollisionConfig, HapticRig, ObjectSpec, RigConfig, ToolSpec, bench};
+use haptico::sim::{Keyframe, SimConfig, SimDevice, TargetPath};
+use haptico::{HapticConfig, HapticEvents, presets};
+
+#[derive(Parser, Debug)]
+#[command(about = "Runs the gemstone-over-bunny trajectory through the full haptic loop and measures it (paper Fig. 9).")]
+struct Args {
+    /// Seconds to run (the trajectory lasts 35 s).
+    #[arg(long, default_value_t = 35.0)]
+    seconds: f64,
+    /// Device preset (part of its name): touch, omni, desktop, premium, falcon, omega, sigma, delta.
+    #[arg(long, default_value = "premium")]
+    device: String,
+    /// Spheres in the gemstone tool's tree.
+    #[arg(long, default_value_t = 500)]
+    tool_spheres: usize,
+    /// Spheres in the bunny's tree.
+    #[arg(long, default_value_t = 10_000)]
+    bunny_spheres: usize,
+    /// Time budget of one collision step, µs.
+    #[arg(long, default_value_t = 500)]
+    budget_us: u32,
+    /// Haptic and collision rate, Hz.
+    #[arg(long, default_value_t = 1000.0)]
+    rate_hz: f32,
+    /// Random extra delay of the simulated device's reads, µs.
+    #[arg(long, default_value_t = 0)]
+    jitter_us: u32,
+    /// Directory for windows.csv and haptic_bench.png.
+    #[arg(long, default_value = "target/haptic-bench")]
+    out_dir: PathBuf,
+    /// Also write the PNG here (e.g. docs/img/haptic_bench.png).
+    #[arg(long)]
+    png: Option<PathBuf>,
+    /// Run both threads under SCHED_FIFO (haptic at this priority, collision one below); needs root or
+    /// an rtprio limit, silently normal otherwise (the summary says which).
+    #[arg(long)]
+    realtime: Option<i32>,
+    /// Spin instead of sleeping for the last part of each period, µs (both threads).
+    #[arg(long, default_value_t = 300)]
+    spin_us: u32,
+    /// Print the summary as one JSON object, last.
+    #[arg(long)]
+    json: bool,
+}
+
+fn main() -> anyhow::Result<()> {
+    let args = Args::parse();
+    let specs = presets::by_name(&args.device).with_context(|| format!("no device preset matches {:?}", args.device))?;
+
+    let locked = args.realtime.is_some() && haptico::timing::lock_memory();
+    let started = Instant::now();
+    let bunny_mesh = scene::load_bunny(scene::default_bunny_path()).context("loading the bunny")?;
+    let gem_mesh = scene::brilliant_cut(scene::TOOL_DIAMETER);
+    let (bunny, _) = collette::build(&bunny_mesh, &collette::BuildOptions::spheres(args.bunny_spheres), &mut |_| {})
+        .context("building the bunny's tree")?;
+    let (gem, _) = collette::build(&gem_mesh, &collette::BuildOptions::spheres(args.tool_spheres), &mut |_| {})
+        .context("building the gemstone's tree")?;
+    eprintln!(
+        "haptic-bench: trees built in {:.1} s ({} bunny spheres, {} tool spheres)",
+        started.elapsed().as_secs_f64(),
+        bunny.spheres().len(),
+        gem.spheres().len()
+    );
+
+    // The hand follows the scripted tool path; the device frame is the scene frame (metres).
+    let path = scene::trajectory(&bunny_mesh);
+    let keyframes: Vec<Keyframe> = path.iter().map(|s| Keyframe { t_s: s.time_s, pose: s.tool }).collect();
+    let device = SimDevice::new(
+        SimConfig { jitter_us: args.jitter_us, ..SimConfig::new(specs.clone()) },
+        TargetPath::Keyframes(keyframes),
+    );
+    let ticks = (args.seconds * args.rate_hz as f64) as usize + 1000;
+    let config = RigConfig {
+        haptic: HapticConfig {
+            rate_hz: args.rate_hz,
+            timing_capacity: ticks,
+            realtime_priority: args.realtime,
+            spin_margin_us: args.spin_us,
+            ..HapticConfig::default()
+        },
+        collision: CollisionConfig {
+            rate_hz: args.rate_hz,
+            budget_us: args.budget_us,
+            timing_capacity: ticks,
+            realtime_priority: args.realtime.map(|p| (p - 1).max(1)),
+            spin_margin_us: args.spin_us,
+            ..CollisionConfig::default()
+        },
+        force_sample_capacity: ticks,
+        ..RigConfig::default()
+    };
+    // Stiff enough for newtons at a few millimetres, soft enough that the deep stretch really goes deep.
+    let tool = ToolSpec::new(Arc::new(gem), Material { stiffness_n_per_m3: 5e8, damping_ns_per_m: 4.0, friction: 0.3 });
+    let bunny_material = Material { stiffness_n_per_m3: 5e7, damping_ns_per_m: 4.0, friction: 0.3 };
+    let rig = HapticRig::start(device, tool, config, HapticEvents::default(), Delegator::new())?;
+    rig.add_object(ObjectSpec { id: 1, tree: Arc::new(bunny), pose: Pose::IDENTITY, material: bunny_material })?;
+
+    let mut haptic = Vec::with_capacity(ticks);
+    let mut collision = Vec::with_capacity(ticks);
+    let mut forces = Vec::with_capacity(ticks);
+    let steal_before = steal_ms();
+    let run_start = Instant::now();
+    while run_start.elapsed() < Duration::from_secs_f64(args.seconds) {
+        std::thread::sleep(Duration::from_millis(100));
+        rig.drain_haptic_timings(&mut haptic);
+        rig.drain_collision_timings(&mut collision);
+        rig.drain_force_samples(&mut forces);
+        rig.collect_garbage();
+    }
+    let steal = steal_ms().zip(steal_before).map(|(after, before)| after.saturating_sub(before));
+    let telemetry = rig.telemetry();
+    let haptic_telemetry = rig.haptic_telemetry();
+    rig.drain_haptic_timings(&mut haptic);
+    rig.drain_collision_timings(&mut collision);
+    rig.drain_force_samples(&mut forces);
+    rig.stop();
+
+    let period_us = (1e6 / args.rate_hz as f64).round() as u64;
+    let windows = bench::windows(&haptic, &collision, &forces, 100_000, period_us);
+    let s = bench::summary(&windows, &haptic, &collision, &forces, period_us as u32);
+    let nominal = args.rate_hz as f64;
+    let low_haptic = windows.iter().filter(|w| w.haptic_hz < nominal).count();
+    let low_collision = windows.iter().filter(|w| w.collision_hz < nominal).count();
+    let stalls = haptic.iter().filter(|t| t.period_us as u64 > 5 * period_us).count();
+
+    std::fs::create_dir_all(&args.out_dir).with_context(|| format!("creating {}", args.out_dir.display()))?;
+    let csv_path = args.out_dir.join("windows.csv");
+    let mut csv = std::io::BufWriter::new(std::fs::File::create(&csv_path)?);
+    bench::write_csv(&mut csv, &windows)?;
+    drop(csv);
+    let title = format!("{} on the gemstone-over-bunny path: 100 ms windows", specs.name);
+    let png_path = args.out_dir.join("haptic_bench.png");
+    bench::plot(&png_path, &windows, &title).map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+    if let Some(p) = &args.png {
+        std::fs::copy(&png_path, p).with_context(|| format!("copying the plot to {}", p.display()))?;
+    }
+
+    println!(
+        "haptic-bench: {} windows of 100 ms; min haptic {:.0} Hz, min collision {:.0} Hz; windows below {:.0} Hz: haptic {}, collision {}; haptic stalls > 5 periods {}; CPU time stolen by the hypervisor {}; haptic period jitter p50 {} us, p99 {} us, max {} us; collision jitter p50 {} us, p99 {} us; budget hits {}; max |F| {:.2} N (peak {:.2}), max |tau| {:.3} N.m, max |dF| per tick {:.3} N; skipped ticks {}; real-time scheduling {}, memory locked {}; safety {:?}; CSV {}, PNG {}",
+        s.windows,
+        s.min_haptic_hz,
+        s.min_collision_hz,
+        nominal,
+        low_haptic,
+        low_collision,
+        stalls,
+        steal.map_or("unknown".to_string(), |ms| format!("{ms} ms (all CPUs)")),
+        s.haptic.jitter_p50_us,
+        s.haptic.jitter_p99_us,
+        s.haptic.jitter_max_us,
+        s.collision.jitter_p50_us,
+        s.collision.jitter_p99_us,
+        s.budget_hits,
+        s.max_force_n,
+        specs.peak_force_n,
+        s.max_torque_nm,
+        s.max_force_step_n,
+        haptic_telemetry.skipped_ticks,
+        if haptic_telemetry.realtime { "on" } else { "off" },
+        if locked { "yes" } else { "no" },
+        telemetry.safety,
+        csv_path.display(),
+        png_path.display(),
+    );
+    if args.json {
+        let json = serde_json::json!({
+            "min_haptic_hz": s.min_haptic_hz,
+            "min_collision_hz": s.min_collision_hz,
+            "jitter_p50_us": s.haptic.jitter_p50_us,
+            "jitter_p99_us": s.haptic.jitter_p99_us,
+            "jitter_max_us": s.haptic.jitter_max_us,
+            "collision_jitter_p50_us": s.collision.jitter_p50_us,
+            "collision_jitter_p99_us": s.collision.jitter_p99_us,
+            "budget_hits": s.budget_hits,
+            "max_force_n": s.max_force_n,
+            "max_torque_nm": s.max_torque_nm,
+            "max_force_step_n": s.max_force_step_n,
+            "windows": s.windows,
+            "device": specs.name,
+            "realtime": haptic_telemetry.realtime,
+            "memory_locked": locked,
+            "windows_below_target_haptic": low_haptic,
+            "windows_below_target_collision": low_collision,
+            "haptic_stalls": stalls,
+            "steal_ms": steal,
+            "seconds": args.seconds,
+        });
+        println!("{json}");
+    }
+    Ok(())
+}
+
+/// CPU time the hypervisor took from this machine so far (Linux `/proc/stat`, "steal"), ms over all CPUs.
+fn steal_ms() -> Option<u64> {
+    let stat = std::fs::read_to_string("/proc/stat").ok()?;
+    let line = stat.lines().find(|l| l.starts_with("cpu "))?;
+    let jiffies: u64 = line.split_whitespace().nth(8)?.parse().ok()?;
+    Some(jiffies * 10) // USER_HZ is 100 on Linux
+}

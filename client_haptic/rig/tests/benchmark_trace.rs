@@ -1,0 +1,50 @@
+//! The whole 35 s gemstone-over-bunny trajectory through the force stage (lockstep, smaller trees):
+//! no command ever exceeds the device's clamps, no tick changes the force by more than the rate limit,
+//! and nothing is ever NaN.
+
+use std::sync::Arc;
+use std::time::Duration;
+
+use collette::scene;
+use forcecomp::{Material, SafetyConfig};
+use haptic_common::Pose;
+use haptic_rig::lockstep::Lockstep;
+use haptic_rig::{ObjectSpec, RigConfig, ToolSpec};
+use haptico::presets;
+use haptico::sim::{Keyframe, SimConfig, SimDevice, TargetPath};
+
+#[test]
+fn clamps_and_force_rate_hold_along_the_whole_benchmark_trace() {
+    let bunny_mesh = scene::load_bunny(scene::default_bunny_path()).expect("bunny");
+    let (bunny, _) = collette::build(&bunny_mesh, &collette::BuildOptions::spheres(1500), &mut |_| {}).expect("bunny tree");
+    let (gem, _) = collette::build(&scene::brilliant_cut(scene::TOOL_DIAMETER), &collette::BuildOptions::spheres(150), &mut |_| {})
+        .expect("gem tree");
+    let path = scene::trajectory(&bunny_mesh);
+    let keyframes = path.iter().map(|s| Keyframe { t_s: s.time_s, pose: s.tool }).collect();
+    let specs = presets::phantom_premium_6dof();
+    let device = SimDevice::new(SimConfig::new(specs.clone()), TargetPath::Keyframes(keyframes));
+    let safety = SafetyConfig::for_limits(specs.peak_force_n, specs.max_torque_nm);
+    let config = RigConfig { safety: Some(safety), ..RigConfig::default() };
+    let mut rig = Lockstep::new(device, ToolSpec::new(Arc::new(gem), Material::default()), &config, 2, Some(Duration::from_micros(400)))
+        .expect("rig");
+    rig.add_object(ObjectSpec { id: 1, tree: Arc::new(bunny), pose: Pose::IDENTITY, material: Material::default() })
+        .expect("bunny");
+
+    let mut previous = haptic_common::ForceTorque::ZERO;
+    let (mut max_f, mut max_tau, mut max_step, mut touched) = (0.0f32, 0.0f32, 0.0f32, 0u32);
+    for i in 0..35_000u64 {
+        let out = rig.tick(i * 1000);
+        assert!(out.is_finite(), "tick {i}");
+        max_f = max_f.max(out.force.length());
+        max_tau = max_tau.max(out.torque.length());
+        max_step = max_step.max((out.force - previous.force).length());
+        touched += (rig.telemetry().contacts > 0) as u32;
+        previous = out;
+    }
+    eprintln!("max |F| {max_f:.3} N, max |tau| {max_tau:.4} N.m, max |dF| {max_step:.3} N/tick, {touched} ticks in contact");
+    assert!(touched > 10_000, "the path does touch the bunny");
+    assert!(max_f <= specs.peak_force_n + 1e-4);
+    assert!(max_tau <= specs.max_torque_nm + 1e-5);
+    assert!(max_step <= safety.max_force_rate_n_per_s * 0.001 + 1e-4);
+    assert!(max_f > 0.5, "forces are actually rendered: {max_f}");
+}
