@@ -30,7 +30,7 @@ pub struct CouplingConfig {
     pub tool_inertia_kg_m2: f32,
     /// Drag of the simulated tool against the world, N·s/m (default 2).
     pub tool_drag_ns_per_m: f32,
-    /// Rotational drag, N·m·s/rad (default 0.002).
+    /// Rotational drag, N·m·s/rad (default 0.0005).
     pub tool_rot_drag_nms_per_rad: f32,
 }
 
@@ -44,7 +44,7 @@ impl Default for CouplingConfig {
             tool_mass_kg: 0.05,
             tool_inertia_kg_m2: 2e-5,
             tool_drag_ns_per_m: 2.0,
-            tool_rot_drag_nms_per_rad: 0.002,
+            tool_rot_drag_nms_per_rad: 0.0005,
         }
     }
 }

@@ -27,6 +27,8 @@ pub struct ForceSample {
     pub contacts: u32,
     /// Age of the contact data, µs.
     pub data_age_us: u32,
+    /// Sequence number of the collision step whose contacts were used.
+    pub collision_sequence: u64,
 }
 
 /// Latest state of the force stage, for the game thread.
@@ -77,14 +79,34 @@ pub enum Rendering {
     Direct,
 }
 
+/// Where the force stage gets contacts from and sends the tool pose to.
+pub(crate) enum Source {
+    /// The rig's own collision thread ([`crate::collision`]).
+    Rig {
+        frames: triple_buffer::Output<CollisionFrame>,
+        poses: triple_buffer::Input<ToolPoseMsg>,
+    },
+    /// collette's collision pipeline thread.
+    Collette(Box<ColletteSource>),
+}
+
+/// The haptic thread's end of collette's pipeline: the tool's pose writer and one reader per object.
+pub(crate) struct ColletteSource {
+    pub(crate) tool: collette::pipeline::PoseWriter,
+    pub(crate) tool_center_of_mass: Vec3,
+    pub(crate) tool_material: forcecomp::Material,
+    pub(crate) objects: Vec<(collette::pipeline::ContactReader, forcecomp::Material, BodyMotion)>,
+    pub(crate) last_sequence: u64,
+    pub(crate) last_change_us: u64,
+}
+
 /// The force stage's state (lives on the haptic thread).
 pub struct ForceStage {
     pub(crate) map: WorkspaceMap,
     pub(crate) rendering: Rendering,
     pub(crate) coupling: VirtualCoupling,
     pub(crate) safety: SafetyLayer,
-    pub(crate) frames: triple_buffer::Output<CollisionFrame>,
-    pub(crate) poses: triple_buffer::Input<ToolPoseMsg>,
+    pub(crate) source: Source,
     pub(crate) telemetry: triple_buffer::Input<RigTelemetry>,
     pub(crate) samples: rtrb::Producer<ForceSample>,
 }
@@ -94,7 +116,6 @@ impl ForceStage {
     /// tick's total with the safety layer's output. Allocation-free.
     pub fn on_tick(&mut self, tick: &ForceOnHapticTick) {
         let device = tick.device;
-        let frame = self.frames.read();
 
         // The tool as the force law sees it: the simulated tool (or the device itself when direct).
         let tool_device = match self.rendering {
@@ -106,7 +127,14 @@ impl ForceStage {
             Rendering::Direct => (device.linear_velocity, device.angular_velocity),
         };
         let tool_scene = self.map.to_scene(&tool_device);
-        let com = tool_scene.transform_point(frame.tool_center_of_mass);
+        let (tool_com_local, tool_material) = match &mut self.source {
+            Source::Rig { frames, .. } => {
+                let f = frames.read();
+                (f.tool_center_of_mass, f.tool_material)
+            }
+            Source::Collette(c) => (c.tool_center_of_mass, c.tool_material),
+        };
+        let com = tool_scene.transform_point(tool_com_local);
         let tool_motion = BodyMotion {
             center_of_mass: com,
             linear_velocity: self.map.velocity_to_scene(v),
@@ -114,13 +142,42 @@ impl ForceStage {
         };
         let mut contact = ForceTorque::ZERO;
         let mut contacts = 0u32;
-        for object in frame.touched() {
-            let material = frame.tool_material.combine(&object.material);
-            let ft = volumetric_penalty(&object.contacts, &tool_motion, &object.motion, &material);
+        let mut add = |set: &haptic_common::ContactSet, material: &forcecomp::Material, motion: &BodyMotion| {
+            let ft = volumetric_penalty(set, &tool_motion, motion, &tool_material.combine(material));
             contact.force += ft.force;
             contact.torque += ft.torque;
-            contacts += object.contacts.len() as u32;
-        }
+            contacts += set.len() as u32;
+        };
+        // (sequence of the data used, age of that data in µs; u64::MAX when there is none yet)
+        let (sequence, age_us) = match &mut self.source {
+            Source::Rig { frames, .. } => {
+                let frame = frames.read();
+                for object in frame.touched() {
+                    add(&object.contacts, &object.material, &object.motion);
+                }
+                let age = if frame.sequence == 0 {
+                    u64::MAX
+                } else {
+                    device.timestamp_us.saturating_sub(frame.pose_timestamp_us)
+                };
+                (frame.sequence, age)
+            }
+            Source::Collette(c) => {
+                let mut sequence = 0;
+                for (reader, material, motion) in &mut c.objects {
+                    let set = reader.latest();
+                    sequence = sequence.max(set.sequence);
+                    add(set, material, motion);
+                }
+                // Freshness from arrival: static objects' poses carry old timestamps in collette's sets.
+                if sequence != c.last_sequence {
+                    c.last_sequence = sequence;
+                    c.last_change_us = device.timestamp_us;
+                }
+                let age = if sequence == 0 { u64::MAX } else { device.timestamp_us.saturating_sub(c.last_change_us) };
+                (sequence, age)
+            }
+        };
         // Torque about the tool frame's origin (where the coupling acts) instead of the centre of mass.
         contact.torque += (com - tool_scene.translation).cross(contact.force);
         let contact_device = self.map.wrench_to_device(contact);
@@ -130,7 +187,6 @@ impl ForceStage {
             Rendering::Coupled => self.coupling.step(&device, contact_device, dt),
             Rendering::Direct => contact_device,
         };
-        let age_us = if frame.sequence == 0 { u64::MAX } else { device.timestamp_us.saturating_sub(frame.pose_timestamp_us) };
         let age_s = if age_us == u64::MAX { f32::INFINITY } else { age_us as f32 * 1e-6 };
         let before = tick.total();
         let requested = ForceTorque { force: before.force + wanted.force, torque: before.torque + wanted.torque };
@@ -141,14 +197,16 @@ impl ForceStage {
             Rendering::Coupled => self.map.to_scene(&self.coupling.tool_pose()),
             Rendering::Direct => self.map.to_scene(&device.pose),
         };
-        self.poses.write(ToolPoseMsg {
-            tick: tick.tick,
-            pose: tool_now,
-            linear_velocity: tool_motion.linear_velocity,
-            angular_velocity: tool_motion.angular_velocity,
-            timestamp_us: device.timestamp_us,
-        });
-        let sequence = frame.sequence;
+        match &mut self.source {
+            Source::Rig { poses, .. } => poses.write(ToolPoseMsg {
+                tick: tick.tick,
+                pose: tool_now,
+                linear_velocity: tool_motion.linear_velocity,
+                angular_velocity: tool_motion.angular_velocity,
+                timestamp_us: device.timestamp_us,
+            }),
+            Source::Collette(c) => c.tool.set(tool_now, device.timestamp_us),
+        }
         let _ = self.samples.push(ForceSample {
             t_us: device.timestamp_us,
             force: out.force,
@@ -156,6 +214,7 @@ impl ForceStage {
             contact_force: contact_device.force,
             contacts,
             data_age_us: age_us.min(u32::MAX as u64) as u32,
+            collision_sequence: sequence,
         });
         self.telemetry.write(RigTelemetry {
             device,

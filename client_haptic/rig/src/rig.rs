@@ -105,8 +105,7 @@ impl Parts {
             rendering: config.rendering,
             coupling: VirtualCoupling::new(coupling),
             safety: SafetyLayer::new(safety),
-            frames: frame_out,
-            poses: pose_in,
+            source: crate::force::Source::Rig { frames: frame_out, poses: pose_in },
             telemetry: telemetry_in,
             samples: samples_tx,
         };
@@ -127,6 +126,8 @@ impl Parts {
 pub struct HapticRig<D: Device + 'static> {
     haptic: Option<HapticHandle<D>>,
     inner: Mutex<RigInner>,
+    collette: Option<Mutex<collette::pipeline::CollisionHandle>>,
+    _static_poses: Mutex<Vec<collette::pipeline::PoseWriter>>,
 }
 
 impl<D: Device + 'static> std::fmt::Debug for HapticRig<D> {
@@ -155,10 +156,63 @@ impl<D: Device + 'static> HapticRig<D> {
             .map_err(RigError::Spawn)?;
         events.force_on_haptic_tick.add_delegate(move |tick| stage.on_tick(tick));
         let haptic = HapticHandle::spawn(device, events, config.haptic.clone(), clock);
-        let mut rig = Self { haptic: None, inner: Mutex::new(RigInner { collision: Some(collision), ..inner }) };
+        let mut rig = Self {
+            haptic: None,
+            inner: Mutex::new(RigInner { collision: Some(collision), ..inner }),
+            collette: None,
+            _static_poses: Mutex::new(Vec::new()),
+        };
         // On error, dropping `rig` stops the collision thread.
         rig.haptic = Some(haptic?);
         Ok(rig)
+    }
+
+    /// Like [`HapticRig::start`], but collision detection runs in collette's own pipeline thread
+    /// (`collette::pipeline`), watching the tool against each of `objects` (fixed for the rig's life:
+    /// `add_object`/`remove_object`/`pause_collision` then answer `Unsupported`). No collision step
+    /// timings are recorded in this mode; the force samples' sequence numbers show its rate.
+    pub fn start_with_collette(
+        device: D,
+        tool: ToolSpec,
+        objects: Vec<ObjectSpec>,
+        config: RigConfig,
+        mut events: HapticEvents,
+    ) -> Result<Self> {
+        let clock = HapticClock::new();
+        let Parts { mut stage, world, inner } = Parts::new(device.specs(), tool.clone(), &config, Delegator::new())?;
+        drop(world);
+        let mut pipeline = collette::pipeline::CollisionThread::spawn(collette::pipeline::CollisionConfig {
+            period: std::time::Duration::from_secs_f64(1.0 / config.collision.rate_hz.max(1.0) as f64),
+            step_budget: std::time::Duration::from_micros(config.collision.budget_us as u64),
+            ..Default::default()
+        })
+        .map_err(RigError::Spawn)?;
+        let full = || RigError::QueueFull("collette");
+        let tool_writer = pipeline.add_object(tool.tree.clone(), haptic_common::Pose::IDENTITY).ok_or_else(full)?;
+        let mut readers = Vec::with_capacity(objects.len());
+        let mut writers = Vec::with_capacity(objects.len());
+        for object in objects {
+            let watched = WatchedObject::boxed(object);
+            let writer = pipeline.add_object(watched.spec.tree.clone(), watched.spec.pose).ok_or_else(full)?;
+            let reader = pipeline.add_watcher(tool_writer.id(), writer.id()).ok_or_else(full)?;
+            readers.push((reader, watched.spec.material, watched.motion));
+            writers.push(writer);
+        }
+        stage.source = crate::force::Source::Collette(Box::new(crate::force::ColletteSource {
+            tool: tool_writer,
+            tool_center_of_mass: tool.center_of_mass,
+            tool_material: tool.material,
+            objects: readers,
+            last_sequence: 0,
+            last_change_us: 0,
+        }));
+        events.force_on_haptic_tick.add_delegate(move |tick| stage.on_tick(tick));
+        let haptic = HapticHandle::spawn(device, events, config.haptic.clone(), clock)?;
+        Ok(Self { haptic: Some(haptic), inner: Mutex::new(inner), collette: Some(Mutex::new(pipeline)), _static_poses: Mutex::new(writers) })
+    }
+
+    fn refuse_in_collette_mode(&self) -> Result<()> {
+        if self.collette.is_some() { Err(RigError::Unsupported("with collette's pipeline thread")) } else { Ok(()) }
     }
 
     fn lock(&self) -> std::sync::MutexGuard<'_, RigInner> {
@@ -184,11 +238,13 @@ impl<D: Device + 'static> HapticRig<D> {
 
     /// Replaces the tool (its tree, centre of mass and material).
     pub fn set_tool(&self, tool: ToolSpec) -> Result<()> {
+        self.refuse_in_collette_mode()?;
         self.send(WorldCommand::SetTool(Box::new(tool)))
     }
 
     /// Watches an object (replaces the one with the same id).
     pub fn add_object(&self, object: ObjectSpec) -> Result<()> {
+        self.refuse_in_collette_mode()?;
         let boxed = WatchedObject::boxed(object);
         let mut inner = self.lock();
         if inner.objects >= MAX_OBJECTS {
@@ -201,6 +257,7 @@ impl<D: Device + 'static> HapticRig<D> {
 
     /// Stops watching object `id`.
     pub fn remove_object(&self, id: u32) -> Result<()> {
+        self.refuse_in_collette_mode()?;
         let mut inner = self.lock();
         inner.commands.push(WorldCommand::RemoveObject(id)).map_err(|_| RigError::QueueFull("collision"))?;
         inner.objects = inner.objects.saturating_sub(1);
@@ -209,6 +266,7 @@ impl<D: Device + 'static> HapticRig<D> {
 
     /// Pauses or resumes collision detection (paused: no new frames, so the watchdog fades forces out).
     pub fn pause_collision(&self, paused: bool) -> Result<()> {
+        self.refuse_in_collette_mode()?;
         self.send(WorldCommand::Pause(paused))
     }
 
@@ -218,6 +276,9 @@ impl<D: Device + 'static> HapticRig<D> {
         let mut n = 0;
         while inner.garbage.pop().is_ok() {
             n += 1;
+        }
+        if let Some(c) = &self.collette {
+            c.lock().unwrap_or_else(|p| p.into_inner()).collect_retired();
         }
         n + self.haptic().collect_garbage()
     }

@@ -42,3 +42,21 @@ fn the_rig_runs_both_threads_and_broadcasts_collisions() {
     assert!(rig.collect_garbage() >= 1, "the removed object came back to be freed here");
     assert!(rig.stop().is_some());
 }
+
+#[test]
+fn the_rig_also_runs_on_collettes_pipeline_thread() {
+    let device = SimDevice::new(
+        SimConfig::new(presets::touch()),
+        TargetPath::line(Vec3::new(0.0, 0.01, 0.0), Vec3::new(0.0, -0.002, 0.0), 0.1),
+    );
+    let tool = ToolSpec::new(utils::ball_tool(), Material::default());
+    let slab = ObjectSpec { id: 3, tree: utils::slab(), pose: Pose::from_translation(Vec3::new(0.0, -0.01, 0.0)), material: Material::default() };
+    let rig = HapticRig::start_with_collette(device, tool, vec![slab], RigConfig::default(), HapticEvents::default()).expect("rig");
+    std::thread::sleep(Duration::from_millis(600));
+    let tel = rig.telemetry();
+    assert!(tel.collision_sequence > 50, "{tel:?}");
+    assert!(tel.contacts > 0, "the ball rests in the slab: {tel:?}");
+    assert!(tel.data_age_us < 100_000, "{tel:?}");
+    assert!(matches!(rig.pause_collision(true), Err(haptic_rig::RigError::Unsupported(_))));
+    assert!(rig.stop().is_some());
+}

@@ -52,6 +52,10 @@ struct Args {
     /// Spin instead of sleeping for the last part of each period, µs (both threads).
     #[arg(long, default_value_t = 300)]
     spin_us: u32,
+    /// Collision thread: "rig" (haptic_rig's, with per-step timings) or "collette" (collette::pipeline's;
+    /// its rate is then read from the contact sets' sequence numbers seen by the haptic thread).
+    #[arg(long, default_value = "rig")]
+    collision: String,
     /// Print the summary as one JSON object, last.
     #[arg(long)]
     json: bool,
@@ -106,8 +110,19 @@ fn main() -> anyhow::Result<()> {
     // Stiff enough for newtons at a few millimetres, soft enough that the deep stretch really goes deep.
     let tool = ToolSpec::new(Arc::new(gem), Material { stiffness_n_per_m3: 5e8, damping_ns_per_m: 4.0, friction: 0.3 });
     let bunny_material = Material { stiffness_n_per_m3: 5e7, damping_ns_per_m: 4.0, friction: 0.3 };
-    let rig = HapticRig::start(device, tool, config, HapticEvents::default(), Delegator::new())?;
-    rig.add_object(ObjectSpec { id: 1, tree: Arc::new(bunny), pose: Pose::IDENTITY, material: bunny_material })?;
+    let bunny = ObjectSpec { id: 1, tree: Arc::new(bunny), pose: Pose::IDENTITY, material: bunny_material };
+    let collette_mode = match args.collision.as_str() {
+        "rig" => false,
+        "collette" => true,
+        other => anyhow::bail!("--collision must be rig or collette, not {other:?}"),
+    };
+    let rig = if collette_mode {
+        HapticRig::start_with_collette(device, tool, vec![bunny], config, HapticEvents::default())?
+    } else {
+        let rig = HapticRig::start(device, tool, config, HapticEvents::default(), Delegator::new())?;
+        rig.add_object(bunny)?;
+        rig
+    };
 
     let mut haptic = Vec::with_capacity(ticks);
     let mut collision = Vec::with_capacity(ticks);
@@ -129,6 +144,9 @@ fn main() -> anyhow::Result<()> {
     rig.drain_force_samples(&mut forces);
     rig.stop();
 
+    if collette_mode {
+        collision = bench::steps_from_sequences(&forces);
+    }
     let period_us = (1e6 / args.rate_hz as f64).round() as u64;
     let windows = bench::windows(&haptic, &collision, &forces, 100_000, period_us);
     let s = bench::summary(&windows, &haptic, &collision, &forces, period_us as u32);
@@ -142,7 +160,11 @@ fn main() -> anyhow::Result<()> {
     let mut csv = std::io::BufWriter::new(std::fs::File::create(&csv_path)?);
     bench::write_csv(&mut csv, &windows)?;
     drop(csv);
-    let title = format!("{} on the gemstone-over-bunny path: 100 ms windows", specs.name);
+    let title = format!(
+        "{} on the gemstone-over-bunny path, {} collision thread: 100 ms windows",
+        specs.name,
+        if collette_mode { "collette's" } else { "the rig's" }
+    );
     let png_path = args.out_dir.join("haptic_bench.png");
     bench::plot(&png_path, &windows, &title).map_err(|e| anyhow::anyhow!("plot: {e}"))?;
     if let Some(p) = &args.png {
@@ -191,6 +213,7 @@ fn main() -> anyhow::Result<()> {
             "max_force_step_n": s.max_force_step_n,
             "windows": s.windows,
             "device": specs.name,
+            "collision_thread": args.collision,
             "realtime": haptic_telemetry.realtime,
             "memory_locked": locked,
             "windows_below_target_haptic": low_haptic,
