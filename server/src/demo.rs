@@ -86,8 +86,8 @@ impl Heist {
                     .map(|gd| format!("{}({:.1},{:.1} f{:.1} {:?})", gd.name, gd.position.x, gd.position.y, gd.facing, gd.alert))
                     .collect();
                 println!(
-                    "  t={:.1} vive=({:.1},{:.1}) {:?} carry={:?} | {}",
-                    g.elapsed_s, g.vive.position.x, g.vive.position.y, g.vive.stance, g.vive.carrying, guards.join(" ")
+                    "  t={:.1} vive=({:.1},{:.1}) {:?} seq={} intent={:?} carry={:?} | {}",
+                    g.elapsed_s, g.vive.position.x, g.vive.position.y, g.vive.stance, g.vive.last_input_seq, g.vive.intent, g.vive.carrying, guards.join(" ")
                 );
             }
             if !self.server.game().is_running() {
@@ -109,6 +109,12 @@ pub fn run_demo(options: ServerOptions, style: ViveStyle) -> anyhow::Result<Phas
     let phase = heist.run(limit + 5.0);
     let game = heist.server.game();
     let result = crate::session::result_line(game).unwrap_or_else(|| format!("RESULT: unfinished ({phase:?})"));
+    for (name, app) in [("Vive", &heist.vive), ("Phantom", &heist.phantom)] {
+        let inbox = app.world().resource::<heist_client::Inbox>();
+        if !inbox.refusals.is_empty() {
+            println!("{name} bot had {} refusals, first: {:?}", inbox.refusals.len(), &inbox.refusals[..inbox.refusals.len().min(5)]);
+        }
+    }
     println!("{result} after {:.1} s of game time", game.elapsed_s);
     Ok(phase)
 }

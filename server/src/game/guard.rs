@@ -13,13 +13,13 @@ use super::Vive;
 /// Patrol walking speed, m/s.
 const PATROL_SPEED: f32 = 1.1;
 /// Speed while investigating, m/s.
-const INVESTIGATE_SPEED: f32 = 1.7;
+const INVESTIGATE_SPEED: f32 = 1.4;
 /// Speed while chasing, m/s (below Vive's run, so a running Vive can get away).
-const CHASE_SPEED: f32 = 3.0;
+const CHASE_SPEED: f32 = 2.6;
 /// Sight range, metres.
-const SIGHT_RANGE: f32 = 9.0;
+const SIGHT_RANGE: f32 = 5.5;
 /// Half of the vision cone, radians.
-const SIGHT_HALF_ANGLE: f32 = 0.9;
+const SIGHT_HALF_ANGLE: f32 = 0.7;
 /// Anyone this close is noticed whatever the facing, metres.
 const NOTICE_RADIUS: f32 = 1.2;
 /// How long a guard looks around at a spot before moving on, seconds.
@@ -262,9 +262,12 @@ pub fn think_and_act(g: &mut Guard, p: &Perception, walls: &WallSet, nav: &NavGr
     if p.sees_vive {
         let range = g.sight_range(alarm).max(1.0);
         let closeness = (1.0 - p.vive_distance / range).clamp(0.0, 1.0);
-        g.suspicion = (g.suspicion + dt * (0.5 + 2.5 * closeness)).min(1.0);
-    } else if !matches!(g.state, GuardState::Chase { .. }) {
-        g.suspicion = (g.suspicion - dt * 0.2).max(0.0);
+        g.suspicion = (g.suspicion + dt * (0.3 + 1.2 * closeness)).min(1.0);
+    } else if matches!(g.state, GuardState::Chase { .. }) {
+        // Losing sight of the quarry: still alarmed, but a new glimpse must build up again.
+        g.suspicion = g.suspicion.min(0.6);
+    } else {
+        g.suspicion = (g.suspicion - dt * 0.35).max(0.0);
     }
     let haste = 1.0 + 0.15 * alarm;
     match decide(g, p) {

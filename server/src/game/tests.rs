@@ -181,3 +181,4 @@ fn the_same_seed_gives_the_same_session() {
     assert_eq!(reals(&a), reals(&b));
     assert_ne!(reals(&a), reals(&started(10)), "another seed shuffles the copies");
 }
+

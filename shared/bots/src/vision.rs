@@ -5,9 +5,9 @@ use heist_shared::level::WallSet;
 use heist_shared::protocol::{GuardAlert, GuardView};
 
 /// Guard sight range, metres (the server's value).
-const RANGE: f32 = 9.0;
+const RANGE: f32 = 5.5;
 /// Half of the vision cone, radians.
-const HALF_ANGLE: f32 = 0.9;
+const HALF_ANGLE: f32 = 0.7;
 /// Extra metres the bot keeps away from the cone's edge.
 const RANGE_MARGIN: f32 = 2.5;
 /// Extra radians the bot keeps away from the cone's edge.
@@ -23,7 +23,7 @@ pub fn could_see(guard: &GuardView, p: Vec2, crouching: bool, alarm: u8, walls: 
     let d = p - guard.position;
     let dist = d.length();
     // Guards turn fast at the ends of their routes: close up, assume they look every way.
-    let all_round = if crouching { 3.5 } else { 5.0 };
+    let all_round = if crouching { 2.5 } else { 3.5 };
     if dist < all_round {
         return walls.line_of_sight(guard.position, p);
     }

@@ -27,6 +27,10 @@ pub enum ViveStyle {
 
 /// Seconds the bot waits for a guard to move before throwing something to lure it away.
 const LURE_AFTER_S: f32 = 4.0;
+/// Seconds of waiting on one goal after which the bot tries another item.
+const GIVE_UP_AFTER_S: f32 = 25.0;
+/// Seconds the bot stays put after backing out of a guard's sight.
+const HOLD_AFTER_RETREAT_S: f32 = 2.0;
 /// Seconds the bot waits for guards to leave earshot before breaking a case anyway.
 const BREAK_PATIENCE_S: f32 = 12.0;
 
@@ -40,8 +44,16 @@ pub struct ViveBrain {
     route: Vec<Vec2>,
     route_goal: Option<Vec2>,
     waited_s: f32,
+    hold_s: f32,
+    refuge: Option<Vec2>,
+    committed: Option<ItemId>,
+    stuck_s: f32,
+    avoid: Vec<(ItemId, f32)>,
+    clock_s: f32,
     break_wait_s: f32,
     trail: Vec<Vec2>,
+    /// Per guard: last seen position, seconds since it changed, estimated velocity.
+    guard_motion: Vec<(heist_shared::protocol::GuardId, Vec2, f32, Vec2)>,
     /// Actions taken, for tests and logs.
     pub actions: Vec<String>,
 }
@@ -68,11 +80,12 @@ struct View<'a> {
     secured: Vec<heist_shared::artifact::ArtifactKind>,
 }
 
+#[derive(Debug)]
 enum Goal {
     /// Walk towards a point, then do nothing.
     Go(Vec2),
-    /// Break this case once in reach.
-    Break(Vec2, heist_shared::protocol::CaseId),
+    /// Break this case once in reach (to get at the item).
+    Break(Vec2, heist_shared::protocol::CaseId, ItemId),
     /// Pick this item up once in reach.
     Take(Vec2, ItemId),
     /// Put this copy on the workbench once in reach.
@@ -106,17 +119,71 @@ fn play(
     if session.phase != Phase::Heist || brain.style == ViveStyle::Idle || brain.map.is_none() {
         return;
     }
+    let dt = time.delta_secs();
+    // Where each guard will be soon if it keeps walking: the bot dodges those too.
+    let walls_for_prediction = brain.map.as_ref().map(|m| m.1.clone());
+    let mut predicted: Vec<GuardView> = Vec::new();
+    for g in guards.iter() {
+        let entry = brain.guard_motion.iter_mut().find(|(id, ..)| *id == g.id);
+        let velocity = match entry {
+            Some((_, last, since, velocity)) => {
+                *since += dt;
+                if g.position != *last {
+                    *velocity = ((g.position - *last) / since.max(1e-3)).clamp_length_max(3.0);
+                    *last = g.position;
+                    *since = 0.0;
+                }
+                *velocity
+            }
+            None => {
+                brain.guard_motion.push((g.id, g.position, 0.0, Vec2::ZERO));
+                Vec2::ZERO
+            }
+        };
+        let future = g.position + velocity * 1.5;
+        let reachable = walls_for_prediction.as_ref().is_some_and(|w| w.line_of_sight(g.position, future));
+        if velocity.length() > 0.3 && reachable {
+            let mut ahead = g.clone();
+            ahead.position = future;
+            ahead.facing = velocity.y.atan2(velocity.x);
+            predicted.push(ahead);
+        }
+    }
     let view = View {
         me,
         alarm: session.alarm,
-        guards: guards.iter().collect(),
+        guards: guards.iter().chain(predicted.iter()).collect(),
         cases: cases.iter().collect(),
         items: items.iter().collect(),
         secured: session.targets.iter().filter(|t| t.1).map(|t| t.0).collect(),
     };
-    let dt = time.delta_secs();
+    brain.clock_s += dt;
+    let now = brain.clock_s;
+    brain.avoid.retain(|(_, until)| *until > now);
     let goal = choose_goal(&brain, &view);
+    brain.committed = match &goal {
+        Goal::Break(_, _, item) | Goal::Take(_, item) => Some(*item),
+        _ => None,
+    };
+    let goal_text = if std::env::var_os("HEIST_BOT_TRACE").is_some() { Some(format!("{goal:?}")) } else { None };
     let (direction, gait, action) = steer(&mut brain, &view, goal, dt);
+    if let Some(goal_text) = goal_text
+        && brain.seq % 60 == 0
+    {
+        println!("    bot: goal {goal_text} route {:?} dir {direction:?} {gait:?}", brain.route);
+    }
+    // Waiting on one goal for too long: try another item for a while.
+    if direction == Vec2::ZERO && action.is_none() {
+        brain.stuck_s += dt;
+        if brain.stuck_s > GIVE_UP_AFTER_S
+            && let Some(item) = brain.committed.take()
+        {
+            brain.avoid.push((item, now + 60.0));
+            brain.stuck_s = 0.0;
+        }
+    } else {
+        brain.stuck_s = 0.0;
+    }
     if let Some(action) = action {
         brain.actions.push(format!("{action:?}"));
         out.write(ClientMsg::Vive(action));
@@ -139,7 +206,9 @@ fn choose_goal(brain: &ViveBrain, view: &View<'_>) -> Goal {
 
     // Copies still worth fetching: their artifact is not secured yet.
     let wanted = view.items.iter().filter(|i| match &i.kind {
-        ItemKind::Copy { artifact, .. } => !view.secured.contains(artifact),
+        ItemKind::Copy { artifact, .. } => {
+            !view.secured.contains(artifact) && !brain.avoid.iter().any(|(a, _)| *a == i.id)
+        }
         ItemKind::Prop => false,
     });
     let fetchable: Vec<(Vec2, &ItemView)> = wanted
@@ -151,6 +220,28 @@ fn choose_goal(brain: &ViveBrain, view: &View<'_>) -> Goal {
         .collect();
     let nearest = fetchable.iter().min_by(|a, b| me.distance(a.0).total_cmp(&me.distance(b.0)));
 
+    // Stick to the item we were going for while it is still there, so the bot never dithers
+    // between two goals of nearly equal appeal.
+    if !hands_full
+        && let Some(item) = brain.committed
+        && !brain.avoid.iter().any(|(a, _)| *a == item)
+        && let Some(view_item) = view.items.iter().find(|i| i.id == item)
+    {
+        let at = match view_item.place {
+            ItemPlace::Floor(p) => Some(p),
+            ItemPlace::InCase(c) => view.cases.iter().find(|cv| cv.id == c).map(|cv| cv.position),
+            _ => None,
+        };
+        let still_wanted = match &view_item.kind {
+            ItemKind::Copy { artifact, .. } => !view.secured.contains(artifact),
+            ItemKind::Prop => true,
+        };
+        if let Some(at) = at
+            && still_wanted
+        {
+            return goal_for(view, at, view_item);
+        }
+    }
     if let Some(copy) = carried_copy {
         // A second copy close by is worth the detour when hands allow.
         if !hands_full
@@ -184,7 +275,7 @@ fn choose_goal(brain: &ViveBrain, view: &View<'_>) -> Goal {
 
 fn goal_for(view: &View<'_>, at: Vec2, item: &ItemView) -> Goal {
     match item.place {
-        ItemPlace::InCase(c) if view.cases.iter().any(|cv| cv.id == c && !cv.broken) => Goal::Break(at, c),
+        ItemPlace::InCase(c) if view.cases.iter().any(|cv| cv.id == c && !cv.broken) => Goal::Break(at, c, item.id),
         _ => Goal::Take(at, item.id),
     }
 }
@@ -195,7 +286,7 @@ fn steer(brain: &mut ViveBrain, view: &View<'_>, goal: Goal, dt: f32) -> (Vec2, 
     let (target, in_reach_action) = match goal {
         Goal::Rest => return (Vec2::ZERO, Gait::Crouch, None),
         Goal::Go(p) => (p, None),
-        Goal::Break(p, c) => (p, Some(ViveMsg::Break(c))),
+        Goal::Break(p, c, _) => (p, Some(ViveMsg::Break(c))),
         Goal::Take(p, i) => (p, Some(ViveMsg::PickUp(i))),
         Goal::Deliver(p, i) => {
             let busy = view.items.iter().any(|it| it.place == ItemPlace::Workbench);
@@ -207,13 +298,40 @@ fn steer(brain: &mut ViveBrain, view: &View<'_>, goal: Goal, dt: f32) -> (Vec2, 
 
     // Chased: run for the place we reach furthest ahead of the guard, and hope it loses sight.
     if !reckless && let Some(g) = view.guards.iter().find(|g| g.alert == GuardAlert::Chasing) {
-        let lead = |p: Vec2| nav.route_length(g.position, p) - nav.route_length(me, p);
-        let refuge = nav.room_centres().chain([home]).max_by(|a, b| lead(*a).total_cmp(&lead(*b))).unwrap_or(home);
-        let first = nav.route(me, refuge).and_then(|r| r.first().copied()).unwrap_or(refuge);
+        // Lead over the nearest guard (any guard, not just the chaser) at each candidate refuge.
+        let _ = g;
+        let lead = |p: Vec2| {
+            let mine = nav.route_length(me, p);
+            view.guards.iter().map(|o| nav.route_length(o.position, p) - mine).fold(f32::INFINITY, f32::min)
+        };
+        if brain.refuge.is_some_and(|r| r.distance(me) < 1.5) {
+            brain.refuge = None; // reached it and still chased: pick the next one
+        }
+        let refuge = *brain.refuge.get_or_insert_with(|| {
+            nav.room_centres()
+                .chain([home])
+                .filter(|p| p.distance(me) > 4.0)
+                .max_by(|a, b| lead(*a).total_cmp(&lead(*b)))
+                .unwrap_or(home)
+        });
+        let first = nav
+            .route(me, refuge)
+            .and_then(|r| r.into_iter().find(|p| p.distance(me) > 0.3))
+            .unwrap_or(refuge);
         brain.route_goal = None;
         return ((first - me).normalize_or_zero(), Gait::Run, None);
     }
-    let exposed = !reckless && view.guards.iter().any(|g| could_see(g, me, true, view.alarm, &walls));
+    brain.refuge = None;
+    // Too close for comfort, seen or not (walls and doors are thin): treat as exposed.
+    let crowded = view.guards.iter().any(|g| g.position.distance(me) < 3.5);
+    let exposed = !reckless && (crowded || view.guards.iter().any(|g| could_see(g, me, true, view.alarm, &walls)));
+    if exposed {
+        brain.hold_s = HOLD_AFTER_RETREAT_S;
+    } else if brain.hold_s > 0.0 {
+        // Just backed off: stay put a moment instead of stepping straight back into view.
+        brain.hold_s -= dt;
+        return (Vec2::ZERO, Gait::Crouch, None);
+    }
 
     if me.distance(target) <= rules::REACH * 0.8 {
         let Some(action) = in_reach_action else { return (Vec2::ZERO, Gait::Crouch, None) };
@@ -251,6 +369,21 @@ fn steer(brain: &mut ViveBrain, view: &View<'_>, goal: Goal, dt: f32) -> (Vec2, 
     }
 
     let next = me + direction * 0.8;
+    // Entering another room while one of its guards is near the threshold: wait for it to walk off.
+    let entering = nav.room_at(next).filter(|r| Some(*r) != nav.room_at(me));
+    let hot = entering.is_some_and(|room| {
+        view.guards.iter().any(|g| {
+            let d = next - g.position;
+            let facing_us = (d.y.atan2(d.x) - g.facing + std::f32::consts::PI).rem_euclid(std::f32::consts::TAU)
+                - std::f32::consts::PI;
+            nav.room_at(g.position) == Some(room)
+                && (d.length() < 8.0 || (d.length() < 12.0 && facing_us.abs() < 1.1))
+        })
+    });
+    if hot && !exposed {
+        brain.waited_s += dt;
+        return lure_or_wait(brain, view, me, &walls);
+    }
     let seen_standing = view.guards.iter().any(|g| could_see(g, next, false, view.alarm, &walls));
     let seen_crouching = view.guards.iter().any(|g| could_see(g, next, true, view.alarm, &walls));
     if !seen_standing {
@@ -269,21 +402,22 @@ fn steer(brain: &mut ViveBrain, view: &View<'_>, goal: Goal, dt: f32) -> (Vec2, 
     }
     // Blocked: wait, back off if we could be seen where we stand, and lure the guard after a while.
     brain.waited_s += dt;
-    let blocker = view
-        .guards
-        .iter()
-        .filter(|g| could_see(g, next, true, view.alarm, &walls))
-        .min_by(|a, b| a.position.distance(me).total_cmp(&b.position.distance(me)));
+    if exposed {
+        return retreat(brain, view, me, &walls);
+    }
+    lure_or_wait(brain, view, me, &walls)
+}
+
+/// Waits crouching; after a while, throws a carried prop past the nearest guard to draw it away.
+fn lure_or_wait(brain: &mut ViveBrain, view: &View<'_>, me: Vec2, _walls: &WallSet) -> (Vec2, Gait, Option<ViveMsg>) {
+    let nearest = view.guards.iter().min_by(|a, b| a.position.distance(me).total_cmp(&b.position.distance(me)));
     if brain.waited_s > LURE_AFTER_S
-        && let Some(g) = blocker
+        && let Some(g) = nearest
         && let Some(&prop) = view.me.carrying.iter().find(|&&i| !is_copy(view, i))
     {
         brain.waited_s = 0.0;
         let beyond = g.position + (g.position - me).normalize_or_zero() * 7.0;
         return (Vec2::ZERO, Gait::Crouch, Some(ViveMsg::Throw { item: prop, target: beyond }));
-    }
-    if exposed {
-        return retreat(brain, view, me, &walls);
     }
     (Vec2::ZERO, Gait::Crouch, None)
 }
@@ -292,15 +426,26 @@ fn steer(brain: &mut ViveBrain, view: &View<'_>, goal: Goal, dt: f32) -> (Vec2, 
 /// trail left, steps straight away from the nearest guard that could see us.
 fn retreat(brain: &mut ViveBrain, view: &View<'_>, me: Vec2, walls: &WallSet) -> (Vec2, Gait, Option<ViveMsg>) {
     brain.route_goal = None;
+    let too_close = view.guards.iter().find(|g| g.position.distance(me) < 3.5);
+    if let Some(g) = too_close {
+        brain.trail.clear();
+        return ((me - g.position).normalize_or_zero(), Gait::Walk, None);
+    }
+    // Run when no guard is near enough to hear the footsteps, walk otherwise.
+    let gait = if view.guards.iter().all(|g| g.position.distance(me) > rules::RUN_LOUDNESS * 1.3) {
+        Gait::Run
+    } else {
+        Gait::Walk
+    };
     while let Some(back) = brain.trail.pop() {
         if back.distance(me) > 0.05 {
-            return ((back - me).normalize_or_zero(), Gait::Walk, None);
+            return ((back - me).normalize_or_zero(), gait, None);
         }
     }
     let watcher = view
         .guards
         .iter()
-        .filter(|g| could_see(g, me, true, view.alarm, walls))
+        .filter(|g| g.position.distance(me) < 3.5 || could_see(g, me, true, view.alarm, walls))
         .min_by(|a, b| a.position.distance(me).total_cmp(&b.position.distance(me)));
     match watcher {
         Some(g) => ((me - g.position).normalize_or_zero(), Gait::Walk, None),
