@@ -1,0 +1,50 @@
+//! Steady-state queries and collision steps allocate nothing (the allocator aborts if they do).
+
+use assert_no_alloc::{AllocDisabler, assert_no_alloc};
+use collette::pipeline::{CollisionConfig, CollisionWorld, Command, ObjectId, TimedPose, WatcherId};
+use collette::shape::box_buffers;
+use collette::{BuildOptions, Budget, ContactSet, Pose, QueryWorkspace, TriMesh, build, overlap, overlap_budgeted, overlap_volume, probe, separation};
+use glam::{Quat, Vec3};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+#[global_allocator]
+static ALLOCATOR: AllocDisabler = AllocDisabler;
+
+#[test]
+fn queries_and_collision_steps_do_not_allocate_once_warmed_up() {
+    let (v, t) = box_buffers(Vec3::splat(0.5));
+    let tree = build(&TriMesh::new(v, t).expect("valid"), &BuildOptions::spheres(500), &mut |_| {}).expect("builds").0;
+    let mut ws = QueryWorkspace::new();
+    let mut set = ContactSet::new();
+    let (pa, pb) = (Pose::IDENTITY, Pose::new(Vec3::new(0.4, 0.2, 0.1), Quat::from_rotation_z(0.5)));
+    let run = |ws: &mut QueryWorkspace, set: &mut ContactSet| {
+        overlap(&tree, &pa, &tree, &pb, ws, set);
+        overlap_budgeted(&tree, &pa, &tree, &pb, Budget::NodePairs(100), ws, set);
+        overlap_budgeted(&tree, &pa, &tree, &pb, Budget::Deadline(Instant::now() + Duration::from_micros(30)), ws, set);
+        overlap_volume(&tree, &pa, &tree, &pb, ws);
+        probe(&tree, &pb, Vec3::new(0.3, 0.1, 0.0), 0.05, ws, Some(set));
+        separation(&tree, &pa, &tree, &Pose::from_translation(Vec3::X * 3.0), ws);
+    };
+    run(&mut ws, &mut set);
+    assert_no_alloc(|| run(&mut ws, &mut set));
+
+    let config = CollisionConfig::default();
+    let mut world = CollisionWorld::new(&config);
+    let shared = Arc::new(tree.clone());
+    let (mut tool_in, tool_out) = triple_buffer::triple_buffer(&TimedPose::default());
+    let (_, target_out) = triple_buffer::triple_buffer(&TimedPose::default());
+    let (contacts_in, mut contacts_out) = triple_buffer::triple_buffer(&ContactSet::new());
+    let mut retired = Vec::new();
+    world.apply(Command::AddObject(ObjectId(0), shared.clone(), tool_out), &mut |r| retired.push(r));
+    world.apply(Command::AddObject(ObjectId(1), shared, target_out), &mut |r| retired.push(r));
+    world.apply(Command::AddWatcher(WatcherId(0), ObjectId(0), ObjectId(1), Box::new(contacts_in)), &mut |r| retired.push(r));
+    tool_in.write(TimedPose { pose: pb, timestamp_us: 5 });
+    world.step(None);
+    assert_no_alloc(|| {
+        world.step(None);
+        world.step(Some(Instant::now() + Duration::from_micros(100)));
+    });
+    let latest = contacts_out.read();
+    assert!(latest.total_volume > 0.0 && latest.sequence == 3 && latest.timestamp_us == 0);
+}
