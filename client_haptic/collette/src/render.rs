@@ -6,6 +6,7 @@
 use crate::partitioning::InnerSphereTree;
 use glam::Vec3;
 use rayon::prelude::*;
+use std::f32::consts::TAU;
 use std::path::Path;
 
 /// An 8-bit RGB image, rows top to bottom.
@@ -93,15 +94,15 @@ fn trace(tree: &InnerSphereTree, o: Vec3, d: Vec3, cut: Option<(Vec3, Vec3)>, st
         if node.leaf {
             for i in node.range() {
                 let s = &tree.spheres()[i];
-                if let Some((p, f)) = cut {
-                    if (s.center - p).dot(f) < 0.0 {
-                        continue;
-                    }
+                if let Some((p, f)) = cut
+                    && (s.center - p).dot(f) < 0.0
+                {
+                    continue;
                 }
-                if let Some(t) = hit(s.center, s.radius) {
-                    if best.is_none_or(|b| t < b.0) {
-                        best = Some((t, i));
-                    }
+                if let Some(t) = hit(s.center, s.radius)
+                    && best.is_none_or(|b| t < b.0)
+                {
+                    best = Some((t, i));
                 }
             }
         } else {
@@ -117,7 +118,7 @@ fn trace(tree: &InnerSphereTree, o: Vec3, d: Vec3, cut: Option<(Vec3, Vec3)>, st
 fn shade(index: usize, _p: Vec3, n: Vec3, light: Vec3, dir: Vec3) -> [f32; 3] {
     // A stable pseudo-random hue per sphere, so neighbours are told apart.
     let h = (index as u32).wrapping_mul(2_654_435_761) as f32 / u32::MAX as f32;
-    let base = Vec3::new(0.55 + 0.45 * (6.283 * h).cos(), 0.55 + 0.45 * (6.283 * (h + 0.33)).cos(), 0.55 + 0.45 * (6.283 * (h + 0.67)).cos());
+    let base = Vec3::new(0.55 + 0.45 * (TAU * h).cos(), 0.55 + 0.45 * (TAU * (h + 0.33)).cos(), 0.55 + 0.45 * (TAU * (h + 0.67)).cos());
     let diffuse = n.dot(light).max(0.0);
     let spec = (2.0 * n.dot(light) * n - light).dot(-dir).max(0.0).powf(24.0);
     let c = base * (0.25 + 0.75 * diffuse) + Vec3::splat(0.35 * spec);

@@ -115,10 +115,10 @@ pub fn build(
     if !(2..=2048).contains(&resolution) {
         return Err(BuildError::InvalidOption(format!("grid resolution {resolution} is outside 2..=2048")));
     }
-    if let Some(c) = options.target_coverage {
-        if !(c > 0.0 && c <= 1.0) {
-            return Err(BuildError::InvalidOption(format!("target coverage {c} is outside (0, 1]")));
-        }
+    if let Some(c) = options.target_coverage
+        && !(c > 0.0 && c <= 1.0)
+    {
+        return Err(BuildError::InvalidOption(format!("target coverage {c} is outside (0, 1]")));
     }
     if options.target_spheres == Some(0) {
         return Err(BuildError::InvalidOption("target sphere count is 0".into()));

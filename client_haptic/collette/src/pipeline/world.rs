@@ -145,10 +145,8 @@ impl CollisionWorld {
     /// object publish an empty set. Returns the number of pairs queried.
     pub fn step(&mut self, deadline: Option<Instant>) -> usize {
         self.sequence += 1;
-        for slot in &mut self.objects {
-            if let Some(o) = slot {
-                o.pose.update();
-            }
+        for o in self.objects.iter_mut().flatten() {
+            o.pose.update();
         }
         let mut queried = 0;
         for w in self.watchers.iter_mut().flatten() {

@@ -21,7 +21,7 @@ impl TriMesh {
         validate(&vertices, &triangles)?;
         let mut mesh = Self { vertices, triangles };
         let volume = mesh.signed_volume();
-        if !(volume.abs() > 0.0) || !volume.is_finite() {
+        if volume == 0.0 || !volume.is_finite() {
             return Err(MeshError::ZeroVolume);
         }
         if volume < 0.0 {
@@ -34,7 +34,7 @@ impl TriMesh {
 
     /// Builds from flat buffers: `positions` as x,y,z triples and `indices` as triangle triples.
     pub fn from_buffers(positions: &[f32], indices: &[u32]) -> Result<Self, MeshError> {
-        if indices.len() % 3 != 0 {
+        if !indices.len().is_multiple_of(3) {
             return Err(MeshError::RaggedIndices(indices.len()));
         }
         let vertices = positions.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])).collect();

@@ -56,10 +56,10 @@ pub fn separation(a: &InnerSphereTree, pose_a: &Pose, b: &InnerSphereTree, pose_
         let mut kids = [(0u32, 0u32, 0.0f32); 4];
         let descend_a = nb.leaf || (!na.leaf && na.bound.radius >= nb.bound.radius);
         let n = if descend_a { na.count as usize } else { nb.count as usize };
-        for k in 0..n {
+        for (k, kid) in kids.iter_mut().enumerate().take(n) {
             let (ca, cb_) = if descend_a { (na.first + k as u32, ib) } else { (ia, nb.first + k as u32) };
             let (ma, mb) = (&a.nodes[ca as usize], &b.nodes[cb_ as usize]);
-            kids[k] = (ca, cb_, gap(ma.bound.center, ma.bound.radius, pos12.transform_point(mb.bound.center), mb.bound.radius));
+            *kid = (ca, cb_, gap(ma.bound.center, ma.bound.radius, pos12.transform_point(mb.bound.center), mb.bound.radius));
         }
         kids[..n].sort_unstable_by(|x, y| y.2.total_cmp(&x.2));
         ws.stack.extend(kids[..n].iter().filter(|k| k.2 < best).map(|k| (k.0, k.1)));

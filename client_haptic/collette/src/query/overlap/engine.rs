@@ -155,12 +155,12 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
         for sb in &self.b.spheres[nb.range()] {
             let cb = self.pos12.transform_point(sb.center);
             for sa in &self.a.spheres[na.range()] {
-                if let Some(l) = lens(sa.center, sa.radius, cb, sb.radius) {
-                    if l.volume > 0.0 {
-                        self.result.total_volume += l.volume;
-                        self.result.leaf_pairs += 1;
-                        (self.sink)(&l, sa.center, cb);
-                    }
+                if let Some(l) = lens(sa.center, sa.radius, cb, sb.radius)
+                    && l.volume > 0.0
+                {
+                    self.result.total_volume += l.volume;
+                    self.result.leaf_pairs += 1;
+                    (self.sink)(&l, sa.center, cb);
                 }
             }
         }
