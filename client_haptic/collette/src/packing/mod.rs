@@ -14,6 +14,9 @@ use crate::partitioning::InnerSphereTree;
 use crate::shape::TriMesh;
 use std::time::Instant;
 
+/// Largest voxel grid the builder accepts (about 1.6 GB of working memory).
+pub const MAX_VOXELS: usize = 1 << 27;
+
 /// Options of the builder. With neither target set, packs [`BuildOptions::DEFAULT_SPHERES`] spheres.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BuildOptions {
@@ -128,6 +131,11 @@ pub fn build(
         (None, Some(_)) => usize::MAX,
         (None, None) => BuildOptions::DEFAULT_SPHERES,
     };
+    let ext = mesh.aabb().extents();
+    let voxels: f64 = (0..3).map(|a| (ext[a] / ext.max_element() * resolution as f32).ceil().max(1.0) as f64).product();
+    if voxels > MAX_VOXELS as f64 {
+        return Err(BuildError::InvalidOption(format!("grid resolution {resolution} needs {voxels:.3e} voxels (at most {MAX_VOXELS})")));
+    }
     let mesh_volume = mesh.volume() as f64;
     progress(BuildProgress::DistanceField);
     let field = DistanceField::new(mesh, resolution);
@@ -201,5 +209,7 @@ mod tests {
         assert!(report.coverage >= 0.6 && report.coverage < 0.7, "{}", report.coverage);
         assert!(matches!(build(&slab(), &BuildOptions::coverage(1.5), &mut |_| {}), Err(BuildError::InvalidOption(_))));
         assert!(matches!(build(&slab(), &BuildOptions::spheres(0), &mut |_| {}), Err(BuildError::InvalidOption(_))));
+        let huge = BuildOptions { grid_resolution: Some(2000), ..BuildOptions::spheres(10) };
+        assert!(matches!(build(&slab(), &huge, &mut |_| {}), Err(BuildError::InvalidOption(_))));
     }
 }
