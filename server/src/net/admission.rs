@@ -14,8 +14,10 @@ use crate::session::{GameState, SessionLog};
 pub struct Player {
     /// Role from the token.
     pub role: Role,
-    /// Refused messages so far.
-    pub strikes: u32,
+    /// Refused messages, leaking away at one per second: sustained abuse fills it.
+    pub strikes: f32,
+    /// Set once the client is being disconnected for abuse.
+    pub expelled: bool,
 }
 
 /// Which client entity plays which role.
@@ -91,7 +93,7 @@ pub(super) fn admit(
     }
     *roles.slot(role) = Some(client);
     settings.roles.set(role, true);
-    commands.entity(client).insert((Player { role, strikes: 0 }, ClientRole(role)));
+    commands.entity(client).insert((Player { role, strikes: 0.0, expelled: false }, ClientRole(role)));
     game.0.join(role);
     log.line(game.0.elapsed_s, format!("{role} joined"));
     messages.write(ToClients {

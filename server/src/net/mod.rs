@@ -43,7 +43,7 @@ pub struct NetSettings {
     pub auth: Auth,
     /// Roles in play, shared with the token endpoint.
     pub roles: RoleTable,
-    /// Refused messages tolerated per client before it is disconnected for abuse.
+    /// Refused messages (leaking one per second) tolerated per client before it is disconnected for abuse.
     pub abuse_limit: u32,
 }
 

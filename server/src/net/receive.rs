@@ -16,18 +16,23 @@ pub fn apply_client_messages(
     mut game: ResMut<GameState>,
     mut tool: Query<&mut PhantomTool>,
     settings: Res<NetSettings>,
+    time: Res<Time<Real>>,
     mut log: ResMut<SessionLog>,
     mut messages: MessageWriter<ToClients<ServerMsg>>,
     mut disconnects: MessageWriter<DisconnectRequest>,
 ) {
+    let leak = time.delta_secs();
+    for mut player in &mut players {
+        player.strikes = (player.strikes - leak).max(0.0);
+    }
     for FromClient { client_id, message } in received.read() {
         let ClientId::Client(client) = *client_id else { continue };
         let Ok(mut player) = players.get_mut(client) else {
             // Not admitted (yet, or refused): nothing it says counts.
             continue;
         };
-        if player.strikes > settings.abuse_limit {
-            continue; // already being disconnected
+        if player.expelled {
+            continue; // being disconnected: nothing more it says counts
         }
         if let ClientMsg::Phantom(PhantomMsg::ToolPose { position, rotation }) = message
             && position.is_finite()
@@ -37,13 +42,14 @@ pub fn apply_client_messages(
             t.set_if_neq(PhantomTool { position: *position, rotation: *rotation });
         }
         if let Err(refusal) = game.0.apply(player.role, message) {
-            player.strikes += 1;
+            player.strikes += 1.0;
             log.debug(game.0.elapsed_s, format!("{} refused: {refusal:?}", player.role));
             messages.write(ToClients {
                 targets: SendTargets::Single(ClientId::Client(client)),
                 message: ServerMsg::Refused(refusal),
             });
-            if player.strikes > settings.abuse_limit {
+            if player.strikes > settings.abuse_limit as f32 {
+                player.expelled = true;
                 log.line(game.0.elapsed_s, format!("{} disconnected for abuse", player.role));
                 refuse_and_disconnect(client, DisconnectReason::Abuse, &mut messages, &mut disconnects);
             }

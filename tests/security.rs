@@ -1,0 +1,150 @@
+//! The server refuses what it must, and nothing a client sends harms the session or leaks the truth.
+
+use bevy::prelude::*;
+use bevy_replicon::shared::message::registry::RemoteMessageRegistry;
+use bevy_replicon_renet::RenetClient;
+use glam::Vec2;
+use heist_client::JoinError;
+use heist_server::ServerOptions;
+use heist_shared::protocol::{
+    CaseId, ClientMsg, DisconnectReason, ItemId, ItemKind, ItemView, LobbyMsg, Phase, PhantomMsg, Refusal, Role,
+    ViveMsg,
+};
+use heist_tests::{HZ, Session, bot_heist, join};
+
+/// Both players joined and ready; returns (session, vive index, phantom index).
+fn heist_in_progress() -> (Session, usize, usize) {
+    let mut s = Session::new(11);
+    let vive = s.join(Role::Vive, |_| {});
+    let phantom = s.join(Role::Phantom, |_| {});
+    assert!(s.step_until(5 * HZ, |s| s.inbox(vive).role.is_some() && s.inbox(phantom).role.is_some()));
+    s.send(vive, ClientMsg::Lobby(LobbyMsg::Ready));
+    s.send(phantom, ClientMsg::Lobby(LobbyMsg::Ready));
+    assert!(s.step_until(5 * HZ, |s| s.server.game().phase == Phase::Heist), "the heist starts");
+    (s, vive, phantom)
+}
+
+fn send_raw(s: &mut Session, client: usize, bytes: &[u8]) {
+    let world = s.clients[client].world_mut();
+    let channel = world
+        .resource::<RemoteMessageRegistry>()
+        .client_message_channel::<ClientMsg>()
+        .expect("ClientMsg is registered");
+    world.resource_mut::<RenetClient>().send_message(channel as u8, bytes.to_vec());
+}
+
+#[test]
+fn a_second_claimant_of_a_role_is_refused_at_the_token_endpoint() {
+    let mut s = Session::new(1);
+    let _vive = s.join(Role::Vive, |_| {});
+    assert!(s.step_until(5 * HZ, |s| s.server.game().is_present(Role::Vive)));
+    match join(&s.server, Role::Vive, |_| {}) {
+        Err(e) => match e.downcast::<JoinError>() {
+            Ok(JoinError::Refused(reason)) => assert!(reason.contains("Vive role is already taken"), "{reason}"),
+            other => panic!("unexpected error {other:?}"),
+        },
+        Ok(_) => panic!("a second Vive got a token"),
+    }
+}
+
+#[test]
+fn a_role_thief_holding_a_token_is_disconnected_with_the_reason() {
+    let mut s = Session::new(2);
+    // Both tokens are minted before either player connects, so only the server can stop the thief.
+    let first = join(&s.server, Role::Vive, |_| {}).unwrap();
+    let thief = join(&s.server, Role::Vive, |_| {}).unwrap();
+    s.clients.push(first);
+    assert!(s.step_until(5 * HZ, |s| s.inbox(0).role == Some(Role::Vive)));
+    s.clients.push(thief);
+    assert!(s.step_until(5 * HZ, |s| s.inbox(1).disconnect.is_some()), "the thief is told");
+    assert_eq!(s.inbox(1).disconnect, Some(DisconnectReason::RoleTaken(Role::Vive)));
+    assert_eq!(s.inbox(1).role, None, "the thief was never welcomed");
+    s.step_until(HZ, |_| false);
+    assert!(s.clients[1].world().resource::<RenetClient>().is_disconnected());
+    assert!(s.server.game().is_present(Role::Vive), "the real Vive is still in");
+}
+
+#[test]
+fn malformed_and_illegal_messages_are_refused_without_harming_the_session() {
+    let (mut s, vive, phantom) = heist_in_progress();
+    send_raw(&mut s, vive, &[0xFF, 0xFF, 0xFF, 0x13, 0x37]);
+    s.send(vive, ClientMsg::Phantom(PhantomMsg::Verdict { item: ItemId(0), real: true }));
+    s.send(vive, ClientMsg::Vive(ViveMsg::Move { seq: 1, direction: Vec2::new(40.0, 0.0), gait: Default::default(), facing: 0.0 }));
+    s.send(vive, ClientMsg::Vive(ViveMsg::Break(CaseId(0))));
+    s.send(vive, ClientMsg::Vive(ViveMsg::Break(CaseId(999))));
+    s.send(phantom, ClientMsg::Phantom(PhantomMsg::Verdict { item: ItemId(0), real: false }));
+    let before = s.server.game().vive.position;
+    assert!(s.step_until(5 * HZ, |s| s.inbox(vive).refusals.len() >= 5 && !s.inbox(phantom).refusals.is_empty()));
+    let refusals = &s.inbox(vive).refusals;
+    assert!(matches!(&refusals[0], Refusal::Malformed(reason) if reason.contains("undecodable")), "{refusals:?}");
+    assert_eq!(refusals[1..5], [Refusal::WrongRole, Refusal::TooFast, Refusal::OutOfReach, Refusal::Unknown]);
+    assert_eq!(s.inbox(phantom).refusals, [Refusal::NotOnWorkbench], "Phantom only hears about its own mistake");
+    assert_eq!(s.server.game().phase, Phase::Heist);
+    assert_eq!(s.server.game().vive.position, before, "the too-fast move was not applied");
+    assert!(s.server.game().cases.iter().all(|c| !c.broken));
+    assert_eq!(s.client_phase(phantom), Some(Phase::Heist));
+}
+
+#[test]
+fn sustained_abuse_disconnects_only_the_abuser() {
+    let (mut s, vive, phantom) = heist_in_progress();
+    for i in 0..120u8 {
+        send_raw(&mut s, vive, &[0xF0, i, 0xAA]);
+    }
+    assert!(s.step_until(10 * HZ, |s| s.inbox(vive).disconnect.is_some()));
+    assert_eq!(s.inbox(vive).disconnect, Some(DisconnectReason::Abuse));
+    assert!(s.step_until(5 * HZ, |s| !s.server.game().is_present(Role::Vive)));
+    assert!(s.server.game().is_present(Role::Phantom));
+    assert!(s.inbox(phantom).refusals.is_empty());
+    assert!(s.clients[phantom].world().resource::<RenetClient>().is_connected());
+}
+
+#[test]
+fn no_client_ever_receives_which_copy_is_real() {
+    // Bots play a while so copies move, cases break and copies reach the workbench.
+    let mut heist = heist_server::demo::Heist::start(ServerOptions::local_test(6), heist_bots::ViveStyle::Careful).unwrap();
+    for _ in 0..(240 * HZ) {
+        heist.step();
+        if !heist.server.game().is_running() {
+            break;
+        }
+    }
+    let phantom_inbox = heist.phantom.world().resource::<heist_client::Inbox>();
+    assert!(phantom_inbox.received.workbench >= 1, "a copy reached the workbench");
+    let vive_inbox = heist.vive.world().resource::<heist_client::Inbox>();
+    assert_eq!(vive_inbox.received.workbench, 0, "the VR side never gets haptic geometry");
+    assert_eq!(vive_inbox.received.briefings, 0);
+
+    for app in [&mut heist.vive, &mut heist.phantom] {
+        let world = app.world_mut();
+        let items: Vec<ItemView> = world.query::<&ItemView>().iter(world).cloned().collect();
+        assert!(items.len() >= 9);
+        // All copies of one artifact look the same; nothing replicated mentions realness.
+        for a in &items {
+            for b in &items {
+                if let (ItemKind::Copy { artifact: x, look: lx }, ItemKind::Copy { artifact: y, look: ly }) = (&a.kind, &b.kind)
+                    && x == y
+                {
+                    assert_eq!(lx, ly);
+                }
+            }
+            let text = ron::to_string(a).unwrap().to_lowercase();
+            assert!(!text.contains("real") && !text.contains("fake") && !text.contains("truth"), "{text}");
+        }
+    }
+    // The truth exists only on the server.
+    assert!(heist.server.game().items.iter().filter_map(|i| i.truth.as_ref()).any(|t| t.real));
+}
+
+#[test]
+fn bots_never_send_anything_the_server_refuses() {
+    for style in [heist_bots::ViveStyle::Reckless, heist_bots::ViveStyle::Careful] {
+        let mut heist = heist_server::demo::Heist::start(ServerOptions::local_test(8), style).unwrap();
+        heist.run(90.0);
+        for app in [&heist.vive, &heist.phantom] {
+            let inbox = app.world().resource::<heist_client::Inbox>();
+            assert!(inbox.role.is_some(), "the bot was welcomed");
+            assert!(inbox.refusals.is_empty(), "{style:?}: {:?}", inbox.refusals);
+        }
+    }
+}

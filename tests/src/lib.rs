@@ -1,1 +1,0 @@
-//! heist_tests (being built).

@@ -1,0 +1,84 @@
+//! Shared helpers for the end-to-end tests: a server and hand-driven clients over loopback UDP.
+//!
+//! Every loop here is bounded by a tick count; the clock is stepped by hand (1/60 s per update), so a
+//! test's outcome does not depend on the machine's speed.
+
+use bevy::prelude::*;
+use heist_client::Inbox;
+pub use heist_server::demo::{Heist, join};
+use heist_server::{HostedServer, ServerOptions, build_server};
+use heist_shared::protocol::{Phase, Role, SessionView};
+
+/// Ticks per second of game time.
+pub const HZ: u64 = 60;
+
+/// A server with hand-driven clients.
+pub struct Session {
+    /// The server.
+    pub server: HostedServer,
+    /// Clients, in join order.
+    pub clients: Vec<App>,
+}
+
+impl Session {
+    /// A secure loopback server with the museum and `seed`.
+    pub fn new(seed: u64) -> Self {
+        Self::with_options(ServerOptions::local_test(seed))
+    }
+
+    /// A server with the given options.
+    pub fn with_options(options: ServerOptions) -> Self {
+        let server = build_server(options).expect("server starts");
+        Self { server, clients: Vec::new() }
+    }
+
+    /// Joins a client with `role` (through the token endpoint); returns its index.
+    pub fn join(&mut self, role: Role, setup: impl FnOnce(&mut App)) -> usize {
+        let app = join(&self.server, role, setup).expect("client joins");
+        self.clients.push(app);
+        self.clients.len() - 1
+    }
+
+    /// One tick for the server and every client.
+    pub fn step(&mut self) {
+        self.server.app.update();
+        for c in &mut self.clients {
+            c.update();
+        }
+    }
+
+    /// Steps until `done` holds, at most `max_ticks`; returns whether it held.
+    pub fn step_until(&mut self, max_ticks: u64, mut done: impl FnMut(&Self) -> bool) -> bool {
+        for _ in 0..max_ticks {
+            self.step();
+            if done(self) {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// A client's inbox.
+    pub fn inbox(&self, client: usize) -> &Inbox {
+        self.clients[client].world().resource::<Inbox>()
+    }
+
+    /// The session phase as a client sees it (None before replication arrives).
+    pub fn client_phase(&mut self, client: usize) -> Option<Phase> {
+        let world = self.clients[client].world_mut();
+        world.query::<&SessionView>().iter(world).next().map(|s| s.phase)
+    }
+
+    /// Sends a message from a client (written as a Bevy message; the client core sends it).
+    pub fn send(&mut self, client: usize, msg: heist_shared::protocol::ClientMsg) {
+        self.clients[client].world_mut().write_message(msg);
+    }
+}
+
+/// Runs a whole bot heist and returns the final phase and the log.
+pub fn bot_heist(options: ServerOptions, style: heist_bots::ViveStyle, max_game_s: f32) -> (Phase, Vec<String>, f32) {
+    let mut heist = Heist::start(options, style).expect("heist starts");
+    let phase = heist.run(max_game_s);
+    let game = heist.server.game();
+    (phase, heist.server.log().to_vec(), game.elapsed_s)
+}
