@@ -37,6 +37,8 @@ pub struct Window {
     pub budget_hits: u32,
     /// Longest collision step, µs.
     pub collision_work_max_us: u32,
+    /// CPU time the hypervisor stole around this window (all CPUs, ±one sampling interval), ms.
+    pub steal_ms: u64,
 }
 
 /// Counts, per window of `window_us`, the starts in `starts_us` (sorted), from `origin_us` on.
@@ -140,6 +142,21 @@ pub fn steps_from_sequences(forces: &[ForceSample]) -> Vec<StepTiming> {
     out
 }
 
+/// Attributes hypervisor steal to windows: `samples` are (haptic-clock µs, cumulative steal ms) taken
+/// every few tens of ms; a window gets the steal between the last sample before it and the first after it.
+pub fn add_steal(windows: &mut [Window], haptic: &[TickTiming], samples: &[(u64, u64)], window_us: u64, nominal_period_us: u64) {
+    let Some(first) = haptic.first() else { return };
+    let origin = first.start_us.saturating_sub(nominal_period_us / 2);
+    for (i, w) in windows.iter_mut().enumerate() {
+        let (t0, t1) = (origin + i as u64 * window_us, origin + (i as u64 + 1) * window_us);
+        let before = samples.iter().rev().find(|s| s.0 <= t0).or(samples.first());
+        let after = samples.iter().find(|s| s.0 >= t1).or(samples.last());
+        if let (Some(b), Some(a)) = (before, after) {
+            w.steal_ms = a.1.saturating_sub(b.1);
+        }
+    }
+}
+
 /// The figures the benchmark reports.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Summary {
@@ -187,12 +204,12 @@ pub fn summary(windows: &[Window], haptic: &[TickTiming], collision: &[StepTimin
 pub fn write_csv(out: &mut impl Write, windows: &[Window]) -> std::io::Result<()> {
     writeln!(
         out,
-        "t_s,haptic_hz,collision_hz,force_mean_n,force_max_n,torque_mean_nm,torque_max_nm,contacts_mean,budget_hits,collision_work_max_us"
+        "t_s,haptic_hz,collision_hz,force_mean_n,force_max_n,torque_mean_nm,torque_max_nm,contacts_mean,budget_hits,collision_work_max_us,steal_ms"
     )?;
     for w in windows {
         writeln!(
             out,
-            "{:.1},{:.0},{:.0},{:.4},{:.4},{:.5},{:.5},{:.1},{},{}",
+            "{:.1},{:.0},{:.0},{:.4},{:.4},{:.5},{:.5},{:.1},{},{},{}",
             w.t_s,
             w.haptic_hz,
             w.collision_hz,
@@ -202,7 +219,8 @@ pub fn write_csv(out: &mut impl Write, windows: &[Window]) -> std::io::Result<()
             w.torque_max_nm,
             w.contacts_mean,
             w.budget_hits,
-            w.collision_work_max_us
+            w.collision_work_max_us,
+            w.steal_ms
         )?;
     }
     Ok(())

@@ -88,6 +88,9 @@ impl WatchedObject {
 /// The collision thread's state.
 pub(crate) struct CollisionWorld {
     pub(crate) tool: Box<ToolSpec>,
+    // Boxed so that objects move in and out through the rings whole: unboxing here would free the box
+    // on this thread.
+    #[allow(clippy::vec_box)]
     pub(crate) objects: Vec<Box<WatchedObject>>,
     pub(crate) workspace: QueryWorkspace,
     pub(crate) poses: triple_buffer::Output<ToolPoseMsg>,

@@ -128,9 +128,14 @@ fn main() -> anyhow::Result<()> {
     let mut collision = Vec::with_capacity(ticks);
     let mut forces = Vec::with_capacity(ticks);
     let steal_before = steal_ms();
+    let clock = rig.clock();
+    let mut steal_samples: Vec<(u64, u64)> = Vec::with_capacity(1000);
     let run_start = Instant::now();
     while run_start.elapsed() < Duration::from_secs_f64(args.seconds) {
-        std::thread::sleep(Duration::from_millis(100));
+        if let Some(st) = steal_ms() {
+            steal_samples.push((clock.now_us(), st));
+        }
+        std::thread::sleep(Duration::from_millis(50));
         rig.drain_haptic_timings(&mut haptic);
         rig.drain_collision_timings(&mut collision);
         rig.drain_force_samples(&mut forces);
@@ -148,12 +153,15 @@ fn main() -> anyhow::Result<()> {
         collision = bench::steps_from_sequences(&forces);
     }
     let period_us = (1e6 / args.rate_hz as f64).round() as u64;
-    let windows = bench::windows(&haptic, &collision, &forces, 100_000, period_us);
+    let mut windows = bench::windows(&haptic, &collision, &forces, 100_000, period_us);
+    bench::add_steal(&mut windows, &haptic, &steal_samples, 100_000, period_us);
     let s = bench::summary(&windows, &haptic, &collision, &forces, period_us as u32);
     let nominal = args.rate_hz as f64;
     let low_haptic = windows.iter().filter(|w| w.haptic_hz < nominal).count();
     let low_collision = windows.iter().filter(|w| w.collision_hz < nominal).count();
     let stalls = haptic.iter().filter(|t| t.period_us as u64 > 5 * period_us).count();
+    let low_without_steal =
+        windows.iter().filter(|w| (w.haptic_hz < nominal || w.collision_hz < nominal) && w.steal_ms == 0).count();
 
     std::fs::create_dir_all(&args.out_dir).with_context(|| format!("creating {}", args.out_dir.display()))?;
     let csv_path = args.out_dir.join("windows.csv");
@@ -172,13 +180,14 @@ fn main() -> anyhow::Result<()> {
     }
 
     println!(
-        "haptic-bench: {} windows of 100 ms; min haptic {:.0} Hz, min collision {:.0} Hz; windows below {:.0} Hz: haptic {}, collision {}; haptic stalls > 5 periods {}; CPU time stolen by the hypervisor {}; haptic period jitter p50 {} us, p99 {} us, max {} us; collision jitter p50 {} us, p99 {} us; budget hits {}; max |F| {:.2} N (peak {:.2}), max |tau| {:.3} N.m, max |dF| per tick {:.3} N; skipped ticks {}; real-time scheduling {}, memory locked {}; safety {:?}; CSV {}, PNG {}",
+        "haptic-bench: {} windows of 100 ms; min haptic {:.0} Hz, min collision {:.0} Hz; windows below {:.0} Hz: haptic {}, collision {} ({} of them without hypervisor steal near them); haptic stalls > 5 periods {}; CPU time stolen by the hypervisor {}; haptic period jitter p50 {} us, p99 {} us, max {} us; collision jitter p50 {} us, p99 {} us; budget hits {}; max |F| {:.2} N (peak {:.2}), max |tau| {:.3} N.m, max |dF| per tick {:.3} N; skipped ticks {}; real-time scheduling {}, memory locked {}; safety {:?}; CSV {}, PNG {}",
         s.windows,
         s.min_haptic_hz,
         s.min_collision_hz,
         nominal,
         low_haptic,
         low_collision,
+        low_without_steal,
         stalls,
         steal.map_or("unknown".to_string(), |ms| format!("{ms} ms (all CPUs)")),
         s.haptic.jitter_p50_us,
@@ -219,6 +228,7 @@ fn main() -> anyhow::Result<()> {
             "windows_below_target_haptic": low_haptic,
             "windows_below_target_collision": low_collision,
             "haptic_stalls": stalls,
+            "windows_below_target_without_steal": low_without_steal,
             "steal_ms": steal,
             "seconds": args.seconds,
         });
