@@ -186,10 +186,12 @@ mod tests {
     use super::*;
     use std::sync::Mutex;
 
-    fn recorder() -> (Arc<Mutex<Vec<u32>>>, impl Fn(u32) -> Box<dyn FnMut(&u32) + Send>) {
+    type Log = Arc<Mutex<Vec<u32>>>;
+
+    fn recorder() -> (Log, impl Fn(u32) -> BoxedDelegate<u32>) {
         let log = Arc::new(Mutex::new(Vec::new()));
         let l = log.clone();
-        let make = move |tag: u32| -> Box<dyn FnMut(&u32) + Send> {
+        let make = move |tag: u32| -> BoxedDelegate<u32> {
             let l = l.clone();
             Box::new(move |v: &u32| l.lock().expect("test lock").push(tag * 100 + v))
         };

@@ -53,7 +53,7 @@ impl<D: Device> Lockstep<D> {
 
     /// One haptic tick at `t_us` (preceded by a collision step when due); returns the device command.
     pub fn tick(&mut self, t_us: u64) -> ForceTorque {
-        if !self.paused && self.core.ticks() % self.collision_every == 0 {
+        if !self.paused && self.core.ticks().is_multiple_of(self.collision_every) {
             self.world.apply_commands();
             self.world.step(&self.clock, t_us, self.budget.map(|b| Instant::now() + b));
         }
