@@ -4,7 +4,7 @@ use super::{Budget, OverlapResult};
 use crate::partitioning::{InnerSphereTree, Node};
 use crate::query::QueryWorkspace;
 use crate::shape::{Lens, lens, sphere_volume};
-use glam::Vec3;
+use glam::{Affine3A, Vec3};
 use haptic_common::Pose;
 use std::time::Instant;
 
@@ -14,7 +14,7 @@ const CLOCK_STRIDE: u32 = 8;
 pub(super) struct Engine<'a, S> {
     a: &'a InnerSphereTree,
     b: &'a InnerSphereTree,
-    pos12: Pose,
+    pos12: Affine3A,
     budget: Budget,
     aggregate: bool,
     sink: S,
@@ -28,7 +28,13 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
     /// volume as one contact (exact volume, far fewer pairs) instead of one contact per leaf pair.
     pub(super) fn new(a: &'a InnerSphereTree, b: &'a InnerSphereTree, pos12: Pose, budget: Budget, aggregate: bool, sink: S) -> Self {
         let result = OverlapResult { complete: true, ..OverlapResult::default() };
-        Self { a, b, pos12, budget, aggregate, sink, until_clock: 0, exhausted: false, result }
+        Self { a, b, pos12: Affine3A::from_rotation_translation(pos12.rotation, pos12.translation), budget, aggregate, sink, until_clock: 0, exhausted: false, result }
+    }
+
+    /// Maps a point of B's frame into A's frame.
+    #[inline(always)]
+    fn tp(&self, p: Vec3) -> Vec3 {
+        Vec3::from(self.pos12.transform_point3a(p.into()))
     }
 
     /// Exact depth-first descent.
@@ -123,7 +129,7 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
         self.result.node_pairs += 1;
         let na = &self.a.nodes[ia as usize];
         let nb = &self.b.nodes[ib as usize];
-        let cb = self.pos12.transform_point(nb.bound.center);
+        let cb = self.tp(nb.bound.center);
         let r = na.bound.radius + nb.bound.radius;
         if na.bound.center.distance_squared(cb) >= r * r {
             return (children, 0);
@@ -153,7 +159,7 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
     #[inline]
     fn leaf_pairs(&mut self, na: &Node, nb: &Node) {
         for sb in &self.b.spheres[nb.range()] {
-            let cb = self.pos12.transform_point(sb.center);
+            let cb = self.tp(sb.center);
             for sa in &self.a.spheres[na.range()] {
                 if let Some(l) = lens(sa.center, sa.radius, cb, sb.radius)
                     && l.volume > 0.0
@@ -173,7 +179,7 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
     fn contained(&mut self, na: &Node, nb: &Node, cb: Vec3) -> bool {
         if nb.leaf {
             for sb in &self.b.spheres[nb.range()] {
-                let c = self.pos12.transform_point(sb.center);
+                let c = self.tp(sb.center);
                 let d = na.bound.center.distance(c);
                 if d + na.bound.radius <= sb.radius {
                     let l = Lens { volume: na.volume, centroid: na.bound.center, depth: sb.radius + na.bound.radius - d };
@@ -206,7 +212,7 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
     fn estimate(&mut self, ia: u32, ib: u32) {
         let na = &self.a.nodes[ia as usize];
         let nb = &self.b.nodes[ib as usize];
-        let cb = self.pos12.transform_point(nb.bound.center);
+        let cb = self.tp(nb.bound.center);
         let Some(mut l) = lens(na.bound.center, na.bound.radius, cb, nb.bound.radius) else { return };
         let fill = |n: &Node| (n.volume / sphere_volume(n.bound.radius).max(f32::MIN_POSITIVE)).min(1.0);
         l.volume = (l.volume * fill(na) * fill(nb)).min(na.volume).min(nb.volume);
