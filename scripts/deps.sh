@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Installs the system packages the workspace needs to build and test (Debian/Ubuntu).
+# Safe to run repeatedly: it only calls apt-get when something is missing.
+set -euo pipefail
+packages=(pkg-config libudev-dev libfontconfig1-dev libfreetype-dev fonts-dejavu-core)
+missing=()
+for p in "${packages[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+    echo "installing system packages: ${missing[*]}"
+    sudo_cmd=""
+    [ "$(id -u)" -eq 0 ] || sudo_cmd="sudo"
+    $sudo_cmd apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq "${missing[@]}"
+fi
