@@ -355,6 +355,18 @@ mod tests {
     use crate::sim::{SimConfig, SimDevice, TargetPath};
     use crate::{MockDevice, presets};
 
+    /// Polls `done` every millisecond for up to 10 s (robust on a loaded CI machine).
+    fn eventually(mut done: impl FnMut() -> bool) -> bool {
+        let start = std::time::Instant::now();
+        while start.elapsed() < Duration::from_secs(10) {
+            if done() {
+                return true;
+            }
+            std::thread::sleep(Duration::from_millis(1));
+        }
+        false
+    }
+
     fn thread_state<D: Device>(
         device: D,
         events: HapticEvents,
@@ -415,9 +427,10 @@ mod tests {
             HapticHandle::spawn(device, HapticEvents::default(), HapticConfig::default(), HapticClock::new())
                 .expect("spawn");
         std::thread::sleep(Duration::from_millis(200));
-        let ticks = handle.telemetry().ticks;
         // Loose bounds: timing is measured by haptic-bench in release mode, not here.
-        assert!(ticks > 20 && ticks < 400, "ticks = {ticks}");
+        assert!(eventually(|| handle.telemetry().ticks > 20));
+        let ticks = handle.telemetry().ticks;
+        assert!(ticks < 20_000, "ticks = {ticks}");
         let mut timings = Vec::new();
         handle.drain_timings(&mut timings);
         assert!(!timings.is_empty());
@@ -434,13 +447,15 @@ mod tests {
         let d = handle
             .bind_force(|t: &ForceOnHapticTick| t.add(ForceTorque { force: Vec3::X, torque: Vec3::ZERO }))
             .expect("bind");
-        std::thread::sleep(Duration::from_millis(50));
-        assert_eq!(log.last_force(), Vec3::X);
+        assert!(eventually(|| log.last_force() == Vec3::X));
         d.unbind();
         handle.purge_unbound().expect("purge");
-        std::thread::sleep(Duration::from_millis(50));
-        assert_eq!(log.last_force(), Vec3::ZERO);
-        assert_eq!(handle.collect_garbage(), 1);
+        assert!(eventually(|| log.last_force() == Vec3::ZERO));
+        let mut freed = 0;
+        assert!(eventually(|| {
+            freed += handle.collect_garbage();
+            freed == 1
+        }));
         handle.set_forces_enabled(false).expect("command");
         drop(handle);
         assert_eq!(log.releases(), 1);

