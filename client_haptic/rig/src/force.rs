@@ -129,7 +129,9 @@ impl ForceStage {
         let tool_scene = self.map.to_scene(&tool_device);
         let (tool_com_local, tool_material) = match &mut self.source {
             Source::Rig { frames, .. } => {
-                let f = frames.read();
+                // Take the newest frame once per tick; both uses below see the same one.
+                frames.update();
+                let f = frames.output_buffer();
                 (f.tool_center_of_mass, f.tool_material)
             }
             Source::Collette(c) => (c.tool_center_of_mass, c.tool_material),
@@ -151,7 +153,7 @@ impl ForceStage {
         // (sequence of the data used, age of that data in µs; u64::MAX when there is none yet)
         let (sequence, age_us) = match &mut self.source {
             Source::Rig { frames, .. } => {
-                let frame = frames.read();
+                let frame = frames.output_buffer();
                 for object in frame.touched() {
                     add(&object.contacts, &object.material, &object.motion);
                 }
