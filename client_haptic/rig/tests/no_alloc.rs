@@ -1,0 +1,42 @@
+//! The whole per-tick work of both threads (collision step with collette's query, penalty force,
+//! coupling, safety, buffers) neither allocates nor frees once warmed up.
+
+mod utils;
+
+use assert_no_alloc::{AllocDisabler, assert_no_alloc};
+use forcecomp::Material;
+use glam::Vec3;
+use haptic_common::Pose;
+use haptic_rig::lockstep::Lockstep;
+use haptic_rig::{ObjectSpec, RigConfig, ToolSpec};
+use haptico::presets;
+use haptico::sim::{SimConfig, SimDevice, TargetPath};
+
+#[global_allocator]
+static ALLOCATOR: AllocDisabler = AllocDisabler;
+
+#[test]
+fn a_steady_state_rig_tick_neither_allocates_nor_frees() {
+    let device = SimDevice::new(
+        SimConfig::new(presets::phantom_premium_6dof()),
+        TargetPath::line(Vec3::new(0.0, 0.01, 0.0), Vec3::new(0.003, -0.003, 0.002), 2.0),
+    );
+    let tool = ToolSpec::new(utils::ball_tool(), Material::default());
+    let mut rig = Lockstep::new(device, tool, &RigConfig::default(), 1, None).expect("rig");
+    let slab = ObjectSpec { id: 1, tree: utils::slab(), pose: Pose::from_translation(Vec3::new(0.0, -0.01, 0.0)), material: Material::default() };
+    rig.add_object(slab).expect("object");
+    let mut t = 0;
+    for _ in 0..500 {
+        rig.tick(t);
+        t += 1000;
+    }
+    let mut contacts = 0;
+    assert_no_alloc(|| {
+        for _ in 0..2500 {
+            rig.tick(t);
+            t += 1000;
+            contacts += rig.telemetry().contacts;
+        }
+    });
+    assert!(contacts > 0, "the tool touched the slab during the checked ticks");
+}
