@@ -15,6 +15,10 @@ use std::path::Path;
 const HEADER: &str = "t_s,phase,x_m,y_m,z_m,qx,qy,qz,qw";
 
 /// Writes `samples` to `path` (created or truncated).
+///
+/// Format: lines starting with `#` are comments; one header line `t_s,phase,x_m,y_m,z_m,qx,qy,qz,qw`;
+/// then one line per sample: time in seconds, phase (`free`, `grazing`, `deep`), the tool's world
+/// translation in metres and its rotation quaternion, in Rust's shortest round-trip number form.
 pub fn write_trajectory_csv(path: impl AsRef<Path>, samples: &[TrajectorySample]) -> Result<(), TrajectoryError> {
     let path = path.as_ref();
     let io = |source| TrajectoryError::Io { path: path.to_owned(), source };
