@@ -29,6 +29,7 @@ fn careful_bots_break_cases_and_get_verdicts_over_the_network() {
     assert!(log.iter().any(|l| l.contains("broken")), "{}", log.join("\n"));
     assert!(log.iter().any(|l| l.contains("delivered to the workbench")));
     assert!(log.iter().any(|l| l.contains("Phantom declares")));
+    assert!(log.iter().any(|l| l.contains("noise: Thud")), "it threw something to lure a guard");
     assert!(log.iter().all(|l| !l.contains(": Wrong")), "the Phantom bot judged a copy wrongly:\n{}", log.join("\n"));
 }
 

@@ -5,9 +5,9 @@
 //! receives (replicated components and [`heist_client::Inbox`]) and only write `ClientMsg`s.
 #![warn(missing_docs)]
 
+mod forecast;
 mod phantom;
 mod vive;
-mod vision;
 
 pub use phantom::{PhantomBotPlugin, PhantomBrain};
 pub use vive::{ViveBotPlugin, ViveBrain, ViveStyle};

@@ -11,7 +11,7 @@ use heist_shared::protocol::{
 };
 use heist_shared::rules;
 
-use crate::vision::could_see;
+use crate::forecast::Forecast;
 
 /// How the Vive bot plays.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -29,8 +29,8 @@ pub enum ViveStyle {
 const LURE_AFTER_S: f32 = 4.0;
 /// Seconds of waiting on one goal after which the bot tries another item.
 const GIVE_UP_AFTER_S: f32 = 25.0;
-/// Seconds the bot stays put after backing out of a guard's sight.
-const HOLD_AFTER_RETREAT_S: f32 = 2.0;
+/// How far ahead the bot checks that its way stays out of sight, seconds.
+const LOOK_AHEAD_S: f32 = 6.0;
 /// Seconds the bot waits for guards to leave earshot before breaking a case anyway.
 const BREAK_PATIENCE_S: f32 = 12.0;
 
@@ -44,7 +44,6 @@ pub struct ViveBrain {
     route: Vec<Vec2>,
     route_goal: Option<Vec2>,
     waited_s: f32,
-    hold_s: f32,
     refuge: Option<Vec2>,
     committed: Option<ItemId>,
     stuck_s: f32,
@@ -52,8 +51,7 @@ pub struct ViveBrain {
     clock_s: f32,
     break_wait_s: f32,
     trail: Vec<Vec2>,
-    /// Per guard: last seen position, seconds since it changed, estimated velocity.
-    guard_motion: Vec<(heist_shared::protocol::GuardId, Vec2, f32, Vec2)>,
+    level: Option<heist_shared::level::Level>,
     /// Actions taken, for tests and logs.
     pub actions: Vec<String>,
 }
@@ -111,6 +109,7 @@ fn play(
         && let Some(level) = &inbox.level
     {
         brain.map = Some((NavGraph::new(level), WallSet::new(level), level.workbench));
+        brain.level = Some(level.clone());
     }
     if session.phase == Phase::Lobby && !brain.ready_sent && inbox.role.is_some() {
         out.write(ClientMsg::Lobby(LobbyMsg::Ready));
@@ -120,39 +119,10 @@ fn play(
         return;
     }
     let dt = time.delta_secs();
-    // Where each guard will be soon if it keeps walking: the bot dodges those too.
-    let walls_for_prediction = brain.map.as_ref().map(|m| m.1.clone());
-    let mut predicted: Vec<GuardView> = Vec::new();
-    for g in guards.iter() {
-        let entry = brain.guard_motion.iter_mut().find(|(id, ..)| *id == g.id);
-        let velocity = match entry {
-            Some((_, last, since, velocity)) => {
-                *since += dt;
-                if g.position != *last {
-                    *velocity = ((g.position - *last) / since.max(1e-3)).clamp_length_max(3.0);
-                    *last = g.position;
-                    *since = 0.0;
-                }
-                *velocity
-            }
-            None => {
-                brain.guard_motion.push((g.id, g.position, 0.0, Vec2::ZERO));
-                Vec2::ZERO
-            }
-        };
-        let future = g.position + velocity * 1.5;
-        let reachable = walls_for_prediction.as_ref().is_some_and(|w| w.line_of_sight(g.position, future));
-        if velocity.length() > 0.3 && reachable {
-            let mut ahead = g.clone();
-            ahead.position = future;
-            ahead.facing = velocity.y.atan2(velocity.x);
-            predicted.push(ahead);
-        }
-    }
     let view = View {
         me,
         alarm: session.alarm,
-        guards: guards.iter().chain(predicted.iter()).collect(),
+        guards: guards.iter().collect(),
         cases: cases.iter().collect(),
         items: items.iter().collect(),
         secured: session.targets.iter().filter(|t| t.1).map(|t| t.0).collect(),
@@ -201,7 +171,6 @@ fn choose_goal(brain: &ViveBrain, view: &View<'_>) -> Goal {
     let Some((_, _, workbench)) = &brain.map else { return Goal::Rest };
     let me = view.me.position;
     let carried_copy = view.me.carrying.iter().copied().find(|&i| is_copy(view, i));
-    let carrying_prop = view.me.carrying.iter().any(|&i| !is_copy(view, i));
     let hands_full = view.me.carrying.len() >= rules::CARRY_LIMIT;
 
     // Copies still worth fetching: their artifact is not secured yet.
@@ -252,6 +221,7 @@ fn choose_goal(brain: &ViveBrain, view: &View<'_>) -> Goal {
         }
         return Goal::Deliver(*workbench, copy);
     }
+    let carrying_prop = view.me.carrying.iter().any(|&i| !is_copy(view, i));
     if !carrying_prop
         && !hands_full
         && let Some((p, prop)) = view
@@ -265,7 +235,7 @@ fn choose_goal(brain: &ViveBrain, view: &View<'_>) -> Goal {
             .min_by(|a, b| me.distance(a.0).total_cmp(&me.distance(b.0)))
         && me.distance(p) < 5.0
     {
-        return Goal::Take(p, prop.id);
+        return Goal::Take(p, prop.id); // something to throw when a guard blocks the way
     }
     match nearest {
         Some((p, item)) => goal_for(view, *p, item),
@@ -296,53 +266,26 @@ fn steer(brain: &mut ViveBrain, view: &View<'_>, goal: Goal, dt: f32) -> (Vec2, 
     let reckless = brain.style == ViveStyle::Reckless;
     let Some((nav, walls, home)) = brain.map.clone() else { return (Vec2::ZERO, Gait::Walk, None) };
 
-    // Chased: run for the place we reach furthest ahead of the guard, and hope it loses sight.
-    if !reckless && let Some(g) = view.guards.iter().find(|g| g.alert == GuardAlert::Chasing) {
-        // Lead over the nearest guard (any guard, not just the chaser) at each candidate refuge.
-        let _ = g;
-        let lead = |p: Vec2| {
-            let mine = nav.route_length(me, p);
-            view.guards.iter().map(|o| nav.route_length(o.position, p) - mine).fold(f32::INFINITY, f32::min)
-        };
-        if brain.refuge.is_some_and(|r| r.distance(me) < 1.5) {
-            brain.refuge = None; // reached it and still chased: pick the next one
-        }
-        let refuge = *brain.refuge.get_or_insert_with(|| {
-            nav.room_centres()
-                .chain([home])
-                .filter(|p| p.distance(me) > 4.0)
-                .max_by(|a, b| lead(*a).total_cmp(&lead(*b)))
-                .unwrap_or(home)
-        });
-        let first = nav
-            .route(me, refuge)
-            .and_then(|r| r.into_iter().find(|p| p.distance(me) > 0.3))
-            .unwrap_or(refuge);
-        brain.route_goal = None;
-        return ((first - me).normalize_or_zero(), Gait::Run, None);
+    // Chased: run for the place we reach furthest ahead of every guard, and hope it loses sight.
+    if !reckless && view.guards.iter().any(|g| g.alert == GuardAlert::Chasing) {
+        return (flee(brain, view, &nav, me, home), Gait::Run, None);
     }
-    brain.refuge = None;
+    let Some(level) = brain.level.clone() else { return (Vec2::ZERO, Gait::Crouch, None) };
+    let forecast = Forecast::new(&level, &view.guards, view.alarm);
     // Too close for comfort, seen or not (walls and doors are thin): treat as exposed.
-    let crowded = view.guards.iter().any(|g| g.position.distance(me) < 3.5);
-    let exposed = !reckless && (crowded || view.guards.iter().any(|g| could_see(g, me, true, view.alarm, &walls)));
-    if exposed {
-        brain.hold_s = HOLD_AFTER_RETREAT_S;
-    } else if brain.hold_s > 0.0 {
-        // Just backed off: stay put a moment instead of stepping straight back into view.
-        brain.hold_s -= dt;
-        return (Vec2::ZERO, Gait::Crouch, None);
-    }
+    let crowded = view.guards.iter().any(|g| g.position.distance(me) < 3.0);
+    let exposed = !reckless && (crowded || forecast.seen(me, 0.0, true, &walls));
 
     if me.distance(target) <= rules::REACH * 0.8 {
         let Some(action) = in_reach_action else { return (Vec2::ZERO, Gait::Crouch, None) };
+        if exposed {
+            return hide(brain, view, &forecast, &nav, &walls, me);
+        }
         if let ViveMsg::Break(_) = action
             && !reckless
             && !safe_to_break(&nav, view, target)
         {
             brain.break_wait_s += dt;
-            if exposed {
-                return retreat(brain, view, me, &walls);
-            }
             if brain.break_wait_s < BREAK_PATIENCE_S {
                 return (Vec2::ZERO, Gait::Crouch, None);
             }
@@ -368,44 +311,92 @@ fn steer(brain: &mut ViveBrain, view: &View<'_>, goal: Goal, dt: f32) -> (Vec2, 
         return (direction, Gait::Run, None);
     }
 
-    let next = me + direction * 0.8;
-    // Entering another room while one of its guards is near the threshold: wait for it to walk off.
-    let entering = nav.room_at(next).filter(|r| Some(*r) != nav.room_at(me));
-    let hot = entering.is_some_and(|room| {
-        view.guards.iter().any(|g| {
-            let d = next - g.position;
-            let facing_us = (d.y.atan2(d.x) - g.facing + std::f32::consts::PI).rem_euclid(std::f32::consts::TAU)
-                - std::f32::consts::PI;
-            nav.room_at(g.position) == Some(room)
-                && (d.length() < 8.0 || (d.length() < 12.0 && facing_us.abs() < 1.1))
-        })
-    });
-    if hot && !exposed {
-        brain.waited_s += dt;
-        return lure_or_wait(brain, view, me, &walls);
+    brain.trail.push(me);
+    if brain.trail.len() > 900 {
+        brain.trail.remove(0);
     }
-    let seen_standing = view.guards.iter().any(|g| could_see(g, next, false, view.alarm, &walls));
-    let seen_crouching = view.guards.iter().any(|g| could_see(g, next, true, view.alarm, &walls));
-    if !seen_standing {
+    // Walk on only if the next seconds of the route stay out of every guard's forecast view.
+    let path: Vec<Vec2> = brain.route.iter().rev().copied().collect();
+    let quiet = view.guards.iter().all(|g| nav.heard_margin(me, g.position, rules::RUN_LOUDNESS * 1.5) < 0.0);
+    if quiet && forecast.path_hidden(me, &path, rules::RUN_SPEED, LOOK_AHEAD_S, false, &walls) {
         brain.waited_s = 0.0;
-        brain.trail.push(me);
-        if brain.trail.len() > 600 {
-            brain.trail.remove(0);
-        }
-        // Walking is quiet; running only when no guard could hear the footsteps.
-        let far = view.guards.iter().all(|g| nav.heard_margin(me, g.position, rules::RUN_LOUDNESS * 1.5) < 0.0);
-        return (direction, if far { Gait::Run } else { Gait::Walk }, None);
+        brain.refuge = None;
+        return (direction, Gait::Run, None);
     }
-    if !seen_crouching {
+    if forecast.path_hidden(me, &path, rules::WALK_SPEED, LOOK_AHEAD_S, false, &walls) {
+        brain.waited_s = 0.0;
+        brain.refuge = None;
+        return (direction, Gait::Walk, None);
+    }
+    if forecast.path_hidden(me, &path, rules::CROUCH_SPEED, LOOK_AHEAD_S * 0.5, true, &walls) {
         brain.waited_s = 0.0;
         return (direction, Gait::Crouch, None);
     }
-    // Blocked: wait, back off if we could be seen where we stand, and lure the guard after a while.
+    // The way is watched: wait where we are if it stays hidden, otherwise find a better hiding place.
     brain.waited_s += dt;
-    if exposed {
-        return retreat(brain, view, me, &walls);
+    if !exposed && forecast.hidden_for(me, LOOK_AHEAD_S * 0.5, &walls) {
+        return lure_or_wait(brain, view, me, &walls);
     }
-    lure_or_wait(brain, view, me, &walls)
+    hide(brain, view, &forecast, &nav, &walls, me)
+}
+
+/// Moves to the nearest spot we can reach unseen that then stays hidden; failing that, away from the
+/// nearest guard.
+fn hide(
+    brain: &mut ViveBrain,
+    view: &View<'_>,
+    forecast: &Forecast,
+    nav: &NavGraph,
+    walls: &WallSet,
+    me: Vec2,
+) -> (Vec2, Gait, Option<ViveMsg>) {
+    brain.route_goal = None;
+    let mut candidates: Vec<Vec2> = brain.trail.iter().rev().step_by(15).take(20).copied().collect();
+    candidates.extend(nav.room_centres());
+    for dx in [-3.0f32, 0.0, 3.0] {
+        for dy in [-3.0f32, 0.0, 3.0] {
+            candidates.push(me + Vec2::new(dx, dy));
+        }
+    }
+    let best = candidates
+        .into_iter()
+        .filter(|c| nav.room_at(*c).is_some())
+        .filter_map(|c| {
+            let route = nav.route(me, c)?;
+            let length = nav.route_length(me, c);
+            let ok = forecast.path_hidden(me, &route, rules::WALK_SPEED, length / rules::WALK_SPEED + 3.0, false, walls);
+            ok.then_some((length, route))
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0));
+    if let Some((_, route)) = best
+        && let Some(first) = route.into_iter().find(|p| p.distance(me) > 0.2)
+    {
+        return ((first - me).normalize_or_zero(), Gait::Walk, None);
+    }
+    let home = brain.map.as_ref().map_or(me, |m| m.2);
+    (flee(brain, view, nav, me, home), Gait::Walk, None)
+}
+
+/// Direction towards the refuge (a room centre or the workbench) we reach furthest ahead of every
+/// guard; the choice sticks until reached so the bot does not dither.
+fn flee(brain: &mut ViveBrain, view: &View<'_>, nav: &NavGraph, me: Vec2, home: Vec2) -> Vec2 {
+    let lead = |p: Vec2| {
+        let mine = nav.route_length(me, p);
+        view.guards.iter().map(|o| nav.route_length(o.position, p) - mine).fold(f32::INFINITY, f32::min)
+    };
+    if brain.refuge.is_some_and(|r| r.distance(me) < 1.5) {
+        brain.refuge = None; // reached it and still in danger: pick the next one
+    }
+    let refuge = *brain.refuge.get_or_insert_with(|| {
+        nav.room_centres()
+            .chain([home])
+            .filter(|p| p.distance(me) > 4.0)
+            .max_by(|a, b| lead(*a).total_cmp(&lead(*b)))
+            .unwrap_or(home)
+    });
+    let first = nav.route(me, refuge).and_then(|r| r.into_iter().find(|p| p.distance(me) > 0.3)).unwrap_or(refuge);
+    brain.route_goal = None;
+    (first - me).normalize_or_zero()
 }
 
 /// Waits crouching; after a while, throws a carried prop past the nearest guard to draw it away.
@@ -420,37 +411,6 @@ fn lure_or_wait(brain: &mut ViveBrain, view: &View<'_>, me: Vec2, _walls: &WallS
         return (Vec2::ZERO, Gait::Crouch, Some(ViveMsg::Throw { item: prop, target: beyond }));
     }
     (Vec2::ZERO, Gait::Crouch, None)
-}
-
-/// Backs off along the way we came, walking (quiet, and faster than a patrolling guard); with no
-/// trail left, steps straight away from the nearest guard that could see us.
-fn retreat(brain: &mut ViveBrain, view: &View<'_>, me: Vec2, walls: &WallSet) -> (Vec2, Gait, Option<ViveMsg>) {
-    brain.route_goal = None;
-    let too_close = view.guards.iter().find(|g| g.position.distance(me) < 3.5);
-    if let Some(g) = too_close {
-        brain.trail.clear();
-        return ((me - g.position).normalize_or_zero(), Gait::Walk, None);
-    }
-    // Run when no guard is near enough to hear the footsteps, walk otherwise.
-    let gait = if view.guards.iter().all(|g| g.position.distance(me) > rules::RUN_LOUDNESS * 1.3) {
-        Gait::Run
-    } else {
-        Gait::Walk
-    };
-    while let Some(back) = brain.trail.pop() {
-        if back.distance(me) > 0.05 {
-            return ((back - me).normalize_or_zero(), gait, None);
-        }
-    }
-    let watcher = view
-        .guards
-        .iter()
-        .filter(|g| g.position.distance(me) < 3.5 || could_see(g, me, true, view.alarm, walls))
-        .min_by(|a, b| a.position.distance(me).total_cmp(&b.position.distance(me)));
-    match watcher {
-        Some(g) => ((me - g.position).normalize_or_zero(), Gait::Walk, None),
-        None => (Vec2::ZERO, Gait::Crouch, None),
-    }
 }
 
 fn safe_to_break(nav: &NavGraph, view: &View<'_>, at: Vec2) -> bool {

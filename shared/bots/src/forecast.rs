@@ -1,0 +1,164 @@
+//! Where guards will be and look in the next seconds, from their public patrol routes.
+//!
+//! A patrolling guard walks its route at patrol speed; the bot replays that walk ahead of time. A guard
+//! that is not patrolling (staring, investigating, chasing, returning) is unpredictable: the bot treats
+//! it as standing still and looking every way.
+
+use glam::Vec2;
+use heist_shared::level::{Level, WallSet};
+use heist_shared::protocol::{GuardAlert, GuardView};
+
+/// Patrol speed the server uses, m/s (×1.15 per alarm level).
+const PATROL_SPEED: f32 = 1.1;
+/// Sight range the bot assumes (server value + margin), metres.
+const RANGE: f32 = 5.5 + 1.5;
+/// Half-angle of the cone the bot assumes (server value + margin), radians.
+const HALF_ANGLE: f32 = 0.7 + 0.35;
+/// Anyone within this distance is assumed seen, whatever the facing, metres.
+const ALL_ROUND: f32 = 2.2;
+
+/// One guard's future.
+enum Future {
+    /// Walks the route: (route, index of the waypoint it heads to, position now, speed).
+    Patrol(Vec<Vec2>, usize, Vec2, f32),
+    /// Unpredictable: stays put and looks all round.
+    Alert(Vec2),
+}
+
+/// The forecast of every guard.
+pub struct Forecast {
+    futures: Vec<Future>,
+    alarm: f32,
+}
+
+fn angle_of(v: Vec2) -> f32 {
+    v.y.atan2(v.x)
+}
+
+fn wrap(a: f32) -> f32 {
+    (a + std::f32::consts::PI).rem_euclid(std::f32::consts::TAU) - std::f32::consts::PI
+}
+
+impl Forecast {
+    /// Builds the forecast from what the client sees now.
+    pub fn new(level: &Level, guards: &[&GuardView], alarm: u8) -> Self {
+        let futures = guards
+            .iter()
+            .map(|g| {
+                let route = level.guards.get(usize::from(g.id.0)).map(|s| s.route.clone()).unwrap_or_default();
+                if g.alert != GuardAlert::Patrolling || route.len() < 2 {
+                    return Future::Alert(g.position);
+                }
+                let facing = Vec2::from_angle(g.facing);
+                let next = (0..route.len())
+                    .filter(|&i| route[i].distance(g.position) > 0.3)
+                    .max_by(|&a, &b| {
+                        let da = (route[a] - g.position).normalize_or_zero().dot(facing);
+                        let db = (route[b] - g.position).normalize_or_zero().dot(facing);
+                        da.total_cmp(&db)
+                    })
+                    .unwrap_or(0);
+                Future::Patrol(route, next, g.position, PATROL_SPEED * (1.0 + 0.15 * f32::from(alarm)))
+            })
+            .collect();
+        Self { futures, alarm: f32::from(alarm) }
+    }
+
+    /// Pose (position, facing) of guard `i` after `t` seconds.
+    fn pose(&self, i: usize, t: f32) -> (Vec2, Option<f32>) {
+        match &self.futures[i] {
+            Future::Alert(p) => (*p, None),
+            Future::Patrol(route, next, start, speed) => {
+                let mut at = *start;
+                let mut target = *next;
+                let mut left = t * speed;
+                loop {
+                    let to = route[target] - at;
+                    let d = to.length();
+                    if d >= left || d < 1e-4 && left <= 0.0 {
+                        let dir = to.normalize_or_zero();
+                        return (at + dir * left.min(d), Some(angle_of(if dir == Vec2::ZERO { Vec2::X } else { dir })));
+                    }
+                    left -= d;
+                    at = route[target];
+                    target = (target + 1) % route.len();
+                }
+            }
+        }
+    }
+
+    /// True when some guard could see a person at `p` (crouching or not) `t` seconds from now.
+    pub fn seen(&self, p: Vec2, t: f32, crouching: bool, walls: &WallSet) -> bool {
+        let range = RANGE * (1.0 + 0.1 * self.alarm) * if crouching { 0.6 } else { 1.0 };
+        (0..self.futures.len()).any(|i| {
+            let (g, facing) = self.pose(i, t);
+            let d = p - g;
+            let dist = d.length();
+            let in_view = match facing {
+                _ if dist < ALL_ROUND => true,
+                None => dist < range,
+                Some(f) => dist < range && wrap(angle_of(d) - f).abs() < HALF_ANGLE,
+            };
+            in_view && walls.line_of_sight(g, p)
+        })
+    }
+
+    /// True when `p` stays unseen (crouching) for the next `horizon` seconds.
+    pub fn hidden_for(&self, p: Vec2, horizon: f32, walls: &WallSet) -> bool {
+        (0..=(horizon * 4.0) as usize).all(|k| !self.seen(p, k as f32 * 0.25, true, walls))
+    }
+
+    /// True when walking the polyline from `from` through `path` at `speed` stays unseen for `horizon` s.
+    pub fn path_hidden(&self, from: Vec2, path: &[Vec2], speed: f32, horizon: f32, crouching: bool, walls: &WallSet) -> bool {
+        let mut at = from;
+        let mut t = 0.0;
+        let step = 0.25;
+        for &wp in path {
+            while at.distance(wp) > 1e-3 {
+                if self.seen(at, t, crouching, walls) {
+                    return false;
+                }
+                if t >= horizon {
+                    return true;
+                }
+                let d = (wp - at).length().min(speed * step);
+                at += (wp - at).normalize_or_zero() * d;
+                t += step;
+            }
+        }
+        // Arrived: the goal itself must stay hidden for what is left of the horizon.
+        (0..=((horizon - t).max(0.0) * 4.0) as usize).all(|k| !self.seen(at, t + k as f32 * 0.25, crouching, walls))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use heist_shared::protocol::GuardId;
+
+    fn guard(at: Vec2, facing: f32) -> GuardView {
+        GuardView { id: GuardId(0), name: "Bruno".into(), position: at, facing, alert: GuardAlert::Patrolling }
+    }
+
+    #[test]
+    fn a_patrolling_guard_is_replayed_along_its_route() {
+        let level = Level::museum();
+        let route = level.guards[0].route.clone();
+        let g = guard(route[0], 0.0);
+        let f = Forecast::new(&level, &[&g], 0);
+        let (p, facing) = f.pose(0, 2.0);
+        assert!((p - (route[0] + (route[1] - route[0]).normalize() * 2.2)).length() < 1e-3, "{p:?}");
+        assert!(facing.is_some());
+    }
+
+    #[test]
+    fn a_spot_behind_a_walking_guard_is_hidden_but_one_ahead_is_not() {
+        let level = Level::museum();
+        let walls = WallSet::new(&level);
+        let route = level.guards[0].route.clone();
+        let g = guard(route[0] + Vec2::new(4.0, 0.0), 0.0); // walking +x along the gallery
+        let f = Forecast::new(&level, &[&g], 0);
+        assert!(f.seen(g.position + Vec2::new(4.0, 0.0), 0.0, false, &walls));
+        assert!(!f.seen(g.position - Vec2::new(4.0, 0.0), 0.0, false, &walls));
+    }
+}
