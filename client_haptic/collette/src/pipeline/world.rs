@@ -141,7 +141,7 @@ impl CollisionWorld {
     }
 
     /// Checks every watched pair once and publishes its contacts; stops refining at `deadline` (each
-    /// query then estimates what it did not traverse). Pairs outside the region or with a missing
+    /// query gets an equal share of the time left and estimates what it did not traverse). Pairs outside the region or with a missing
     /// object publish an empty set. Returns the number of pairs queried.
     pub fn step(&mut self, deadline: Option<Instant>) -> usize {
         self.sequence += 1;
@@ -149,7 +149,14 @@ impl CollisionWorld {
             o.pose.update();
         }
         let mut queried = 0;
+        let mut remaining = self.watchers.iter().flatten().count() as u32;
         for w in self.watchers.iter_mut().flatten() {
+            // Each pair gets an equal share of what is left of the step, so one deep pair cannot starve the rest.
+            let share = deadline.map(|d| {
+                let now = Instant::now();
+                now + d.saturating_duration_since(now) / remaining.max(1)
+            });
+            remaining = remaining.saturating_sub(1);
             let set = w.out.input_buffer_mut();
             set.clear();
             set.object_a = w.a.0;
@@ -165,7 +172,7 @@ impl CollisionWorld {
                 self.region.is_none_or(|r| r.intersects_sphere(pose.transform_point(tree.root().bound.center), tree.root().bound.radius))
             };
             if in_region(&a.tree, &pa.pose) && in_region(&b.tree, &pb.pose) {
-                let budget = deadline.map_or(Budget::Unlimited, Budget::Deadline);
+                let budget = share.map_or(Budget::Unlimited, Budget::Deadline);
                 overlap_budgeted(&a.tree, &pa.pose, &b.tree, &pb.pose, budget, &mut self.workspace, set);
                 set.object_a = w.a.0;
                 set.object_b = w.b.0;
