@@ -148,3 +148,18 @@ fn bots_never_send_anything_the_server_refuses() {
         }
     }
 }
+
+#[test]
+fn an_insecure_server_admits_a_tokenless_client_by_its_claimed_role() {
+    let mut options = ServerOptions::local_test(4);
+    options.insecure = true;
+    let mut s = Session::with_options(options);
+    assert!(s.server.tokens.is_none(), "no token endpoint in insecure mode");
+    let mut app = heist_server::demo::stepped_client_app();
+    app.finish();
+    app.cleanup();
+    heist_client::connect_insecure(&mut app, s.server.addr, Role::Phantom).unwrap();
+    s.clients.push(app);
+    assert!(s.step_until(5 * HZ, |s| s.inbox(0).role == Some(Role::Phantom)));
+    assert!(s.server.game().is_present(Role::Phantom));
+}

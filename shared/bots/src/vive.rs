@@ -135,13 +135,7 @@ fn play(
         Goal::Break(_, _, item) | Goal::Take(_, item) => Some(*item),
         _ => None,
     };
-    let goal_text = if std::env::var_os("HEIST_BOT_TRACE").is_some() { Some(format!("{goal:?}")) } else { None };
     let (direction, gait, action) = steer(&mut brain, &view, goal, dt);
-    if let Some(goal_text) = goal_text
-        && brain.seq % 60 == 0
-    {
-        println!("    bot: goal {goal_text} route {:?} dir {direction:?} {gait:?}", brain.route);
-    }
     // Waiting on one goal for too long: try another item for a while.
     if direction == Vec2::ZERO && action.is_none() {
         brain.stuck_s += dt;

@@ -111,33 +111,26 @@ fn fill_inbox(mut messages: MessageReader<ServerMsg>, mut inbox: ResMut<Inbox>) 
 /// registration is done, before the first update).
 pub fn connect(app: &mut App, token: ConnectToken) -> Result<(), JoinError> {
     let server = token.server_addresses.iter().flatten().next().copied().ok_or(JoinError::NoServerAddress)?;
-    let bind = if server.ip().is_loopback() { "127.0.0.1:0" } else { "0.0.0.0:0" };
-    let socket = UdpSocket::bind(bind).map_err(JoinError::Socket)?;
-    let now = SystemTime::now().duration_since(UNIX_EPOCH).unwrap_or_default();
-    let transport = NetcodeClientTransport::new(now, ClientAuthentication::Secure { connect_token: token }, socket)
-        .map_err(|e| JoinError::Transport(e.to_string()))?;
-    let channels = app.world().resource::<RepliconChannels>();
-    let connection = ConnectionConfig {
-        server_channels_config: channels.server_configs(),
-        client_channels_config: channels.client_configs(),
-        ..Default::default()
-    };
-    app.insert_resource(RenetClient::new(connection)).insert_resource(transport);
-    Ok(())
+    insert_transport(app, server, ClientAuthentication::Secure { connect_token: token })
 }
 
 /// Connects without a token (the server must run with `--insecure`), claiming `role`.
 pub fn connect_insecure(app: &mut App, server: std::net::SocketAddr, role: Role) -> Result<(), JoinError> {
-    let bind = if server.ip().is_loopback() { "127.0.0.1:0" } else { "0.0.0.0:0" };
-    let socket = UdpSocket::bind(bind).map_err(JoinError::Socket)?;
-    let now = SystemTime::now().duration_since(UNIX_EPOCH).unwrap_or_default();
     let user_data = heist_shared::protocol::TokenUserData { role, session: 0 }.encode();
+    let client_id = SystemTime::now().duration_since(UNIX_EPOCH).unwrap_or_default().as_nanos() as u64;
     let auth = ClientAuthentication::Unsecure {
         protocol_id: heist_shared::protocol::PROTOCOL_ID,
-        client_id: now.as_nanos() as u64,
+        client_id,
         server_addr: server,
         user_data: Some(user_data),
     };
+    insert_transport(app, server, auth)
+}
+
+fn insert_transport(app: &mut App, server: std::net::SocketAddr, auth: ClientAuthentication) -> Result<(), JoinError> {
+    let bind = if server.ip().is_loopback() { "127.0.0.1:0" } else { "0.0.0.0:0" };
+    let socket = UdpSocket::bind(bind).map_err(JoinError::Socket)?;
+    let now = SystemTime::now().duration_since(UNIX_EPOCH).unwrap_or_default();
     let transport =
         NetcodeClientTransport::new(now, auth, socket).map_err(|e| JoinError::Transport(e.to_string()))?;
     let channels = app.world().resource::<RepliconChannels>();
