@@ -7,7 +7,7 @@
 //!
 //! - Build: [`TriMesh::from_obj`] / [`TriMesh::from_buffers`], then [`build`] with [`BuildOptions`].
 //! - Store: [`InnerSphereTree::save`] / [`InnerSphereTree::load`] (the `.ist` format, see [`io`]).
-//! - Query: [`overlap`], [`overlap_budgeted`], [`overlap_volume`], [`probe`], [`separation`], each with a
+//! - Query: [`overlap()`], [`overlap_budgeted`], [`overlap_volume`], [`probe()`], [`separation`], each with a
 //!   caller-owned [`QueryWorkspace`] and (for contacts) a [`ContactSet`].
 //! - Run: [`CollisionThread::spawn`] gives a [`CollisionHandle`]; poses in through [`PoseWriter`],
 //!   contacts out through [`ContactReader`].
