@@ -141,18 +141,28 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
         if self.aggregate && self.contained(na, nb, cb) {
             return (children, 0);
         }
+        // Children are tested here, so pairs that cannot overlap are never queued.
         let descend_a = nb.leaf || (!na.leaf && na.bound.radius >= nb.bound.radius);
-        let n = if descend_a {
-            for (k, c) in na.range().enumerate() {
-                children[k] = (c as u32, ib);
+        let mut n = 0;
+        if descend_a {
+            for c in na.range() {
+                let child = &self.a.nodes[c].bound;
+                let r = child.radius + nb.bound.radius;
+                if child.center.distance_squared(cb) < r * r {
+                    children[n] = (c as u32, ib);
+                    n += 1;
+                }
             }
-            na.count as usize
         } else {
-            for (k, c) in nb.range().enumerate() {
-                children[k] = (ia, c as u32);
+            for c in nb.range() {
+                let child = &self.b.nodes[c].bound;
+                let r = na.bound.radius + child.radius;
+                if na.bound.center.distance_squared(self.tp(child.center)) < r * r {
+                    children[n] = (ia, c as u32);
+                    n += 1;
+                }
             }
-            nb.count as usize
-        };
+        }
         (children, n)
     }
 
