@@ -28,6 +28,8 @@ const LOOK_AROUND_S: f32 = 3.0;
 const TURN_RATE: f32 = 4.0;
 /// How long a guard keeps staring at a vanished glimpse before checking the spot, seconds.
 const STARE_S: f32 = 1.5;
+/// Longest a guard stares at all before walking over to check, seconds.
+const MAX_STARE_S: f32 = 4.0;
 
 /// What a guard is doing and why.
 #[derive(Clone, Debug, PartialEq)]
@@ -40,6 +42,8 @@ pub enum GuardState {
         at: Vec2,
         /// Seconds since the glimpse was lost.
         unseen: f32,
+        /// Seconds spent staring so far.
+        stared: f32,
     },
     /// Walking to `at` (a noise or glimpse), then looking around.
     Investigate {
@@ -199,9 +203,17 @@ fn pursue_if_lost_sight(g: &Guard, _p: &Perception) -> Option<Decision> {
     }
 }
 
-/// Stop and stare at a glimpse that is not yet certain.
-fn stare_if_glimpsed(_g: &Guard, p: &Perception) -> Option<Decision> {
-    p.sees_vive.then_some(Decision::Stare(p.vive_at))
+/// Stop and stare at a glimpse that is not yet certain; after a while, walk over to check.
+fn stare_if_glimpsed(g: &Guard, p: &Perception) -> Option<Decision> {
+    if !p.sees_vive {
+        return None;
+    }
+    match g.state {
+        GuardState::Suspicious { stared, .. } if stared >= MAX_STARE_S => Some(Decision::Investigate(p.vive_at)),
+        // Already walking over to check: keep walking, towards the fresh glimpse.
+        GuardState::Investigate { .. } => Some(Decision::Investigate(p.vive_at)),
+        _ => Some(Decision::Stare(p.vive_at)),
+    }
 }
 
 /// Walk to a noise.
@@ -212,7 +224,9 @@ fn investigate_if_heard(_g: &Guard, p: &Perception) -> Option<Decision> {
 /// Keep staring a moment at a glimpse that vanished, then go and check the spot.
 fn investigate_if_glimpse_lost(g: &Guard, _p: &Perception) -> Option<Decision> {
     match g.state {
-        GuardState::Suspicious { at, unseen } if unseen < STARE_S => Some(Decision::Stare(at)),
+        GuardState::Suspicious { at, unseen, stared } if unseen < STARE_S && stared < MAX_STARE_S => {
+            Some(Decision::Stare(at))
+        }
         GuardState::Suspicious { at, .. } => Some(Decision::Investigate(at)),
         _ => None,
     }
@@ -278,11 +292,13 @@ pub fn think_and_act(g: &mut Guard, p: &Perception, walls: &WallSet, nav: &NavGr
             walk_towards(g, at, CHASE_SPEED * haste, walls, nav, dt);
         }
         Decision::Stare(at) => {
-            let unseen = match g.state {
-                GuardState::Suspicious { unseen, .. } if !p.sees_vive => unseen + dt,
-                _ => 0.0,
+            let (unseen, stared) = match g.state {
+                GuardState::Suspicious { unseen, stared, .. } => {
+                    (if p.sees_vive { 0.0 } else { unseen + dt }, stared + dt)
+                }
+                _ => (0.0, 0.0),
             };
-            g.state = GuardState::Suspicious { at, unseen };
+            g.state = GuardState::Suspicious { at, unseen, stared };
             g.alert = GuardAlert::Suspicious;
             turn_towards(g, angle_of(at - g.position), dt);
         }
@@ -378,6 +394,21 @@ mod tests {
     #[test]
     fn a_first_glimpse_makes_a_guard_stare_not_chase() {
         assert_eq!(decide(&guard(), &seen(Vec2::X * 6.0, 6.0)), Decision::Stare(Vec2::X * 6.0));
+    }
+
+    #[test]
+    fn a_guard_stops_staring_after_a_while_and_walks_over() {
+        let mut g = guard();
+        g.state = GuardState::Suspicious { at: Vec2::X * 5.0, unseen: 0.0, stared: MAX_STARE_S + 0.1 };
+        assert_eq!(decide(&g, &seen(Vec2::X * 5.0, 5.0)), Decision::Investigate(Vec2::X * 5.0));
+        assert_eq!(decide(&g, &Perception::default()), Decision::Investigate(Vec2::X * 5.0));
+    }
+
+    #[test]
+    fn a_guard_checking_a_spot_keeps_walking_when_it_glimpses_vive_again() {
+        let mut g = guard();
+        g.state = GuardState::Investigate { at: Vec2::X * 3.0, looked: 0.0 };
+        assert_eq!(decide(&g, &seen(Vec2::X * 6.0, 6.0)), Decision::Investigate(Vec2::X * 6.0));
     }
 
     #[test]

@@ -10,6 +10,8 @@ use heist_shared::protocol::{GuardAlert, GuardView};
 
 /// Patrol speed the server uses, m/s (×1.15 per alarm level).
 const PATROL_SPEED: f32 = 1.1;
+/// Speed at which the bot assumes an alerted guard comes at it, m/s.
+const ALERT_SPEED: f32 = 1.4;
 /// Sight range the bot assumes (server value + margin), metres.
 const RANGE: f32 = 5.5 + 1.5;
 /// Half-angle of the cone the bot assumes (server value + margin), radians.
@@ -21,8 +23,8 @@ const ALL_ROUND: f32 = 2.2;
 enum Future {
     /// Walks the route: (route, index of the waypoint it heads to, position now, speed).
     Patrol(Vec<Vec2>, usize, Vec2, f32),
-    /// Unpredictable: stays put and looks all round.
-    Alert(Vec2),
+    /// Unpredictable: assumed to walk straight at the bot, looking all round.
+    Alert(Vec2, Vec2),
 }
 
 /// The forecast of every guard.
@@ -40,14 +42,14 @@ fn wrap(a: f32) -> f32 {
 }
 
 impl Forecast {
-    /// Builds the forecast from what the client sees now.
-    pub fn new(level: &Level, guards: &[&GuardView], alarm: u8) -> Self {
+    /// Builds the forecast from what the client sees now; `me` is the bot's position.
+    pub fn new(level: &Level, guards: &[&GuardView], alarm: u8, me: Vec2) -> Self {
         let futures = guards
             .iter()
             .map(|g| {
                 let route = level.guards.get(usize::from(g.id.0)).map(|s| s.route.clone()).unwrap_or_default();
                 if g.alert != GuardAlert::Patrolling || route.len() < 2 {
-                    return Future::Alert(g.position);
+                    return Future::Alert(g.position, me);
                 }
                 let facing = Vec2::from_angle(g.facing);
                 let next = (0..route.len())
@@ -67,7 +69,11 @@ impl Forecast {
     /// Pose (position, facing) of guard `i` after `t` seconds.
     fn pose(&self, i: usize, t: f32) -> (Vec2, Option<f32>) {
         match &self.futures[i] {
-            Future::Alert(p) => (*p, None),
+            Future::Alert(p, towards) => {
+                let d = *towards - *p;
+                let walk = (ALERT_SPEED * t).min((d.length() - 1.0).max(0.0));
+                (*p + d.normalize_or_zero() * walk, None)
+            }
             Future::Patrol(route, next, start, speed) => {
                 let mut at = *start;
                 let mut target = *next;
@@ -145,7 +151,7 @@ mod tests {
         let level = Level::museum();
         let route = level.guards[0].route.clone();
         let g = guard(route[0], 0.0);
-        let f = Forecast::new(&level, &[&g], 0);
+        let f = Forecast::new(&level, &[&g], 0, Vec2::ZERO);
         let (p, facing) = f.pose(0, 2.0);
         assert!((p - (route[0] + (route[1] - route[0]).normalize() * 2.2)).length() < 1e-3, "{p:?}");
         assert!(facing.is_some());
@@ -157,7 +163,7 @@ mod tests {
         let walls = WallSet::new(&level);
         let route = level.guards[0].route.clone();
         let g = guard(route[0] + Vec2::new(4.0, 0.0), 0.0); // walking +x along the gallery
-        let f = Forecast::new(&level, &[&g], 0);
+        let f = Forecast::new(&level, &[&g], 0, Vec2::ZERO);
         assert!(f.seen(g.position + Vec2::new(4.0, 0.0), 0.0, false, &walls));
         assert!(!f.seen(g.position - Vec2::new(4.0, 0.0), 0.0, false, &walls));
     }

@@ -265,7 +265,7 @@ fn steer(brain: &mut ViveBrain, view: &View<'_>, goal: Goal, dt: f32) -> (Vec2, 
         return (flee(brain, view, &nav, me, home), Gait::Run, None);
     }
     let Some(level) = brain.level.clone() else { return (Vec2::ZERO, Gait::Crouch, None) };
-    let forecast = Forecast::new(&level, &view.guards, view.alarm);
+    let forecast = Forecast::new(&level, &view.guards, view.alarm, me);
     // Too close for comfort, seen or not (walls and doors are thin): treat as exposed.
     let crowded = view.guards.iter().any(|g| g.position.distance(me) < 3.0);
     let exposed = !reckless && (crowded || forecast.seen(me, 0.0, true, &walls));
