@@ -92,8 +92,18 @@ fn load_level(path: Option<PathBuf>) -> anyhow::Result<Level> {
     }
 }
 
-fn main() -> anyhow::Result<()> {
-    match Cli::parse().command {
+fn main() -> std::process::ExitCode {
+    match run(Cli::parse()) {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
         Command::Demo { seed, level, vive, time_limit } => {
             let mut options = ServerOptions::local_test(seed);
             options.level = load_level(level)?;
