@@ -131,7 +131,7 @@ pub struct GuardSpec {
 #[derive(Debug, Error)]
 pub enum LevelError {
     /// The file could not be read.
-    #[error("{path}: cannot read the level file: {source}")]
+    #[error("{path}: cannot read the level file")]
     Io {
         /// The file.
         path: PathBuf,
