@@ -118,3 +118,50 @@ pub fn run_demo(options: ServerOptions, style: ViveStyle) -> anyhow::Result<Phas
     println!("{result} after {:.1} s of game time", game.elapsed_s);
     Ok(phase)
 }
+
+/// Outcomes of many bot heists.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Tally {
+    /// Seeds won.
+    pub won: Vec<u64>,
+    /// Seeds lost because a guard caught Vive.
+    pub caught: Vec<u64>,
+    /// Seeds lost for any other reason (the timer, the alarm).
+    pub other: Vec<u64>,
+}
+
+impl std::fmt::Display for Tally {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let n = self.won.len() + self.caught.len() + self.other.len();
+        write!(
+            f,
+            "won {} of {n} ({:.1}%), caught {}, other losses {}; winning seeds: {:?}",
+            self.won.len(),
+            100.0 * self.won.len() as f64 / n.max(1) as f64,
+            self.caught.len(),
+            self.other.len(),
+            self.won
+        )
+    }
+}
+
+/// Plays one whole heist per seed on the shipped museum and tallies the outcomes; `each` gets every
+/// seed's result line as it finishes.
+pub fn sweep(seeds: impl IntoIterator<Item = u64>, style: ViveStyle, mut each: impl FnMut(u64, &str)) -> anyhow::Result<Tally> {
+    let mut tally = Tally::default();
+    for seed in seeds {
+        let options = ServerOptions::local_test(seed);
+        let limit = options.level.time_limit_s;
+        let mut heist = Heist::start(options, style)?;
+        let phase = heist.run(limit + 5.0);
+        let game = heist.server.game();
+        let line = crate::session::result_line(game).unwrap_or_else(|| format!("RESULT: unfinished ({phase:?})"));
+        each(seed, &format!("{line} after {:.1} s", game.elapsed_s));
+        match phase {
+            Phase::Won => tally.won.push(seed),
+            Phase::Lost(heist_shared::protocol::LossReason::Caught) => tally.caught.push(seed),
+            _ => tally.other.push(seed),
+        }
+    }
+    Ok(tally)
+}

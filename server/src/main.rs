@@ -54,6 +54,18 @@ enum Command {
         #[arg(long)]
         time_limit: Option<f32>,
     },
+    /// Play one whole bot heist per seed (no live log) and print each result and the tally.
+    Sweep {
+        /// First seed.
+        #[arg(long, default_value_t = 1)]
+        from: u64,
+        /// Last seed (inclusive).
+        #[arg(long, default_value_t = 50)]
+        to: u64,
+        /// How the Vive bot plays.
+        #[arg(long, value_enum, default_value_t = Style::Careful)]
+        vive: Style,
+    },
     /// Host a session for players: prints the address and the join code.
     Host {
         /// UDP game address; the token endpoint listens on the same port over TCP.
@@ -111,6 +123,12 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             options.echo_log = true;
             println!("Phantom Heist demo: {} with seed {seed}, both bots over loopback UDP", options.level.name);
             heist_server::demo::run_demo(options, vive.into())?;
+            Ok(())
+        }
+        Command::Sweep { from, to, vive } => {
+            anyhow::ensure!(from <= to, "--from {from} is after --to {to}");
+            let tally = heist_server::demo::sweep(from..=to, vive.into(), |seed, line| println!("seed {seed:>4}: {line}"))?;
+            println!("{tally}");
             Ok(())
         }
         Command::Host { bind, seed, level, insecure } => {

@@ -36,3 +36,20 @@ fn the_demo_prints_a_result_line() {
     assert!(last.starts_with("RESULT: Lost(caught) after "), "{stdout}");
     assert!(stdout.contains("phase: Heist"));
 }
+
+#[test]
+fn a_sweep_tallies_every_seed() {
+    let out = Command::new(env!("CARGO_BIN_EXE_heist-server"))
+        .args(["sweep", "--from", "1", "--to", "2", "--vive", "reckless"])
+        .output()
+        .expect("the server binary runs");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("seed    1: RESULT: Lost(caught)"), "{stdout}");
+    assert!(stdout.contains("seed    2: RESULT: Lost(caught)"), "{stdout}");
+    assert_eq!(stdout.lines().last(), Some("won 0 of 2 (0.0%), caught 2, other losses 0; winning seeds: []"), "{stdout}");
+
+    let bad = Command::new(env!("CARGO_BIN_EXE_heist-server")).args(["sweep", "--from", "5", "--to", "2"]).output().unwrap();
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--from 5 is after --to 2"));
+}
