@@ -35,15 +35,15 @@ fn careful_bots_break_cases_and_get_verdicts_over_the_network() {
 
 #[test]
 fn careful_bots_can_win_a_whole_heist() {
-    // Seed 7 is one the careful bot wins (deterministic: stepped clock, loopback UDP).
-    let (phase, log, t) = bot_heist(ServerOptions::local_test(7), ViveStyle::Careful, 600.0);
+    // Seed 10 is one the careful bot wins (deterministic: stepped clock, loopback UDP).
+    let (phase, log, t) = bot_heist(ServerOptions::local_test(10), ViveStyle::Careful, 600.0);
     assert_eq!(phase, Phase::Won, "after {t} s:\n{}", log.join("\n"));
     assert_eq!(log.iter().filter(|l| l.contains(": Secured")).count(), 3);
     assert!(log.iter().any(|l| l.contains(": Discarded")), "fakes were delivered and recognised too");
 }
 
 /// Bots win whole heists on several seeds. These are seeds the careful Vive bot wins (it wins about
-/// 1 in 30; `heist-server sweep` measures it, and docs/rules.md "Bot status" has the figures). The
+/// 1 in 5; `heist-server sweep` measures it, and docs/rules.md "Bot status" has the figures). The
 /// outcome of a seed is deterministic: stepped clock, loopback UDP.
 #[test]
 fn careful_bots_win_full_heists_on_several_seeds() {

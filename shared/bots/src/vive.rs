@@ -52,6 +52,8 @@ pub struct ViveBrain {
     break_wait_s: f32,
     trail: Vec<Vec2>,
     level: Option<heist_shared::level::Level>,
+    /// When the refuge was last chosen.
+    refuge_at: f32,
     /// Actions taken, for tests and logs.
     pub actions: Vec<String>,
 }
@@ -374,23 +376,61 @@ fn hide(
 /// Direction towards the refuge (a room centre or the workbench) we reach furthest ahead of every
 /// guard; the choice sticks until reached so the bot does not dither.
 fn flee(brain: &mut ViveBrain, view: &View<'_>, nav: &NavGraph, me: Vec2, home: Vec2) -> Vec2 {
-    let lead = |p: Vec2| {
-        let mine = nav.route_length(me, p);
-        view.guards.iter().map(|o| nav.route_length(o.position, p) - mine).fold(f32::INFINITY, f32::min)
-    };
     if brain.refuge.is_some_and(|r| r.distance(me) < 1.5) {
         brain.refuge = None; // reached it and still in danger: pick the next one
     }
-    let refuge = *brain.refuge.get_or_insert_with(|| {
-        nav.room_centres()
-            .chain([home])
-            .filter(|p| p.distance(me) > 4.0)
-            .max_by(|a, b| lead(*a).total_cmp(&lead(*b)))
-            .unwrap_or(home)
-    });
+    // Think again every second (guards move), but switch only for a clearly better refuge.
+    if brain.refuge.is_none() || brain.clock_s - brain.refuge_at > 1.0 {
+        brain.refuge_at = brain.clock_s;
+        brain.refuge = pick_refuge(brain, view, nav, me, brain.refuge);
+    }
+    let refuge = brain.refuge.unwrap_or(home);
     let first = nav.route(me, refuge).and_then(|r| r.into_iter().find(|p| p.distance(me) > 0.3)).unwrap_or(refuge);
     brain.route_goal = None;
     (first - me).normalize_or_zero()
+}
+
+/// The spot (a room centre or the middle of a room quarter) we keep the most room at along the whole
+/// way there: ahead of every alerted guard, and outside every patrolling guard's sight.
+fn pick_refuge(brain: &ViveBrain, view: &View<'_>, nav: &NavGraph, me: Vec2, current: Option<Vec2>) -> Option<Vec2> {
+    let level = brain.level.as_ref()?;
+    let spots = level.rooms.iter().flat_map(|r| {
+        let (c, h) = ((r.min + r.max) * 0.5, (r.max - r.min) * 0.25);
+        [c, c + h, c - h, c + Vec2::new(h.x, -h.y), c + Vec2::new(-h.x, h.y)]
+    });
+    let room_left = |p: Vec2| {
+        let Some(route) = nav.route(me, p) else { return f32::NEG_INFINITY };
+        let (mut last, mut mine, mut worst) = (me, 0.0f32, 20.0f32);
+        for wp in points_along(me, &route) {
+            mine += last.distance(wp);
+            last = wp;
+            for g in &view.guards {
+                let theirs = nav.route_length(g.position, wp);
+                worst = worst.min(match g.alert {
+                    GuardAlert::Patrolling | GuardAlert::Returning => theirs - 6.0,
+                    _ => theirs - mine,
+                });
+            }
+        }
+        worst + 0.05 * mine
+    };
+    let best = spots.filter(|p| p.distance(me) > 6.0).map(|p| (room_left(p), p)).max_by(|a, b| a.0.total_cmp(&b.0));
+    match (current, best) {
+        (Some(c), Some((s, _))) if room_left(c) + 3.0 >= s => Some(c),
+        (_, best) => best.map(|b| b.1),
+    }
+}
+
+/// Points every metre along a polyline starting at `from`.
+fn points_along(from: Vec2, route: &[Vec2]) -> Vec<Vec2> {
+    let mut at = from;
+    let mut points = Vec::new();
+    for &wp in route {
+        let steps = at.distance(wp).ceil().max(1.0) as usize;
+        points.extend((1..=steps).map(|k| at.lerp(wp, k as f32 / steps as f32)));
+        at = wp;
+    }
+    points
 }
 
 /// Waits crouching; after a while, throws a carried prop past the nearest guard to draw it away.
