@@ -102,13 +102,21 @@ impl Heist {
     }
 }
 
-/// Runs a whole heist with bots and prints the log and the result.
-pub fn run_demo(options: ServerOptions, style: ViveStyle) -> anyhow::Result<Phase> {
+/// Plays a whole heist with bots to its end (or a little past its time limit); returns the heist, the
+/// final phase and the result line.
+fn play_to_the_end(options: ServerOptions, style: ViveStyle) -> anyhow::Result<(Heist, Phase, String)> {
     let limit = options.game.time_limit_s.unwrap_or(options.level.time_limit_s);
     let mut heist = Heist::start(options, style)?;
     let phase = heist.run(limit + 5.0);
+    let result =
+        crate::session::result_line(heist.server.game()).unwrap_or_else(|| format!("RESULT: unfinished ({phase:?})"));
+    Ok((heist, phase, result))
+}
+
+/// Runs a whole heist with bots and prints the log and the result.
+pub fn run_demo(options: ServerOptions, style: ViveStyle) -> anyhow::Result<Phase> {
+    let (heist, phase, result) = play_to_the_end(options, style)?;
     let game = heist.server.game();
-    let result = crate::session::result_line(game).unwrap_or_else(|| format!("RESULT: unfinished ({phase:?})"));
     for (name, app) in [("Vive", &heist.vive), ("Phantom", &heist.phantom)] {
         let inbox = app.world().resource::<heist_client::Inbox>();
         if !inbox.refusals.is_empty() {
@@ -150,13 +158,8 @@ impl std::fmt::Display for Tally {
 pub fn sweep(seeds: impl IntoIterator<Item = u64>, style: ViveStyle, mut each: impl FnMut(u64, &str)) -> anyhow::Result<Tally> {
     let mut tally = Tally::default();
     for seed in seeds {
-        let options = ServerOptions::local_test(seed);
-        let limit = options.level.time_limit_s;
-        let mut heist = Heist::start(options, style)?;
-        let phase = heist.run(limit + 5.0);
-        let game = heist.server.game();
-        let line = crate::session::result_line(game).unwrap_or_else(|| format!("RESULT: unfinished ({phase:?})"));
-        each(seed, &format!("{line} after {:.1} s", game.elapsed_s));
+        let (heist, phase, result) = play_to_the_end(ServerOptions::local_test(seed), style)?;
+        each(seed, &format!("{result} after {:.1} s", heist.server.game().elapsed_s));
         match phase {
             Phase::Won => tally.won.push(seed),
             Phase::Lost(heist_shared::protocol::LossReason::Caught) => tally.caught.push(seed),

@@ -373,8 +373,8 @@ fn hide(
     (flee(brain, view, nav, me, home), Gait::Walk, None)
 }
 
-/// Direction towards the refuge (a room centre or the workbench) we reach furthest ahead of every
-/// guard; the choice sticks until reached so the bot does not dither.
+/// Direction towards the refuge chosen by [`pick_refuge`] (the workbench when there is none); the
+/// choice is reconsidered every second and dropped once reached.
 fn flee(brain: &mut ViveBrain, view: &View<'_>, nav: &NavGraph, me: Vec2, home: Vec2) -> Vec2 {
     if brain.refuge.is_some_and(|r| r.distance(me) < 1.5) {
         brain.refuge = None; // reached it and still in danger: pick the next one
