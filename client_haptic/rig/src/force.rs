@@ -23,6 +23,8 @@ pub struct ForceSample {
     pub torque: Vec3,
     /// Contact force on the simulated tool before coupling and safety (device frame), N.
     pub contact_force: Vec3,
+    /// Where the simulated tool was (scene frame), m.
+    pub tool_position: Vec3,
     /// Contacts used.
     pub contacts: u32,
     /// Age of the contact data, µs.
@@ -214,6 +216,7 @@ impl ForceStage {
             force: out.force,
             torque: out.torque,
             contact_force: contact_device.force,
+            tool_position: tool_now.translation,
             contacts,
             data_age_us: age_us.min(u32::MAX as u64) as u32,
             collision_sequence: sequence,

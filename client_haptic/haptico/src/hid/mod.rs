@@ -105,9 +105,12 @@ pub fn list_devices() -> Result<Vec<HidDeviceInfo>> {
         .collect())
 }
 
-pub(crate) fn open_first(kind: HidKind, wanted: &str) -> Result<(hidapi::HidDevice, HidDeviceInfo)> {
+pub(crate) fn open_first(kind: HidKind, wanted: &str, path: Option<&str>) -> Result<(hidapi::HidDevice, HidDeviceInfo)> {
     let api = hidapi::HidApi::new().map_err(hid_err)?;
-    let found = api.device_list().find(|d| classify(d.vendor_id(), d.usage_page(), d.usage()) == kind);
+    let found = api.device_list().find(|d| {
+        classify(d.vendor_id(), d.usage_page(), d.usage()) == kind
+            && path.is_none_or(|p| d.path().to_string_lossy() == p)
+    });
     let Some(info) = found else {
         return Err(HapticoError::NoDevice { wanted: wanted.into(), hint: UDEV_HINT.into() });
     };

@@ -90,7 +90,12 @@ impl PidForceDevice {
     /// Opens the first PID device, creates and starts a constant-force effect in block 1 at zero force.
     /// `peak_force_n` is what full magnitude means on this device (not published by the device itself).
     pub fn open_first(ids: PidReportIds, peak_force_n: f32) -> Result<Self> {
-        let (device, info) = open_first(HidKind::ForceFeedback, "HID PID force-feedback device")?;
+        Self::open(ids, peak_force_n, None)
+    }
+
+    /// Like [`PidForceDevice::open_first`], but only the interface at hidraw `path` (e.g. `/dev/hidraw3`) when given.
+    pub fn open(ids: PidReportIds, peak_force_n: f32, path: Option<&str>) -> Result<Self> {
+        let (device, info) = open_first(HidKind::ForceFeedback, "HID PID force-feedback device", path)?;
         let block = 1;
         device.write(&[ids.device_control, 0x01]).map_err(hid_err)?; // enable actuators
         device.write(&encode_set_effect(&ids, block, 0)).map_err(hid_err)?;

@@ -110,7 +110,12 @@ impl std::fmt::Debug for SpaceMouse {
 impl SpaceMouse {
     /// Opens the first SpaceMouse found.
     pub fn open_first(mode: SpaceMouseMode) -> Result<Self> {
-        let (device, info) = open_first(HidKind::SixDofInput, "3Dconnexion SpaceMouse")?;
+        Self::open(mode, None)
+    }
+
+    /// Like [`SpaceMouse::open_first`], but only the interface at hidraw `path` when given.
+    pub fn open(mode: SpaceMouseMode, path: Option<&str>) -> Result<Self> {
+        let (device, info) = open_first(HidKind::SixDofInput, "3Dconnexion SpaceMouse", path)?;
         Ok(Self {
             device,
             info,

@@ -139,8 +139,9 @@ fn ray_hit(origin: Vec3, dir: Vec3, c: &[Vec3; 3]) -> Option<f32> {
 }
 
 /// Number of separate stretches where a circular profile is high, with hysteresis so that
-/// tessellation ripples do not count.
-fn count_high_runs(profile: &[f32]) -> u32 {
+/// tessellation ripples (or a probe's noise) do not count: a run starts above 65 % of the
+/// peak-to-valley range and ends below 35 %; a profile varying less than [`MIN_FEATURE_SIZE_M`] has none.
+pub fn count_high_runs(profile: &[f32]) -> u32 {
     let Some(start) = profile.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1)).map(|(i, _)| i) else {
         return 0;
     };

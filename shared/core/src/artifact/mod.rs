@@ -15,7 +15,7 @@ mod lathe;
 mod mesh;
 mod shapes;
 
-pub use analyze::{MIN_FEATURE_SIZE_M, Observed, PROBE_RAYS, analyze, judge, matches};
+pub use analyze::{MIN_FEATURE_SIZE_M, Observed, PROBE_RAYS, analyze, count_high_runs, judge, matches};
 pub use briefing::{Briefing, briefing, number_in_words};
 pub use generate::{MIN_COPIES, generate_copies};
 pub use kind::{ArtifactKind, ArtifactLook, CopyTraits, Material, MaterialClass, look};
