@@ -1,0 +1,105 @@
+//! Offline listening tests: the engine renders into memory and the frames are measured.
+
+use super::*;
+
+fn engine(spatial: SpatialMode) -> AudioEngine {
+    AudioEngine::new(&AudioSettings { output: AudioOutput::Manual, spatial, ..Default::default() }).expect("engine starts")
+}
+
+/// A 20 ms noise burst.
+fn click() -> StaticSoundData {
+    let mut n = synth::Noise::new(5);
+    let s: Vec<f32> = (0..960).map(|_| 0.5 * n.next_sample()).collect();
+    synth::mono(&s)
+}
+
+fn energy(frames: &[(f32, f32)]) -> (f32, f32) {
+    frames.iter().fold((0.0, 0.0), |(l, r), f| (l + f.0 * f.0, r + f.1 * f.1))
+}
+
+/// How many samples the left ear lags the right (the lag of the cross-correlation's peak).
+fn left_lag(frames: &[(f32, f32)]) -> i64 {
+    (-60i64..=60)
+        .map(|lag| {
+            let c: f32 = (60..frames.len() - 60).map(|i| frames[i].1 * frames[(i as i64 + lag) as usize].0).sum();
+            (lag, c)
+        })
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .map_or(0, |(lag, _)| lag)
+}
+
+fn right_source_is_louder_and_earlier_in_the_right_ear(spatial: SpatialMode) {
+    let mut e = engine(spatial);
+    e.play_at(click(), Vec3::new(2.0, 0.0, 0.0), "click");
+    let frames = e.capture().expect("memory output").render(9600);
+    let (l, r) = energy(&frames);
+    assert!(r > 2.0 * l, "{spatial:?}: right {r} left {l}");
+    // The left ear hears it later: about 0.66 ms at 90°, 32 samples at 48 kHz.
+    let lag = left_lag(&frames);
+    assert!((20..=45).contains(&lag), "{spatial:?}: the left ear lags by {lag} samples");
+}
+
+#[test]
+fn a_source_on_the_right_is_louder_in_the_right_ear_and_arrives_there_first_through_the_hrtf() {
+    right_source_is_louder_and_earlier_in_the_right_ear(SpatialMode::Hrtf);
+}
+
+#[test]
+fn the_time_and_level_fallback_also_puts_a_right_source_on_the_right() {
+    right_source_is_louder_and_earlier_in_the_right_ear(SpatialMode::TimeLevel);
+}
+
+#[test]
+fn a_source_on_the_left_is_louder_in_the_left_ear() {
+    let mut e = engine(SpatialMode::Hrtf);
+    e.play_at(click(), Vec3::new(-2.0, 0.0, -0.5), "click");
+    let (l, r) = energy(&e.capture().expect("memory output").render(9600));
+    assert!(l > 2.0 * r, "left {l} right {r}");
+}
+
+#[test]
+fn a_source_four_times_farther_is_four_times_quieter() {
+    let rms = |distance: f32| {
+        let mut e = engine(SpatialMode::Hrtf);
+        e.play_at(click(), Vec3::new(0.0, 0.0, -distance), "click");
+        let (l, r) = energy(&e.capture().expect("memory output").render(9600));
+        ((l + r) / 2.0).sqrt()
+    };
+    let (near, far) = (rms(2.0), rms(8.0));
+    assert!(near > 0.0);
+    let ratio = near / far;
+    assert!((3.5..4.5).contains(&ratio), "amplitude ratio {ratio} for 2 m vs 8 m");
+    assert_eq!(rms(binaural::MAX_DISTANCE_M + 1.0), 0.0, "past the maximum distance a source is silent");
+}
+
+#[test]
+fn a_contact_makes_a_contact_sound_and_free_space_is_silent() {
+    let mut e = engine(SpatialMode::Hrtf);
+    let capture = e.capture().expect("memory output").clone();
+    e.contact(ContactParams::default());
+    let (l, r) = energy(&capture.render(24_000));
+    assert!(l + r < 1e-9, "free space: energy {}", l + r);
+    e.contact(ContactParams { force_n: 1.5, slip_m_per_s: 0.05, hardness: 1.0, roughness: 1.0 });
+    let (l, r) = energy(&capture.render(24_000));
+    assert!(l + r > 1e-2, "sliding contact: energy {}", l + r);
+    e.contact(ContactParams::default());
+    capture.render(24_000);
+    let (l, r) = energy(&capture.render(24_000));
+    assert!(l + r < 1e-6, "after lifting the stylus: energy {}", l + r);
+    e.tap(1.0);
+    let (l, r) = energy(&capture.render(4_800));
+    assert!(l + r > 1e-3, "a tap: energy {}", l + r);
+}
+
+#[test]
+fn a_rough_scrape_is_louder_than_a_smooth_one() {
+    let scrape = |roughness: f32| {
+        let mut e = engine(SpatialMode::TimeLevel);
+        let capture = e.capture().expect("memory output").clone();
+        e.contact(ContactParams { force_n: 1.0, slip_m_per_s: 0.05, hardness: 0.5, roughness });
+        capture.render(4_800);
+        let (l, r) = energy(&capture.render(24_000));
+        l + r
+    };
+    assert!(scrape(1.0) > 1.5 * scrape(0.0));
+}

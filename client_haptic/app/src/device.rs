@@ -1,0 +1,280 @@
+//! Which haptic device the client drives, and how the game thread steers a simulated hand.
+//!
+//! You need this module to open the device named on the command line (`sim`, `trace:FILE`,
+//! `hid[:PATH]`) and, with the sim device, to move its hand from the keyboard or from the bot through
+//! a [`HandControl`] (latest [`HandGoal`] through a triple buffer: the haptic thread never waits).
+
+use std::f32::consts::TAU;
+use std::path::PathBuf;
+use std::str::FromStr;
+
+use glam::{Quat, Vec3};
+use haptic_common::{DeviceState, ForceTorque, Pose};
+use haptico::sim::{SimConfig, SimDevice, TargetPath};
+use haptico::{Device, DeviceSpecs};
+
+use crate::error::ClientError;
+
+/// The device named by `--device`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum DeviceChoice {
+    /// A simulated device moved by the keyboard or the bot (the default).
+    Sim,
+    /// Replays a recorded trace (haptico's CSV format), looping.
+    Trace(PathBuf),
+    /// A HID device: the first HID PID force-feedback device or SpaceMouse, or the one at hidraw `PATH`.
+    Hid(Option<String>),
+}
+
+impl FromStr for DeviceChoice {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.split_once(':') {
+            None if s == "sim" => Ok(Self::Sim),
+            None if s == "hid" => Ok(Self::Hid(None)),
+            Some(("trace", file)) if !file.is_empty() => Ok(Self::Trace(PathBuf::from(file))),
+            Some(("hid", path)) if !path.is_empty() => Ok(Self::Hid(Some(path.to_owned()))),
+            _ => Err(format!("{s:?} is not a device: use sim, trace:FILE or hid[:PATH]")),
+        }
+    }
+}
+
+/// Where the simulated hand wants the stylus, sampled on the haptic thread at each tick (device frame).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum HandGoal {
+    /// Stay at one pose.
+    Hold(Pose),
+    /// Go around a vertical circle: `centre` + `radius`·(cos φ, 0, −sin φ), φ = `start_rad` + 2π·turns
+    /// done, one turn per `period_s`, starting at `start_us` on the haptic clock; holds at the end.
+    Orbit {
+        /// Centre of the circle, m.
+        centre: Vec3,
+        /// Radius, m.
+        radius: f32,
+        /// Angle at the start, rad.
+        start_rad: f32,
+        /// Seconds per turn.
+        period_s: f32,
+        /// Turns to make.
+        turns: f32,
+        /// Haptic-clock time of the start, µs.
+        start_us: u64,
+    },
+    /// A ring of `n` radial pokes around the vertical axis through `centre`, one per `tap_s` from
+    /// `start_us`: in from `r_out` to `r_in` (first 40 %), stay (to 60 %), out (to 90 %), then round to the
+    /// next angle at `r_out`; back at the first angle after the last poke.
+    Taps {
+        /// A point on the axis, at the pokes' height, m.
+        centre: Vec3,
+        /// Radius where each poke starts, m.
+        r_out: f32,
+        /// Radius each poke reaches for, m.
+        r_in: f32,
+        /// Number of pokes.
+        n: u32,
+        /// Seconds per poke.
+        tap_s: f32,
+        /// Haptic-clock time of the start, µs.
+        start_us: u64,
+    },
+    /// Move in a straight line from `from` to `to` in `duration_s` from `start_us`, then hold.
+    Line {
+        /// Start, m.
+        from: Vec3,
+        /// End, m.
+        to: Vec3,
+        /// Seconds.
+        duration_s: f32,
+        /// Haptic-clock time of the start, µs.
+        start_us: u64,
+    },
+}
+
+impl HandGoal {
+    /// The goal's pose at haptic-clock time `t_us`. Pure and allocation-free.
+    pub fn sample(&self, t_us: u64) -> Pose {
+        let since = |start_us: u64| t_us.saturating_sub(start_us) as f32 * 1e-6;
+        match *self {
+            Self::Hold(p) => p,
+            Self::Orbit { centre, radius, start_rad, period_s, turns, start_us } => {
+                let done = (since(start_us) / period_s.max(1e-3)).min(turns.max(0.0));
+                let phi = start_rad + TAU * done;
+                Pose::from_translation(centre + radius * Vec3::new(phi.cos(), 0.0, -phi.sin()))
+            }
+            Self::Line { from, to, duration_s, start_us } => {
+                let s = (since(start_us) / duration_s.max(1e-3)).min(1.0);
+                Pose::from_translation(from.lerp(to, s))
+            }
+            Self::Taps { centre, r_out, r_in, n, tap_s, start_us } => {
+                let n = n.max(1) as f32;
+                let t = (since(start_us) / tap_s.max(1e-3)).min(n);
+                let (k, u) = (t.floor(), t.fract());
+                let lerp = |a: f32, b: f32, s: f32| a + (b - a) * s;
+                let (r, turn) = match u {
+                    _ if t >= n => (r_out, n),
+                    u if u < 0.4 => (lerp(r_out, r_in, u / 0.4), k),
+                    u if u < 0.6 => (r_in, k),
+                    u if u < 0.9 => (lerp(r_in, r_out, (u - 0.6) / 0.3), k),
+                    u => (r_out, k + (u - 0.9) / 0.1),
+                };
+                let phi = TAU * turn / n;
+                Pose::from_translation(centre + r * Vec3::new(phi.cos(), 0.0, -phi.sin()))
+            }
+        }
+    }
+
+    /// True once the goal has stopped moving at `t_us`.
+    pub fn finished(&self, t_us: u64) -> bool {
+        let since = |start_us: u64| t_us.saturating_sub(start_us) as f32 * 1e-6;
+        match *self {
+            Self::Hold(_) => true,
+            Self::Orbit { period_s, turns, start_us, .. } => since(start_us) >= period_s * turns,
+            Self::Line { duration_s, start_us, .. } => since(start_us) >= duration_s,
+            Self::Taps { n, tap_s, start_us, .. } => since(start_us) >= n as f32 * tap_s,
+        }
+    }
+}
+
+/// The game thread's end of a steerable simulated hand.
+pub struct HandControl {
+    input: triple_buffer::Input<HandGoal>,
+    latest: HandGoal,
+}
+
+impl HandControl {
+    /// Sets where the hand goes from now on.
+    pub fn set(&mut self, goal: HandGoal) {
+        self.latest = goal;
+        self.input.write(goal);
+    }
+
+    /// The goal last set.
+    pub fn goal(&self) -> HandGoal {
+        self.latest
+    }
+}
+
+impl std::fmt::Debug for HandControl {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("HandControl").field("latest", &self.latest).finish()
+    }
+}
+
+/// A [`SimDevice`] whose hand follows the latest [`HandGoal`] from a [`HandControl`].
+pub struct SteeredSim {
+    sim: SimDevice,
+    goal: triple_buffer::Output<HandGoal>,
+}
+
+impl SteeredSim {
+    /// A simulated `specs` device resting at `start`, and the handle that steers it.
+    pub fn new(specs: DeviceSpecs, start: Pose) -> (Self, HandControl) {
+        let (input, goal) = triple_buffer::triple_buffer(&HandGoal::Hold(start));
+        let sim = SimDevice::new(SimConfig::new(specs), TargetPath::Hold(start));
+        (Self { sim, goal }, HandControl { input, latest: HandGoal::Hold(start) })
+    }
+}
+
+impl Device for SteeredSim {
+    fn specs(&self) -> &DeviceSpecs {
+        self.sim.specs()
+    }
+
+    fn read_state(&mut self, t_us: u64) -> DeviceState {
+        let target = self.goal.read().sample(t_us);
+        // `Hold` owns no heap memory: replacing the path neither allocates nor frees.
+        self.sim.set_path(TargetPath::Hold(target));
+        self.sim.read_state(t_us)
+    }
+
+    fn command(&mut self, ft: ForceTorque) {
+        self.sim.command(ft);
+    }
+
+    fn release(&mut self) {
+        self.sim.release();
+    }
+}
+
+/// The device preset a simulated device copies (`--preset`; default the Phantom Desktop: 7.9 N, 1000 N/m).
+pub fn preset(name: Option<&str>) -> Result<DeviceSpecs, ClientError> {
+    match name {
+        None => Ok(haptico::presets::phantom_desktop()),
+        Some(n) => haptico::presets::by_name(n).ok_or_else(|| ClientError::Device(format!("no device preset named {n:?}"))),
+    }
+}
+
+/// Opens the chosen device. With `sim`, also returns the control that moves its hand.
+pub fn open(choice: &DeviceChoice, specs: DeviceSpecs) -> Result<(Box<dyn Device>, Option<HandControl>), ClientError> {
+    match choice {
+        DeviceChoice::Sim => {
+            let (device, control) = SteeredSim::new(specs, Pose::new(Vec3::new(0.0, 0.06, 0.07), Quat::IDENTITY));
+            Ok((Box::new(device), Some(control)))
+        }
+        DeviceChoice::Trace(path) => {
+            let samples = haptico::trace::load(path)
+                .map_err(|e| ClientError::Device(format!("reading the trace {}: {e}", path.display())))?;
+            let device = haptico::trace::TraceDevice::new(specs, samples, true)
+                .map_err(|e| ClientError::Device(format!("the trace {}: {e}", path.display())))?;
+            Ok((Box::new(device), None))
+        }
+        DeviceChoice::Hid(path) => open_hid(path.as_deref(), &specs),
+    }
+}
+
+fn open_hid(path: Option<&str>, specs: &DeviceSpecs) -> Result<(Box<dyn Device>, Option<HandControl>), ClientError> {
+    use haptico::hid::{PidForceDevice, PidReportIds, SpaceMouse, SpaceMouseMode};
+    match PidForceDevice::open(PidReportIds::default(), specs.peak_force_n, path) {
+        Ok(d) => return Ok((Box::new(d), None)),
+        Err(e) => log::info!("no HID force-feedback device: {e}"),
+    }
+    let mode = SpaceMouseMode::Rate { metres_per_s_per_count: 2e-4, radians_per_s_per_count: 2e-3 };
+    let device = SpaceMouse::open(mode, path).map_err(|e| ClientError::Device(format!("no HID device: {e}")))?;
+    Ok((Box::new(device), None))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn device_names_parse_and_bad_ones_say_what_is_accepted() {
+        assert_eq!("sim".parse(), Ok(DeviceChoice::Sim));
+        assert_eq!("trace:/tmp/a.csv".parse(), Ok(DeviceChoice::Trace("/tmp/a.csv".into())));
+        assert_eq!("hid".parse(), Ok(DeviceChoice::Hid(None)));
+        assert_eq!("hid:/dev/hidraw2".parse(), Ok(DeviceChoice::Hid(Some("/dev/hidraw2".into()))));
+        let err = "trace:".parse::<DeviceChoice>().unwrap_err();
+        assert!(err.contains("sim, trace:FILE or hid[:PATH]"), "{err}");
+        assert!("falcon".parse::<DeviceChoice>().is_err());
+    }
+
+    #[test]
+    fn an_orbit_goes_round_once_and_holds() {
+        let goal = HandGoal::Orbit {
+            centre: Vec3::Y,
+            radius: 0.1,
+            start_rad: 0.0,
+            period_s: 2.0,
+            turns: 1.0,
+            start_us: 1_000_000,
+        };
+        let at = |s: f64| goal.sample((s * 1e6) as u64).translation;
+        assert!((at(0.0) - Vec3::new(0.1, 1.0, 0.0)).length() < 1e-5, "holds the start before it begins");
+        assert!((at(1.5) - Vec3::new(0.0, 1.0, -0.1)).length() < 1e-5, "a quarter turn after half a second");
+        assert!((at(3.0) - Vec3::new(0.1, 1.0, 0.0)).length() < 1e-4);
+        assert!((at(9.0) - at(3.0)).length() < 1e-4, "holds after one turn");
+        assert!(!goal.finished(2_900_000) && goal.finished(3_000_000));
+    }
+
+    #[test]
+    fn the_steered_hand_reaches_a_new_goal() {
+        let (mut device, mut control) = SteeredSim::new(haptico::presets::phantom_desktop(), Pose::IDENTITY);
+        control.set(HandGoal::Hold(Pose::from_translation(Vec3::new(0.02, 0.0, 0.0))));
+        let mut state = device.read_state(0);
+        for tick in 1..2000 {
+            state = device.read_state(tick * 1000);
+        }
+        assert!((state.pose.translation.x - 0.02).abs() < 1e-3, "{:?}", state.pose.translation);
+    }
+}

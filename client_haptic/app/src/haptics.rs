@@ -1,0 +1,336 @@
+//! The haptic side of the Phantom client: the 1 kHz rig, the copy on the workbench as a sphere tree,
+//! and the loop's window rates.
+//!
+//! You need this module to feel a copy. When a copy lands on the workbench its Inner Sphere Tree is
+//! built (or loaded from the cache, keyed by the mesh's content hash) on a worker thread, then handed
+//! to the collision thread with the copy's material; the haptic thread renders the paper's volumetric
+//! force (and torque on 6-DOF devices) against the stylus's gemstone. Nothing here waits for the network
+//! or blocks the game thread: a build in progress is polled each frame.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::mpsc::{Receiver, TryRecvError};
+
+use bevy::prelude::*;
+use collette::{BuildOptions, InnerSphereTree, TriMesh};
+use forcecomp::Material;
+use glam::Vec3;
+use haptic_common::Pose;
+use haptic_rig::{ForceSample, HapticRig, ObjectSpec, RigConfig, StepTiming, ToolSpec, WorkspaceMap};
+use haptico::{Device, DeviceSpecs, HapticEvents, TickTiming};
+use heist_shared::artifact::{self, HapticMesh};
+use heist_shared::protocol::{ItemId, WorkbenchCopy};
+
+use crate::device::{self, DeviceChoice, HandControl};
+use crate::error::ClientError;
+
+/// Diameter of the stylus's gemstone, m (a fine tip: the idol's notches are 16 mm wide).
+pub const TOOL_DIAMETER_M: f32 = 0.006;
+/// Depth at which a copy pushes back with its briefed stiffness (N/m) times the depth, m (see [`haptic_material`]).
+pub const REFERENCE_DEPTH_M: f32 = 0.002;
+/// Id of the copy on the collision thread.
+const COPY_OBJECT: u32 = 1;
+/// Length of a rate window, µs.
+const WINDOW_US: u64 = 1_000_000;
+
+/// How the haptic side is set up.
+#[derive(Resource, Clone, Debug)]
+pub struct HapticsSettings {
+    /// The device (default sim).
+    pub device: DeviceChoice,
+    /// Device preset the sim device copies (default the Phantom Desktop).
+    pub preset: Option<String>,
+    /// Spheres per copy's tree (default 1500).
+    pub spheres: usize,
+    /// Where built trees are cached (default none).
+    pub cache_dir: Option<PathBuf>,
+    /// Real-time priority for the haptic thread (default none).
+    pub realtime_priority: Option<i32>,
+}
+
+impl Default for HapticsSettings {
+    fn default() -> Self {
+        Self { device: DeviceChoice::Sim, preset: None, spheres: 1500, cache_dir: None, realtime_priority: None }
+    }
+}
+
+/// The copy being felt.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OnBench {
+    /// The copy.
+    pub item: ItemId,
+    /// The haptic clock when its tree reached the collision thread, µs.
+    pub since_us: u64,
+    /// Spheres in its tree.
+    pub spheres: usize,
+    /// Whether the tree came from the cache.
+    pub cached: bool,
+}
+
+/// One second of the haptic and collision loops.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RateWindow {
+    /// Start of the window on the haptic clock, µs.
+    pub start_us: u64,
+    /// Haptic ticks in the window per second, Hz.
+    pub haptic_hz: u32,
+    /// Collision steps in the window per second, Hz.
+    pub collision_hz: u32,
+    /// Whether a copy was on the bench for the whole window.
+    pub with_copy: bool,
+}
+
+/// The running rig and what it renders (a non-send resource: the device lives on the haptic thread, this
+/// is the game thread's handle).
+pub struct Haptics {
+    rig: HapticRig<Box<dyn Device>>,
+    /// Moves the simulated hand (sim device only).
+    pub hand: Option<HandControl>,
+    /// The device's limits.
+    pub specs: DeviceSpecs,
+    /// Device frame to scene (the workbench frame).
+    pub map: WorkspaceMap,
+    building: Option<(ItemId, Receiver<Result<(InnerSphereTree, bool), String>>, Material)>,
+    /// The copy being felt.
+    pub on_bench: Option<OnBench>,
+    /// Force samples drained this frame (1 kHz; preallocated).
+    pub samples: Vec<ForceSample>,
+    ticks: Vec<TickTiming>,
+    steps: Vec<StepTiming>,
+    window: Option<(u64, u32, u32, bool)>,
+    /// Every complete rate window so far.
+    pub rates: Vec<RateWindow>,
+    settings: HapticsSettings,
+}
+
+impl Haptics {
+    /// Opens the device and starts the haptic and collision threads with the gemstone tool.
+    pub fn start(settings: HapticsSettings) -> Result<Self, ClientError> {
+        let specs = device::preset(settings.preset.as_deref())?;
+        let (device, hand) = device::open(&settings.device, specs.clone())?;
+        let specs = device.specs().clone();
+        let gem = collette::scene::brilliant_cut(TOOL_DIAMETER_M);
+        let (tree, _) = collette::build(&gem, &BuildOptions::spheres(200), &mut |_| {})
+            .map_err(|e| ClientError::Device(format!("building the gemstone's tree: {e}")))?;
+        // The gem is far stiffer than any copy, and its friction is 1 so the copy's own coefficient decides
+        // (see `haptic_material`).
+        let tool = ToolSpec::new(Arc::new(tree), Material { stiffness_n_per_m3: 1e12, damping_ns_per_m: 1e6, friction: 1.0 });
+        let scale = if specs.workspace_radius_m > 0.0 { (0.08 / specs.workspace_radius_m).max(1.0) } else { 1.0 };
+        let map = WorkspaceMap { origin: Pose::IDENTITY, scale };
+        let mut config = RigConfig { map, ..RigConfig::default() };
+        config.haptic.realtime_priority = settings.realtime_priority;
+        config.collision.realtime_priority = settings.realtime_priority.map(|p| (p - 1).max(1));
+        let rig = HapticRig::start(device, tool, config, HapticEvents::default(), haptic_common::Delegator::new())?;
+        Ok(Self {
+            rig,
+            hand,
+            specs,
+            map,
+            building: None,
+            on_bench: None,
+            samples: Vec::with_capacity(1 << 14),
+            ticks: Vec::with_capacity(1 << 14),
+            steps: Vec::with_capacity(1 << 14),
+            window: None,
+            rates: Vec::new(),
+            settings,
+        })
+    }
+
+    /// Microseconds on the haptic clock.
+    pub fn now_us(&self) -> u64 {
+        self.rig.clock().now_us()
+    }
+
+    /// The rig's latest state (device sample, output force, contacts).
+    pub fn telemetry(&self) -> haptic_rig::RigTelemetry {
+        self.rig.telemetry()
+    }
+
+    /// Whether 6-DOF torques reach the device.
+    pub fn renders_torque(&self) -> bool {
+        self.specs.renders_torque()
+    }
+
+    /// Starts building the tree of `copy` (replacing whatever was on the bench).
+    pub fn place(&mut self, copy: &WorkbenchCopy) {
+        self.clear();
+        let (tx, rx) = std::sync::mpsc::channel();
+        let mesh = copy.mesh.clone();
+        let (spheres, cache) = (self.settings.spheres, self.settings.cache_dir.clone());
+        let item = copy.item;
+        std::thread::Builder::new()
+            .name("ist-build".into())
+            .spawn(move || {
+                let _ = tx.send(build_tree(&mesh, spheres, cache.as_deref()));
+            })
+            .map_or_else(|e| log::error!("could not start building copy {}: {e}", item.0), drop);
+        self.building = Some((copy.item, rx, haptic_material(&copy.material)));
+    }
+
+    /// Takes the copy off the bench.
+    pub fn clear(&mut self) {
+        self.building = None;
+        if self.on_bench.take().is_some() {
+            let _ = self.rig.remove_object(COPY_OBJECT);
+            self.rig.collect_garbage();
+        }
+    }
+
+    /// True while a copy's tree is being built.
+    pub fn building(&self) -> Option<ItemId> {
+        self.building.as_ref().map(|b| b.0)
+    }
+
+    /// Polls the build, drains the rig's rings and closes rate windows. Call once per frame.
+    pub fn poll(&mut self) -> Option<Result<OnBench, ClientError>> {
+        self.samples.clear();
+        self.rig.drain_force_samples(&mut self.samples);
+        self.drain_rates();
+        let (item, rx, material) = self.building.as_ref()?;
+        let (item, material) = (*item, *material);
+        let built = match rx.try_recv() {
+            Err(TryRecvError::Empty) => return None,
+            Err(TryRecvError::Disconnected) => Err("the build thread stopped".to_owned()),
+            Ok(r) => r,
+        };
+        self.building = None;
+        let result = built.and_then(|(tree, cached)| {
+            let spheres = tree.spheres().len();
+            let object = ObjectSpec { id: COPY_OBJECT, tree: Arc::new(tree), pose: Pose::IDENTITY, material };
+            self.rig.add_object(object).map_err(|e| e.to_string())?;
+            Ok(OnBench { item, since_us: self.now_us(), spheres, cached })
+        });
+        Some(match result {
+            Ok(on) => {
+                self.on_bench = Some(on.clone());
+                Ok(on)
+            }
+            Err(reason) => Err(ClientError::Copy { item: item.0 as u32, reason }),
+        })
+    }
+
+    fn drain_rates(&mut self) {
+        self.ticks.clear();
+        self.steps.clear();
+        self.rig.drain_haptic_timings(&mut self.ticks);
+        self.rig.drain_collision_timings(&mut self.steps);
+        let with_copy = self.on_bench.is_some();
+        for t in self.ticks.iter().map(|t| (t.start_us, true)).chain(self.steps.iter().map(|s| (s.start_us, false))) {
+            let w = self.window.get_or_insert((t.0 - t.0 % WINDOW_US, 0, 0, with_copy));
+            if t.0 >= w.0 + WINDOW_US {
+                let done = RateWindow { start_us: w.0, haptic_hz: w.1, collision_hz: w.2, with_copy: w.3 };
+                self.rates.push(done);
+                log::info!(
+                    "haptic loop: {} Hz, collision {} Hz{}",
+                    done.haptic_hz,
+                    done.collision_hz,
+                    if done.with_copy { " (copy on the bench)" } else { "" }
+                );
+                *w = (t.0 - t.0 % WINDOW_US, 0, 0, with_copy);
+            }
+            if t.1 { w.1 += 1 } else { w.2 += 1 }
+            w.3 &= with_copy;
+        }
+    }
+
+    /// Stops both threads.
+    pub fn stop(self) {
+        self.rig.stop();
+    }
+}
+
+/// The contact material of a copy: the briefed stiffness `k` (N/m) becomes the volumetric stiffness
+/// that pushes back `k · d0` when the gemstone (radius R) is `d0` = [`REFERENCE_DEPTH_M`] deep in a flat
+/// face (cap volume ≈ π R d0²); friction is squared because contact friction is the geometric mean
+/// with the gem's (1).
+pub fn haptic_material(m: &artifact::Material) -> Material {
+    let r = TOOL_DIAMETER_M / 2.0;
+    Material {
+        stiffness_n_per_m3: m.stiffness_n_per_m / (std::f32::consts::PI * r * REFERENCE_DEPTH_M),
+        damping_ns_per_m: m.damping,
+        friction: m.friction * m.friction,
+    }
+}
+
+/// Content hash of a mesh and the build settings, as the cache file's name.
+pub fn cache_key(mesh: &HapticMesh, spheres: usize) -> String {
+    let mut h = blake3::Hasher::new();
+    h.update(b"phantom-heist ist v1");
+    h.update(&(spheres as u64).to_le_bytes());
+    for v in &mesh.vertices {
+        for c in v {
+            h.update(&c.to_le_bytes());
+        }
+    }
+    for t in &mesh.triangles {
+        for i in t {
+            h.update(&i.to_le_bytes());
+        }
+    }
+    h.finalize().to_hex()[..32].to_owned()
+}
+
+/// Builds (or loads) the tree of `mesh`; the flag tells whether it came from `cache`.
+pub fn build_tree(mesh: &HapticMesh, spheres: usize, cache: Option<&std::path::Path>) -> Result<(InnerSphereTree, bool), String> {
+    let file = cache.map(|dir| dir.join(format!("{}.ist", cache_key(mesh, spheres))));
+    if let Some(file) = &file
+        && file.exists()
+    {
+        match InnerSphereTree::load(file) {
+            Ok(tree) => return Ok((tree, true)),
+            Err(e) => log::warn!("ignoring the cached tree {}: {e}", file.display()),
+        }
+    }
+    let vertices = mesh.vertices.iter().map(|v| Vec3::from_array(*v)).collect();
+    let tri = TriMesh::new(vertices, mesh.triangles.clone()).map_err(|e| format!("its mesh is not a closed surface: {e}"))?;
+    let (tree, _) = collette::build(&tri, &BuildOptions::spheres(spheres), &mut |_| {}).map_err(|e| e.to_string())?;
+    if let Some(file) = &file {
+        let saved = file.parent().map_or(Ok(()), std::fs::create_dir_all).map_err(|e| e.to_string());
+        if let Err(e) = saved.and_then(|()| tree.save(file).map_err(|e| e.to_string())) {
+            log::warn!("could not cache the tree in {}: {e}", file.display());
+        }
+    }
+    Ok((tree, false))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use heist_shared::artifact::{ArtifactKind, MaterialClass, build_mesh, generate_copies};
+
+    #[test]
+    fn a_hard_copy_pushes_back_its_briefed_stiffness_at_the_reference_depth() {
+        let m = haptic_material(&MaterialClass::HardRough.material());
+        let r = TOOL_DIAMETER_M / 2.0;
+        let d = REFERENCE_DEPTH_M;
+        let cap = std::f32::consts::PI * d * d * (3.0 * r - d) / 3.0;
+        let force = m.stiffness_n_per_m3 * cap;
+        assert!((force / (800.0 * d) - 1.0).abs() < 0.25, "{force} N at {d} m");
+        assert!((m.combine(&Material { stiffness_n_per_m3: 1e12, damping_ns_per_m: 1e6, friction: 1.0 }).friction - 0.6).abs() < 1e-4);
+    }
+
+    #[test]
+    fn a_tree_is_cached_by_content_and_loaded_again() {
+        let dir = std::env::temp_dir().join(format!("phantom-cache-{}", std::process::id()));
+        let (copies, _) = generate_copies(ArtifactKind::Idol, 3, 3);
+        let mesh = build_mesh(&copies[0], 3);
+        let (built, cached) = build_tree(&mesh, 300, Some(&dir)).expect("builds");
+        assert!(!cached);
+        let (loaded, cached) = build_tree(&mesh, 300, Some(&dir)).expect("loads");
+        assert!(cached, "the second build comes from the cache");
+        assert_eq!(built.spheres().len(), loaded.spheres().len());
+        let differs = copies.iter().find(|c| c.feature_count != copies[0].feature_count).expect("a fake with another count");
+        let other = build_mesh(differs, 3);
+        assert_ne!(cache_key(&mesh, 300), cache_key(&other, 300));
+        assert_ne!(cache_key(&mesh, 300), cache_key(&mesh, 301));
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
+    #[test]
+    fn a_broken_mesh_is_refused_with_the_reason() {
+        let mesh = HapticMesh { vertices: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], triangles: vec![[0, 1, 2]] };
+        let err = build_tree(&mesh, 100, None).err().expect("refused");
+        assert!(err.contains("not a closed surface"), "{err}");
+    }
+}
