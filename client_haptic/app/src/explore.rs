@@ -4,10 +4,12 @@
 //! player knows — which artifact the copy is (its look), where the bench is, and the briefing — and
 //! moves the simulated hand along a path of its own:
 //! 1. taps: a ring of radial pokes at the height where the kind's features are (the crown's points,
-//!    the amphora's ridges, the idol's notches); how far in each poke got is a circular profile whose
-//!    high runs are counted;
-//! 2. a press on a plain part: the contact force over the depth since first touch gives the stiffness;
-//! 3. a stroke down and up while pressing: the vertical drag over the normal force gives the friction.
+//!    the amphora's ridges, the idol's notches); where each poke first met the surface (or how deep it
+//!    got where it met none) is a circular profile whose high runs are counted;
+//!    Each poke that met the surface also rests there: the force over the depth since first touch,
+//!    median over the pokes, gives the stiffness;
+//! 2. a light press on a plain part and a stroke down and up: the drag against the motion over the
+//!    normal force gives the friction.
 
 use std::f32::consts::TAU;
 
@@ -22,14 +24,31 @@ use crate::device::HandGoal;
 pub const TAPS: usize = 48;
 /// Seconds per poke.
 pub const TAP_S: f32 = 0.4;
-/// Secant stiffness above which a copy feels hard, N/m (hard copies read ≈ 800, soft ≈ 450 on flat faces).
-pub const HARD_ABOVE_N_PER_M: f32 = 600.0;
-/// Friction above which a copy feels rough (smooth 0.1, rough 0.6).
-pub const ROUGH_ABOVE: f32 = 0.3;
+/// Friction above which a copy feels rough (briefed: smooth 0.1, rough 0.6; felt through the packed
+/// skin's bumps a little higher).
+pub const ROUGH_ABOVE: f32 = 0.45;
+
+/// Resting force over depth² (see [`Findings::pressure_n_per_m2`]) above which a copy of `kind` feels
+/// hard, N/m². Learnt per kind, like a player learns how a hard crown feels: the crown's thin points give
+/// way more than the solid amphora or idol, and a smooth point lets the stylus slip off it (so the crown
+/// has one threshold for smooth and one for rough copies; friction is told apart first). Set from the
+/// copies of seeds 3, 5 and 11 (docs/phantom-client.md); the tests use other seeds.
+pub fn hard_above_n_per_m2(kind: ArtifactKind, rough: bool) -> f32 {
+    match (kind, rough) {
+        (ArtifactKind::Crown, false) => 30_000.0,
+        (ArtifactKind::Crown, true) => 140_000.0,
+        (ArtifactKind::Amphora, _) => 550_000.0,
+        (ArtifactKind::Idol, _) => 70_000.0,
+    }
+}
+
 /// Contact force that counts as touching, N.
 const TOUCH_N: f32 = 0.05;
-/// How far past the expected surface the hand reaches, m.
-const REACH_M: f32 = 0.012;
+/// How far past the surface the hand reaches when pressing to stroke (lightly: the stylus stays in the
+/// skin, where the sphere packing is even), m.
+const REACH_M: f32 = 0.003;
+/// Length of the strokes down and up, m.
+const SLIDE_M: f32 = 0.012;
 
 /// Where a kind's features are, from its public look: (height of the ring of pokes, outer radius, inner
 /// radius, height of the plain part for the press), metres in the workbench frame.
@@ -38,9 +57,11 @@ fn ring(kind: ArtifactKind) -> (f32, f32, f32, f32) {
     let (d, h) = (look.size_m[0], look.size_m[1]);
     match kind {
         // The points stand on the rim: poke halfway up them; press the plain band below.
-        ArtifactKind::Crown => (0.3 * h, 0.5 * d + 0.015, 0.5 * d - 0.015, 0.0),
-        ArtifactKind::Amphora => (-0.08 * h, 0.5 * d + 0.015, 0.5 * d - 0.025, -0.08 * h),
-        ArtifactKind::Idol => (-0.15 * h, 0.5 * d + 0.015, 0.5 * d - 0.02, -0.15 * h),
+        // The hand reaches only about 7 mm past the plain surface: it feels a face without breaking
+        // through it, and still sinks deep where the features leave a gap.
+        ArtifactKind::Crown => (0.3 * h, 0.5 * d + 0.015, 0.5 * d - 0.007, 0.0),
+        ArtifactKind::Amphora => (-0.08 * h, 0.5 * d + 0.015, 0.5 * d - 0.018, -0.08 * h),
+        ArtifactKind::Idol => (-0.15 * h, 0.5 * d + 0.015, 0.5 * d - 0.013, -0.15 * h),
     }
 }
 
@@ -51,8 +72,11 @@ pub struct Findings {
     pub profile: Vec<f32>,
     /// Features counted.
     pub feature_count: u32,
-    /// Secant stiffness at the press, N/m.
+    /// Resting force over depth since first touch on plain parts (median), N/m.
     pub stiffness_n_per_m: f32,
+    /// Resting force over depth² (median): the volumetric model's force grows with the depth squared
+    /// on a face, so this separates hard from soft by their stiffness ratio, N/m².
+    pub pressure_n_per_m2: f32,
     /// Friction coefficient from the stroke.
     pub friction: f32,
     /// The material class these make.
@@ -65,20 +89,23 @@ impl Findings {
         self.feature_count == briefing.feature_count && self.material == briefing.material
     }
 
-    /// A sentence for the log and for speech.
+    /// The figures, for the log.
     pub fn describe(&self) -> String {
         format!(
-            "{} features, stiffness {:.0} newtons per metre, friction {:.2}: {}",
+            "{} features, stiffness {:.0} N/m ({:.0} kN/m²), friction {:.2}: {}",
             self.feature_count,
             self.stiffness_n_per_m,
+            self.pressure_n_per_m2 / 1000.0,
             self.friction,
-            match self.material {
-                MaterialClass::HardSmooth => "hard and smooth",
-                MaterialClass::HardRough => "hard and rough",
-                MaterialClass::SoftSmooth => "soft and smooth",
-                MaterialClass::SoftRough => "soft and rough",
-            }
+            self.material.adjective()
         )
+    }
+
+    /// What the bot says it felt, e.g. "seven points, hard and smooth".
+    pub fn spoken(&self, kind: ArtifactKind) -> String {
+        let (one, many) = kind.feature_noun();
+        let noun = if self.feature_count == 1 { one } else { many };
+        format!("{} {noun}, {}", artifact::number_in_words(self.feature_count), self.material.adjective())
     }
 }
 
@@ -93,6 +120,20 @@ enum Stage {
     Done,
 }
 
+/// Mean radius and mean inward contact force over the rest at the bottom of a poke.
+#[derive(Clone, Copy, Debug, Default)]
+struct Hold {
+    along: f32,
+    force: f32,
+    n: u32,
+}
+
+impl Hold {
+    fn mean(&self) -> Option<(f32, f32)> {
+        (self.n > 0).then(|| (self.along / self.n as f32, self.force / self.n as f32))
+    }
+}
+
 /// One exploration of one copy, stepped by the game thread; the hand moves on the haptic clock.
 #[derive(Debug)]
 pub struct Exploration {
@@ -100,13 +141,16 @@ pub struct Exploration {
     stage: Stage,
     goal: HandGoal,
     stage_start_us: u64,
+    stage_end_us: u64,
     taps_start_us: u64,
+    tap_touch: Vec<Option<f32>>,
     tap_min: Vec<f32>,
+    tap_hold: Vec<Hold>,
     press_angle: f32,
     press_normal: Vec3,
-    first_touch_r: Option<f32>,
-    press: Vec<(f32, f32)>,
-    slide: [(f32, f32, u32); 2],
+    surface: f32,
+    slide: (f32, f32),
+    last: Option<(u64, Vec3)>,
     findings: Option<Findings>,
 }
 
@@ -124,13 +168,16 @@ impl Exploration {
                 start_us: now_us,
             },
             stage_start_us: now_us,
+            stage_end_us: now_us + 1_000_000,
             taps_start_us: 0,
+            tap_touch: vec![None; TAPS],
             tap_min: vec![f32::INFINITY; TAPS],
+            tap_hold: vec![Hold::default(); TAPS],
             press_angle: 0.0,
             press_normal: Vec3::X,
-            first_touch_r: None,
-            press: Vec::with_capacity(4096),
-            slide: [(0.0, 0.0, 0); 2],
+            surface: 0.0,
+            slide: (0.0, 0.0),
+            last: None,
             findings: None,
         }
     }
@@ -145,105 +192,111 @@ impl Exploration {
         self.findings.as_ref()
     }
 
-    /// Takes this frame's force samples and moves on when a stage ends; returns true when the goal changed.
-    pub fn step(&mut self, now_us: u64, samples: &[ForceSample]) -> bool {
-        let (y, r_out, r_in, y_press) = ring(self.kind);
-        for s in samples {
-            self.take(s, y_press);
-        }
-        let elapsed_s = now_us.saturating_sub(self.stage_start_us) as f32 * 1e-6;
-        let start = now_us + 10_000;
-        let (next, goal) = match self.stage {
-            Stage::Settle if elapsed_s > 1.0 => {
-                self.taps_start_us = start;
-                (Stage::Taps, HandGoal::Taps { centre: Vec3::new(0.0, y, 0.0), r_out, r_in, n: TAPS as u32, tap_s: TAP_S, start_us: start })
-            }
-            Stage::Taps if elapsed_s > TAPS as f32 * TAP_S + 0.05 => {
-                self.press_angle = self.plain_angle();
-                let dir = Vec3::new(self.press_angle.cos(), 0.0, -self.press_angle.sin());
-                self.press_normal = dir;
-                let from = Vec3::new(0.0, y_press, 0.0) + dir * r_out;
-                (Stage::Approach, HandGoal::Line { from: self.goal.sample(now_us).translation, to: from, duration_s: 0.4, start_us: start })
-            }
-            Stage::Approach if elapsed_s > 0.5 => {
-                let from = Vec3::new(0.0, y_press, 0.0) + self.press_normal * r_out;
-                let to = Vec3::new(0.0, y_press, 0.0) + self.press_normal * (self.expected_surface(r_in) - REACH_M);
-                self.first_touch_r = None;
-                (Stage::Press, HandGoal::Line { from, to, duration_s: 0.8, start_us: start })
-            }
-            Stage::Press if elapsed_s > 1.4 => {
-                let at = self.goal.sample(now_us).translation;
-                (Stage::SlideDown, HandGoal::Line { from: at, to: at - Vec3::Y * 0.01, duration_s: 0.4, start_us: start })
-            }
-            Stage::SlideDown if elapsed_s > 0.45 => {
-                let at = self.goal.sample(now_us).translation;
-                (Stage::SlideUp, HandGoal::Line { from: at, to: at + Vec3::Y * 0.01, duration_s: 0.4, start_us: start })
-            }
-            Stage::SlideUp if elapsed_s > 0.45 => {
-                self.findings = Some(self.conclude());
-                let at = self.goal.sample(now_us).translation;
-                let away = Vec3::new(0.0, y_press, 0.0) + self.press_normal * (r_out + 0.02);
-                (Stage::Done, HandGoal::Line { from: at, to: away, duration_s: 0.4, start_us: start })
-            }
-            _ => return false,
-        };
-        self.stage = next;
-        self.stage_start_us = now_us;
-        self.goal = goal;
-        true
-    }
-
     /// Whether the exploration is over.
     pub fn done(&self) -> bool {
         self.stage == Stage::Done
     }
 
-    fn take(&mut self, s: &ForceSample, y_press: f32) {
+    /// Takes this frame's force samples and moves on when a stage ends; returns true when the goal changed.
+    pub fn step(&mut self, now_us: u64, samples: &[ForceSample]) -> bool {
+        for s in samples {
+            self.take(s);
+        }
+        if now_us < self.stage_end_us || self.stage == Stage::Done {
+            return false;
+        }
+        let (y, r_out, r_in, y_press) = ring(self.kind);
+        let start = now_us + 10_000;
+        let at = self.goal.sample(now_us).translation;
+        let line = |from: Vec3, to: Vec3, duration_s: f32| HandGoal::Line { from, to, duration_s, start_us: start };
+        let axis = Vec3::new(0.0, y_press, 0.0);
+        let (next, goal, seconds) = match self.stage {
+            Stage::Settle => {
+                self.taps_start_us = start;
+                let taps = HandGoal::Taps { centre: Vec3::new(0.0, y, 0.0), r_out, r_in, n: TAPS as u32, tap_s: TAP_S, start_us: start };
+                (Stage::Taps, taps, TAPS as f32 * TAP_S + 0.05)
+            }
+            Stage::Taps => {
+                self.press_angle = self.plain_angle();
+                self.press_normal = Vec3::new(self.press_angle.cos(), 0.0, -self.press_angle.sin());
+                let k = ((self.press_angle / TAU * TAPS as f32).round() as usize) % TAPS;
+                self.surface = self.tap_touch[k].unwrap_or(r_in + 0.007);
+                (Stage::Approach, line(at, axis + self.press_normal * r_out, 0.4), 0.5)
+            }
+            Stage::Approach => (Stage::Press, line(at, axis + self.press_normal * (self.surface - REACH_M), 0.5), 0.8),
+            Stage::Press => (Stage::SlideDown, line(at, at - Vec3::Y * SLIDE_M, 0.5), 0.55),
+            Stage::SlideDown => (Stage::SlideUp, line(at, at + Vec3::Y * SLIDE_M, 0.5), 0.55),
+            Stage::SlideUp => {
+                self.findings = Some(self.conclude());
+                (Stage::Done, line(at, axis + self.press_normal * (r_out + 0.02), 0.4), 0.4)
+            }
+            Stage::Done => return false,
+        };
+        self.stage = next;
+        self.stage_start_us = start;
+        self.stage_end_us = start + (seconds * 1e6) as u64;
+        self.goal = goal;
+        true
+    }
+
+    fn take(&mut self, s: &ForceSample) {
         let p = s.tool_position;
         let radial = Vec3::new(p.x, 0.0, p.z).length();
+        let velocity = match self.last {
+            Some((t, q)) if s.t_us > t => (p - q) / ((s.t_us - t) as f32 * 1e-6),
+            _ => Vec3::ZERO,
+        };
+        self.last = Some((s.t_us, p));
+        let touching = s.contact_force.length() > TOUCH_N;
         match self.stage {
             Stage::Taps => {
                 let since = s.t_us.saturating_sub(self.taps_start_us) as f32 * 1e-6 / TAP_S;
                 let (k, u) = (since.floor() as usize, since.fract());
-                // The bottom of the poke: where the hand stopped, on the surface or deep in a gap.
-                if k < TAPS && (0.3..0.75).contains(&u) {
+                if k >= TAPS || s.t_us < self.taps_start_us {
+                    return;
+                }
+                // Where the stylus first met the surface on the way in; how deep it got where it met none.
+                if u < 0.6 && touching && self.tap_touch[k].is_none() {
+                    self.tap_touch[k] = Some(radial);
+                }
+                if (0.3..0.75).contains(&u) {
                     self.tap_min[k] = self.tap_min[k].min(radial);
                 }
-            }
-            Stage::Press => {
-                let along = p.dot(self.press_normal);
-                let f = s.contact_force.dot(self.press_normal);
-                if self.first_touch_r.is_none() && f > TOUCH_N {
-                    self.first_touch_r = Some(along);
-                }
-                if self.press.len() < self.press.capacity() {
-                    self.press.push((along, f));
+                // Resting at the bottom of the poke: how deep, how hard.
+                if (0.45..0.6).contains(&u) {
+                    let inward = -Vec3::new(p.x, 0.0, p.z).normalize_or_zero();
+                    let hold = &mut self.tap_hold[k];
+                    hold.along += radial;
+                    hold.force += -s.contact_force.dot(inward);
+                    hold.n += 1;
                 }
             }
             Stage::SlideDown | Stage::SlideUp => {
-                let i = usize::from(self.stage == Stage::SlideUp);
                 let normal = s.contact_force.dot(self.press_normal);
-                if normal > TOUCH_N && (p.y - y_press).abs() < 0.02 {
-                    self.slide[i].0 += s.contact_force.y;
-                    self.slide[i].1 += normal;
-                    self.slide[i].2 += 1;
+                // Only while really sliding: friction opposes the vertical motion. Summed over both strokes,
+                // the packing's bumps push as much with the motion as against it and cancel.
+                if normal > TOUCH_N && velocity.y.abs() > 0.005 {
+                    self.slide.0 += -s.contact_force.y * velocity.y.signum();
+                    self.slide.1 += normal;
                 }
             }
             _ => {}
         }
     }
 
-    /// Where the surface was expected at the press angle: the poke there, or the outer radius.
-    fn expected_surface(&self, r_in: f32) -> f32 {
-        let k = ((self.press_angle / TAU * TAPS as f32).round() as usize) % TAPS;
-        let r = self.tap_min[k];
-        if r.is_finite() && r > r_in + 0.003 { r } else { ring(self.kind).1 - 0.015 }
+    /// The profile of the taps: where each first touched, or how deep it got.
+    fn profile(&self) -> Vec<f32> {
+        self.tap_touch
+            .iter()
+            .zip(&self.tap_min)
+            .map(|(touch, min)| touch.unwrap_or(if min.is_finite() { *min } else { 0.0 }))
+            .collect()
     }
 
-    /// The angle of a plain part: between two points (crown: any, it is pressed below them), on the
-    /// amphora's belly between ridges, on the idol's body between notches.
+    /// The angle of a plain part: the crown's band below its points (any angle), the amphora's belly
+    /// between ridges, the idol's body between notches.
     fn plain_angle(&self) -> f32 {
-        let profile: Vec<f32> = self.tap_min.iter().map(|r| if r.is_finite() { *r } else { 0.0 }).collect();
+        let profile = self.profile();
         let pick = match self.kind {
             ArtifactKind::Crown => return 0.0,
             ArtifactKind::Amphora => lowest_run_middle(&profile),
@@ -253,36 +306,78 @@ impl Exploration {
     }
 
     fn conclude(&self) -> Findings {
-        let profile: Vec<f32> = self.tap_min.iter().map(|r| if r.is_finite() { *r } else { 0.0 }).collect();
+        let profile = self.profile();
         let feature_count = match self.kind {
             ArtifactKind::Crown | ArtifactKind::Amphora => artifact::count_high_runs(&profile),
             ArtifactKind::Idol => artifact::count_high_runs(&profile.iter().map(|r| -r).collect::<Vec<_>>()),
         };
-        // Stiffness: the force of the last third of the press over how deep the tool sank since first touch.
-        let tail = &self.press[self.press.len() * 2 / 3..];
-        let (depth, force) = match (self.first_touch_r, tail.is_empty()) {
-            (Some(touch), false) => {
-                let n = tail.len() as f32;
-                let along = tail.iter().map(|s| s.0).sum::<f32>() / n;
-                let f = tail.iter().map(|s| s.1).sum::<f32>() / n;
-                (touch - along, f)
-            }
-            _ => (0.0, 0.0),
+        // Stiffness: the median, over the pokes that met a plain part, of the force at rest over the depth
+        // since first touch. Plain parts: the amphora's belly (the lower touches; its ridges are narrow
+        // and give way), the idol's body and the crown's points (the higher touches).
+        let touched: Vec<f32> = self.tap_touch.iter().flatten().copied().collect();
+        let (lo, hi) = touched.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &r| (a.min(r), b.max(r)));
+        let mid = 0.5 * (lo + hi);
+        let plain = |r: f32| if self.kind == ArtifactKind::Amphora { r <= mid } else { r >= mid };
+        let rests: Vec<(f32, f32)> = self
+            .tap_touch
+            .iter()
+            .zip(&self.tap_hold)
+            .filter_map(|(touch, hold)| {
+                let (touch, (at, force)) = ((*touch)?, hold.mean()?);
+                (plain(touch) && touch - at > 2e-4 && force > TOUCH_N).then_some((touch - at, force))
+            })
+            .collect();
+        let median = |mut v: Vec<f32>| {
+            v.sort_by(f32::total_cmp);
+            v.get(v.len() / 2).copied().unwrap_or(0.0)
         };
-        let stiffness_n_per_m = if depth > 1e-4 { force / depth } else { 0.0 };
-        let mean = |(fy, fnormal, n): (f32, f32, u32)| if n > 0 { (fy / n as f32, fnormal / n as f32) } else { (0.0, 0.0) };
-        let ((down_fy, down_n), (up_fy, up_n)) = (mean(self.slide[0]), mean(self.slide[1]));
-        // Sliding down, friction pushes the tool up; sliding up, down: half the difference is μ·N.
-        let normal = 0.5 * (down_n + up_n);
-        let friction = if normal > TOUCH_N { (down_fy - up_fy) / (2.0 * normal) } else { 0.0 };
-        let material = match (stiffness_n_per_m > HARD_ABOVE_N_PER_M, friction > ROUGH_ABOVE) {
+        let stiffness_n_per_m = median(rests.iter().map(|(d, f)| f / d).collect());
+        let pressure_n_per_m2 = median(rests.iter().map(|(d, f)| f / (d * d)).collect());
+        let friction = if self.slide.1 > 0.0 { self.slide.0 / self.slide.1 } else { 0.0 };
+        let rough = friction > ROUGH_ABOVE;
+        let material = match (pressure_n_per_m2 > hard_above_n_per_m2(self.kind, rough), rough) {
             (true, false) => MaterialClass::HardSmooth,
             (true, true) => MaterialClass::HardRough,
             (false, false) => MaterialClass::SoftSmooth,
             (false, true) => MaterialClass::SoftRough,
         };
-        Findings { profile, feature_count, stiffness_n_per_m, friction, material }
+        Findings { profile, feature_count, stiffness_n_per_m, pressure_n_per_m2, friction, material }
     }
+}
+
+/// Places `copy` on the bench of a running [`crate::haptics::Haptics`] (sim device) and explores it;
+/// gives up after a minute for the build and a minute for the exploration. Used by the tests and the
+/// `feel_copies` example; the client runs the same steps from its systems.
+pub fn feel(h: &mut crate::haptics::Haptics, copy: &heist_shared::protocol::WorkbenchCopy, kind: ArtifactKind) -> Result<Findings, String> {
+    use std::time::{Duration, Instant};
+    h.place(copy);
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while h.on_bench.is_none() {
+        if Instant::now() > deadline {
+            return Err("the tree was not built within a minute".into());
+        }
+        if let Some(Err(e)) = h.poll() {
+            return Err(e.to_string());
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let mut ex = Exploration::new(kind, h.now_us());
+    let map = h.map;
+    let hand = |h: &mut crate::haptics::Haptics, goal| h.hand.as_mut().map(|c| c.set(to_device(&map, goal))).ok_or("the device has no steerable hand");
+    hand(h, ex.goal())?;
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while !ex.done() {
+        if Instant::now() > deadline {
+            return Err("the exploration did not end within a minute".into());
+        }
+        std::thread::sleep(Duration::from_millis(8));
+        h.poll();
+        let now = h.now_us();
+        if ex.step(now, &h.samples) {
+            hand(h, ex.goal())?;
+        }
+    }
+    ex.findings().cloned().ok_or_else(|| "no findings".into())
 }
 
 /// Index at the middle of the longest stretch within 25 % of the profile's minimum.

@@ -28,6 +28,8 @@ use crate::error::ClientError;
 pub const TOOL_DIAMETER_M: f32 = 0.006;
 /// Depth at which a copy pushes back with its briefed stiffness (N/m) times the depth, m (see [`haptic_material`]).
 pub const REFERENCE_DEPTH_M: f32 = 0.002;
+/// The gem's sphere count.
+const TOOL_SPHERES: usize = 200;
 /// Id of the copy on the collision thread.
 const COPY_OBJECT: u32 = 1;
 /// Length of a rate window, µs.
@@ -40,7 +42,7 @@ pub struct HapticsSettings {
     pub device: DeviceChoice,
     /// Device preset the sim device copies (default the Phantom Desktop).
     pub preset: Option<String>,
-    /// Spheres per copy's tree (default 1500).
+    /// Spheres per copy's tree (default 3000).
     pub spheres: usize,
     /// Where built trees are cached (default none).
     pub cache_dir: Option<PathBuf>,
@@ -50,7 +52,7 @@ pub struct HapticsSettings {
 
 impl Default for HapticsSettings {
     fn default() -> Self {
-        Self { device: DeviceChoice::Sim, preset: None, spheres: 1500, cache_dir: None, realtime_priority: None }
+        Self { device: DeviceChoice::Sim, preset: None, spheres: 3000, cache_dir: None, realtime_priority: None }
     }
 }
 
@@ -90,6 +92,8 @@ pub struct Haptics {
     pub specs: DeviceSpecs,
     /// Device frame to scene (the workbench frame).
     pub map: WorkspaceMap,
+    /// The gem's packed volume [`REFERENCE_DEPTH_M`] deep in a flat face, m³ (see [`haptic_material`]).
+    pub tool_reference_volume_m3: f32,
     building: Option<(ItemId, Receiver<Result<(InnerSphereTree, bool), String>>, Material)>,
     /// The copy being felt.
     pub on_bench: Option<OnBench>,
@@ -110,8 +114,9 @@ impl Haptics {
         let (device, hand) = device::open(&settings.device, specs.clone())?;
         let specs = device.specs().clone();
         let gem = collette::scene::brilliant_cut(TOOL_DIAMETER_M);
-        let (tree, _) = collette::build(&gem, &BuildOptions::spheres(200), &mut |_| {})
+        let (tree, _) = collette::build(&gem, &BuildOptions::spheres(TOOL_SPHERES), &mut |_| {})
             .map_err(|e| ClientError::Device(format!("building the gemstone's tree: {e}")))?;
+        let tool_reference_volume_m3 = immersed_volume(tree.spheres(), glam::Vec3::X, REFERENCE_DEPTH_M);
         // The gem is far stiffer than any copy, and its friction is 1 so the copy's own coefficient decides
         // (see `haptic_material`).
         let tool = ToolSpec::new(Arc::new(tree), Material { stiffness_n_per_m3: 1e12, damping_ns_per_m: 1e6, friction: 1.0 });
@@ -126,6 +131,7 @@ impl Haptics {
             hand,
             specs,
             map,
+            tool_reference_volume_m3,
             building: None,
             on_bench: None,
             samples: Vec::with_capacity(1 << 14),
@@ -165,7 +171,7 @@ impl Haptics {
                 let _ = tx.send(build_tree(&mesh, spheres, cache.as_deref()));
             })
             .map_or_else(|e| log::error!("could not start building copy {}: {e}", item.0), drop);
-        self.building = Some((copy.item, rx, haptic_material(&copy.material)));
+        self.building = Some((copy.item, rx, haptic_material(&copy.material, self.tool_reference_volume_m3)));
     }
 
     /// Takes the copy off the bench.
@@ -241,16 +247,31 @@ impl Haptics {
 }
 
 /// The contact material of a copy: the briefed stiffness `k` (N/m) becomes the volumetric stiffness
-/// that pushes back `k · d0` when the gemstone (radius R) is `d0` = [`REFERENCE_DEPTH_M`] deep in a flat
-/// face (cap volume ≈ π R d0²); friction is squared because contact friction is the geometric mean
-/// with the gem's (1).
-pub fn haptic_material(m: &artifact::Material) -> Material {
-    let r = TOOL_DIAMETER_M / 2.0;
+/// that pushes back `k · d0` when the gemstone is `d0` = [`REFERENCE_DEPTH_M`] deep in a flat, fully
+/// packed face, where its packed volume is `tool_volume_m3` (see [`immersed_volume`]); a copy's own
+/// packing leaves its skin a little softer. Friction is squared because contact friction is the
+/// geometric mean with the gem's (1).
+pub fn haptic_material(m: &artifact::Material, tool_volume_m3: f32) -> Material {
     Material {
-        stiffness_n_per_m3: m.stiffness_n_per_m / (std::f32::consts::PI * r * REFERENCE_DEPTH_M),
+        stiffness_n_per_m3: m.stiffness_n_per_m * REFERENCE_DEPTH_M / tool_volume_m3.max(1e-12),
         damping_ns_per_m: m.damping,
         friction: m.friction * m.friction,
     }
+}
+
+/// Volume of `spheres` past a plane `depth` behind their outermost point along `normal` (what of a
+/// tool is inside a flat face it was pushed `depth` into, along −`normal`), m³.
+pub fn immersed_volume(spheres: &[collette::Sphere], normal: Vec3, depth: f32) -> f32 {
+    let n = normal.normalize_or(Vec3::X);
+    let front = spheres.iter().map(|s| s.center.dot(n) + s.radius).fold(f32::NEG_INFINITY, f32::max);
+    let plane = front - depth;
+    spheres
+        .iter()
+        .map(|s| {
+            let h = (s.center.dot(n) + s.radius - plane).clamp(0.0, 2.0 * s.radius);
+            std::f32::consts::PI * h * h * (3.0 * s.radius - h) / 3.0
+        })
+        .sum()
 }
 
 /// Content hash of a mesh and the build settings, as the cache file's name.
@@ -301,12 +322,18 @@ mod tests {
 
     #[test]
     fn a_hard_copy_pushes_back_its_briefed_stiffness_at_the_reference_depth() {
-        let m = haptic_material(&MaterialClass::HardRough.material());
+        // A single sphere: the immersed volume is a cap.
         let r = TOOL_DIAMETER_M / 2.0;
         let d = REFERENCE_DEPTH_M;
+        let one = [collette::Sphere { center: Vec3::ZERO, radius: r }];
         let cap = std::f32::consts::PI * d * d * (3.0 * r - d) / 3.0;
+        assert!((immersed_volume(&one, Vec3::X, d) / cap - 1.0).abs() < 1e-4);
+        assert!((immersed_volume(&one, Vec3::X, 3.0 * r) / (4.0 / 3.0 * std::f32::consts::PI * r * r * r) - 1.0).abs() < 1e-4);
+        let m = haptic_material(&MaterialClass::HardRough.material(), cap);
         let force = m.stiffness_n_per_m3 * cap;
-        assert!((force / (800.0 * d) - 1.0).abs() < 0.25, "{force} N at {d} m");
+        assert!((force / (800.0 * d) - 1.0).abs() < 1e-4, "{force} N at {d} m");
+        let soft = haptic_material(&MaterialClass::SoftRough.material(), cap);
+        assert!((m.stiffness_n_per_m3 / soft.stiffness_n_per_m3 - 800.0 / 300.0).abs() < 1e-3);
         assert!((m.combine(&Material { stiffness_n_per_m3: 1e12, damping_ns_per_m: 1e6, friction: 1.0 }).friction - 0.6).abs() < 1e-4);
     }
 

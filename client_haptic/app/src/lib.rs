@@ -1,11 +1,25 @@
 //! The Phantom client: join a heist as the blind player and play by touch and sound alone.
+//!
+//! The tree: [`device`] (which device, the steerable simulated hand), [`haptics`] (the 1 kHz rig and the
+//! copy on the workbench as a sphere tree), [`explore`] (the touch bot), [`audio`] (kira, binaural voices,
+//! synthesized sounds), [`speech`] (espeak-ng), [`status`] (the sentences), [`client`] (the Bevy app that
+//! ties them to the session), [`cli`] (the command line) and, with the `spectator` feature, [`spectator`]
+//! (a window for sighted onlookers).
 #![warn(missing_docs)]
 
+pub mod audio;
+pub mod cli;
+pub mod client;
 pub mod device;
 pub mod error;
 pub mod explore;
 pub mod haptics;
-pub mod audio;
+pub mod practice;
+#[cfg(feature = "spectator")]
+pub mod spectator;
 pub mod speech;
+pub mod status;
+pub mod terminal;
 
+pub use client::{PhantomClientPlugin, PhantomSettings, PhantomState, start};
 pub use error::ClientError;

@@ -122,6 +122,18 @@ pub fn earcon(e: Earcon) -> StaticSoundData {
     mono(&out)
 }
 
+/// A guard's bark: a voiced "hey!" (two formants over a falling pitch); sharper when chasing.
+pub fn bark(chasing: bool) -> StaticSoundData {
+    let (len, f0) = if chasing { (0.35, 210.0) } else { (0.45, 160.0) };
+    let mut phase = 0.0f32;
+    mono(&samples(len, |t| {
+        phase += TAU * f0 * (1.0 - 0.3 * t / len) / RATE as f32;
+        let voice = phase.sin().signum() * 0.3;
+        let formants = (TAU * 700.0 * t).sin() * 0.6 + (TAU * 1200.0 * t).sin() * 0.4;
+        0.5 * voice * formants * (t / 0.02).min(1.0) * (1.0 - t / len)
+    }))
+}
+
 /// What the contact sound follows, written by the game thread.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ContactParams {
@@ -228,7 +240,7 @@ mod tests {
 
     #[test]
     fn every_one_shot_is_short_audible_and_bounded() {
-        let all = [footstep(1), glass(), thud(), alarm()]
+        let all = [footstep(1), glass(), thud(), alarm(), bark(true), bark(false)]
             .into_iter()
             .chain([Earcon::CopyArrived, Earcon::ReadyToFeel, Earcon::Right, Earcon::Wrong, Earcon::AlarmUp, Earcon::Won, Earcon::Lost].map(earcon));
         for s in all {

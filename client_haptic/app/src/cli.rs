@@ -1,0 +1,319 @@
+//! The `client_haptic` command line: `join ADDR --code CODE` and `devices`.
+//!
+//! You need this module to run the client from a shell; [`app`] builds the same Bevy app the tests
+//! drive by hand.
+
+use std::net::SocketAddr;
+use std::path::PathBuf;
+use std::time::Duration;
+
+use bevy::app::ScheduleRunnerPlugin;
+use bevy::prelude::*;
+use clap::{Parser, Subcommand, ValueEnum};
+use heist_client::ClientNetPlugin;
+use heist_shared::protocol::{Phase, Role, SessionView, TICK_HZ};
+
+use crate::audio::{AudioOutput, AudioSettings, SpatialMode};
+use crate::client::{PhantomSettings, PhantomState};
+use crate::device::DeviceChoice;
+use crate::haptics::HapticsSettings;
+
+/// The command line.
+#[derive(Parser, Debug)]
+#[command(name = "client_haptic", about = "Phantom Heist: join as Phantom, the blind player, and play by touch and sound")]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// Where the sound goes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum AudioChoice {
+    /// The sound card (falls back to memory when there is none).
+    Card,
+    /// Rendered in memory only (with `--wav`, into that file too).
+    Memory,
+}
+
+/// Subcommands.
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Join a session as Phantom.
+    Join(JoinArgs),
+    /// Practise at the workbench offline: the copies of one artifact, one after another.
+    Practice(PracticeArgs),
+    /// List the device presets and the HID devices found.
+    Devices,
+}
+
+/// The artifact to practise on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum KindArg {
+    /// The crown (count its points).
+    Crown,
+    /// The amphora (count its ridges).
+    Amphora,
+    /// The idol (count its notches).
+    Idol,
+}
+
+/// Arguments of `practice`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct PracticeArgs {
+    /// Which artifact.
+    #[arg(long, value_enum, default_value_t = KindArg::Crown)]
+    pub kind: KindArg,
+    /// Seed of the copies.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Everything else, as for `join` (the address and code are not used).
+    #[command(flatten)]
+    pub client: ClientArgs,
+}
+
+/// Arguments of `join`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct JoinArgs {
+    /// The server's address (its join endpoint), e.g. 127.0.0.1:5757.
+    pub addr: SocketAddr,
+    /// The join code the host printed.
+    #[arg(long)]
+    pub code: String,
+    /// Device, window, audio and bot settings.
+    #[command(flatten)]
+    pub client: ClientArgs,
+}
+
+/// Settings shared by `join` and `practice`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct ClientArgs {
+    /// The haptic device: sim (keyboard moves its hand), trace:FILE (replay), hid or hid:/dev/hidrawN.
+    #[arg(long, default_value = "sim")]
+    pub device: DeviceChoice,
+    /// Device preset the sim device copies (e.g. touch, falcon, phantom-premium-6dof); default Phantom Desktop.
+    #[arg(long)]
+    pub preset: Option<String>,
+    /// No window: sound and touch only.
+    #[arg(long)]
+    pub headless: bool,
+    /// Play by touch automatically (needs the sim device).
+    #[arg(long)]
+    pub bot: bool,
+    /// Spheres per copy's sphere tree.
+    #[arg(long, default_value_t = 3000)]
+    pub spheres: usize,
+    /// Cache built sphere trees here (default: the system's cache directory).
+    #[arg(long)]
+    pub cache: Option<PathBuf>,
+    /// Where the sound goes.
+    #[arg(long, value_enum, default_value_t = AudioChoice::Card)]
+    pub audio: AudioChoice,
+    /// Also write what was heard to this WAV file (with `--audio memory`).
+    #[arg(long)]
+    pub wav: Option<PathBuf>,
+    /// Place sounds with interaural time and level differences instead of the HRTF.
+    #[arg(long)]
+    pub no_hrtf: bool,
+    /// Real-time priority (1–99) for the haptic thread, if the system allows it.
+    #[arg(long)]
+    pub realtime: Option<i32>,
+    /// Spectator window: save a screenshot to this PNG after `--shot-after` frames, then quit.
+    #[arg(long)]
+    pub screenshot: Option<PathBuf>,
+    /// Frames before the screenshot.
+    #[arg(long, default_value_t = 150)]
+    pub shot_after: u32,
+}
+
+impl ClientArgs {
+    /// The client's settings from the arguments.
+    pub fn settings(&self) -> Result<PhantomSettings, String> {
+        if self.bot && self.device != DeviceChoice::Sim {
+            return Err("--bot moves the hand itself: it needs --device sim".into());
+        }
+        let cache = self.cache.clone().or_else(default_cache);
+        Ok(PhantomSettings {
+            bot: self.bot,
+            haptics: HapticsSettings {
+                device: self.device.clone(),
+                preset: self.preset.clone(),
+                spheres: self.spheres,
+                cache_dir: cache,
+                realtime_priority: self.realtime,
+            },
+            audio: AudioSettings {
+                output: match self.audio {
+                    AudioChoice::Card => AudioOutput::SoundCard,
+                    AudioChoice::Memory => AudioOutput::Background(self.wav.clone()),
+                },
+                spatial: if self.no_hrtf { SpatialMode::TimeLevel } else { SpatialMode::Hrtf },
+                ..Default::default()
+            },
+        })
+    }
+}
+
+/// `$XDG_CACHE_HOME/phantom-heist/ist` or `~/.cache/phantom-heist/ist`.
+pub fn default_cache() -> Option<PathBuf> {
+    let base = std::env::var_os("XDG_CACHE_HOME")
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))?;
+    Some(base.join("phantom-heist").join("ist"))
+}
+
+/// The Phantom client's Bevy app, not yet connected: headless (60 Hz loop) or with the spectator window;
+/// on the network, or practising offline.
+pub fn app(settings: PhantomSettings, headless: bool, practice: Option<crate::practice::Practice>) -> Result<App, crate::ClientError> {
+    let mut app = App::new();
+    if headless {
+        app.add_plugins(MinimalPlugins.set(ScheduleRunnerPlugin::run_loop(Duration::from_secs_f64(1.0 / TICK_HZ))))
+            .add_plugins(bevy::log::LogPlugin::default());
+    } else {
+        #[cfg(feature = "spectator")]
+        crate::spectator::add_window_plugins(&mut app);
+        #[cfg(not(feature = "spectator"))]
+        return Err(crate::ClientError::Device("built without the spectator window: run with --headless".into()));
+    }
+    let practising = practice.is_some();
+    match practice {
+        None => app.add_plugins(ClientNetPlugin),
+        Some(p) => app.insert_resource(p).add_plugins(crate::practice::PracticePlugin),
+    };
+    let bot = settings.bot;
+    crate::client::start(&mut app, settings)?;
+    if headless && !bot {
+        app.add_plugins(crate::terminal::TerminalKeysPlugin);
+    }
+    #[cfg(feature = "spectator")]
+    if !headless {
+        app.add_plugins(crate::spectator::SpectatorPlugin);
+    }
+    if practising {
+        app.add_systems(Update, quit_when_practice_is_over);
+    } else {
+        app.add_systems(Update, quit_when_over);
+    }
+    Ok(app)
+}
+
+/// Quits a few seconds after the last practice copy was judged.
+fn quit_when_practice_is_over(p: Res<crate::practice::Practice>, time: Res<Time<Real>>, mut done_at: Local<Option<f32>>, mut exit: MessageWriter<AppExit>) {
+    let now = time.elapsed_secs();
+    if p.finished() && done_at.is_none() {
+        *done_at = Some(now);
+    }
+    if done_at.is_some_and(|t| now - t > 4.0) {
+        exit.write(AppExit::Success);
+    }
+}
+
+/// Quits a few seconds after the heist ends (so the result is heard) or when the server goes away.
+fn quit_when_over(
+    q: Query<&SessionView>,
+    inbox: Res<heist_client::Inbox>,
+    time: Res<Time<Real>>,
+    mut over_at: Local<Option<f32>>,
+    state: Res<PhantomState>,
+    mut exit: MessageWriter<AppExit>,
+) {
+    let over = q.iter().next().is_some_and(|s| matches!(s.phase, Phase::Won | Phase::Lost(_))) || inbox.disconnect.is_some();
+    let now = time.elapsed_secs();
+    if over && over_at.is_none() {
+        *over_at = Some(now);
+        log::info!("the session is over after {} verdicts", state.verdicts.len());
+    }
+    if over_at.is_some_and(|t| now - t > 4.0) {
+        exit.write(AppExit::Success);
+    }
+}
+
+/// Runs `join`: gets a token, connects, plays until the session ends.
+pub fn join(args: &JoinArgs) -> anyhow::Result<()> {
+    use anyhow::Context as _;
+    let settings = args.client.settings().map_err(anyhow::Error::msg)?;
+    let token = heist_client::request_token(args.addr, &args.code, Role::Phantom, Duration::from_secs(5))
+        .with_context(|| format!("joining {} as Phantom", args.addr))?;
+    let mut app = app(settings, args.client.headless, None)?;
+    args.client.request_shot(&mut app);
+    app.finish();
+    app.cleanup();
+    heist_client::connect(&mut app, token)?;
+    app.run();
+    Ok(())
+}
+
+/// Runs `practice`.
+pub fn practice(args: &PracticeArgs) -> anyhow::Result<()> {
+    let settings = args.client.settings().map_err(anyhow::Error::msg)?;
+    let kind = match args.kind {
+        KindArg::Crown => heist_shared::artifact::ArtifactKind::Crown,
+        KindArg::Amphora => heist_shared::artifact::ArtifactKind::Amphora,
+        KindArg::Idol => heist_shared::artifact::ArtifactKind::Idol,
+    };
+    let mut app = app(settings, args.client.headless, Some(crate::practice::Practice::new(kind, args.seed)))?;
+    args.client.request_shot(&mut app);
+    app.run();
+    Ok(())
+}
+
+impl ClientArgs {
+    /// Asks the spectator window for a screenshot when `--screenshot` was given.
+    pub fn request_shot(&self, app: &mut App) {
+        #[cfg(feature = "spectator")]
+        if let Some(path) = &self.screenshot {
+            app.insert_resource(crate::spectator::ShotRequest { path: path.clone(), after_frames: self.shot_after });
+        }
+        #[cfg(not(feature = "spectator"))]
+        if self.screenshot.is_some() {
+            log::warn!("built without the spectator window: no screenshot");
+            let _ = app;
+        }
+    }
+}
+
+/// Runs `devices`.
+pub fn devices() -> anyhow::Result<()> {
+    println!("Device presets (for --preset with the sim device):");
+    for p in haptico::presets::all() {
+        println!(
+            "  {:<28} {:.1} N peak, {} N/m, {}",
+            p.name,
+            p.peak_force_n,
+            p.max_stiffness_n_per_m,
+            if p.renders_torque() { "forces and torques" } else { "forces only" }
+        );
+    }
+    match haptico::hid::list_devices() {
+        Ok(list) if list.is_empty() => println!("No HID haptic device found (see docs/haptics.md for the udev rule)."),
+        Ok(list) => {
+            println!("HID devices (for --device hid:PATH):");
+            for d in list {
+                println!("  {} {:04x}:{:04x} {:?} {}", d.path, d.vendor_id, d.product_id, d.kind, d.product);
+            }
+        }
+        Err(e) => println!("HID devices could not be listed: {e}"),
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_bot_refuses_a_device_it_cannot_steer() {
+        let cli = Cli::try_parse_from(["client_haptic", "join", "127.0.0.1:5757", "--code", "ABCD", "--bot", "--device", "hid"])
+            .expect("parses");
+        let Command::Join(args) = cli.command else { panic!("join") };
+        assert!(args.client.settings().unwrap_err().contains("--device sim"));
+    }
+
+    #[test]
+    fn a_bad_device_is_a_clear_usage_error() {
+        let err = Cli::try_parse_from(["client_haptic", "join", "127.0.0.1:5757", "--code", "A", "--device", "falcon"])
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("sim, trace:FILE or hid[:PATH]"), "{err}");
+    }
+}

@@ -1,0 +1,580 @@
+//! The Phantom client as a Bevy app: the session (through the shared client core), the copy on the
+//! workbench, verdicts, speech, sounds, keys, and the touch bot.
+//!
+//! You need this module to run Phantom. [`start`] opens the device, the haptic loop and the audio engine
+//! (they can fail, so they are set up before the plugin) and adds [`PhantomClientPlugin`]. Systems run in
+//! [`PhantomSystems`] order each frame: `Receive` (server events and copies in), `Play` (lobby, keys,
+//! verdicts, the bot), `Sound` (speech, museum sounds, contact sound); all in `Update`.
+
+use std::collections::HashMap;
+
+use bevy::input::ButtonInput;
+use bevy::input::keyboard::KeyCode;
+use bevy::prelude::*;
+use glam::{Vec2, Vec3};
+use heist_client::Inbox;
+use heist_shared::artifact::{ArtifactKind, MaterialClass};
+use heist_shared::protocol::{
+    ClientMsg, GameEvent, GuardAlert, GuardView, ItemId, ItemKind, ItemView, LobbyMsg, NoiseKind, Phase, PhantomMsg,
+    SessionView, VerdictOutcome, ViveAvatar, WarningKind,
+};
+
+use crate::audio::synth::{ContactParams, Earcon};
+use crate::audio::{AudioEngine, AudioSettings, listener_offset};
+use crate::device::HandGoal;
+use crate::error::ClientError;
+use crate::explore::{Exploration, Findings, to_device};
+use crate::haptics::{Haptics, HapticsSettings};
+use crate::speech::Speaker;
+use crate::status::{self, MenuItem};
+
+/// How the Phantom client runs.
+#[derive(Resource, Clone, Debug, Default)]
+pub struct PhantomSettings {
+    /// Play by touch automatically (the touch bot).
+    pub bot: bool,
+    /// The haptic side.
+    pub haptics: HapticsSettings,
+    /// The audio side.
+    pub audio: AudioSettings,
+}
+
+/// What is on the workbench, for the spectator window: the copy, its mesh and its (public) colour.
+#[derive(Resource, Default, Debug)]
+pub struct BenchView {
+    /// The copy, its mesh (workbench frame) and its look's sRGB colour.
+    pub copy: Option<(ItemId, heist_shared::artifact::HapticMesh, [u8; 3])>,
+}
+
+/// A server event, re-sent as a Bevy message so every system can read it.
+#[derive(Message, Clone, Debug, PartialEq)]
+pub struct HeistEvent(pub GameEvent);
+
+/// System sets of the Phantom client, chained in `Update`.
+#[derive(SystemSet, Debug, Clone, PartialEq, Eq, Hash)]
+pub enum PhantomSystems {
+    /// Server events and copies in; the haptic rig polled.
+    Receive,
+    /// Lobby, keys, verdicts, the bot.
+    Play,
+    /// Speech, museum sounds, contact sound, tool pose out.
+    Sound,
+}
+
+/// What one verdict was based on.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VerdictRecord {
+    /// The copy.
+    pub item: ItemId,
+    /// Declared real.
+    pub real: bool,
+    /// What touch found (bot only).
+    pub findings: Option<Findings>,
+}
+
+/// The Phantom client's memory.
+#[derive(Resource, Default, Debug)]
+pub struct PhantomState {
+    ready_sent: bool,
+    greeted: bool,
+    briefed: bool,
+    menu: usize,
+    /// The copy on the bench and its kind (from the replicated item, never its data).
+    pub copy: Option<(ItemId, Option<ArtifactKind>)>,
+    /// The copy's material class, for the contact sound only.
+    copy_feel: Option<MaterialClass>,
+    exploration: Option<Exploration>,
+    last_verdict: Option<(ItemId, bool)>,
+    judged: Option<ItemId>,
+    /// Every verdict given.
+    pub verdicts: Vec<VerdictRecord>,
+    buttons: u32,
+    touching: bool,
+    last_tool: Option<(u64, Vec3)>,
+    frame: u64,
+    steps: HashMap<u16, Vec2>,
+    vive_step: Option<Vec2>,
+    alerts: HashMap<u16, GuardAlert>,
+    /// The hand target moved by the keys (sim device), scene frame.
+    hand_target: Option<Vec3>,
+}
+
+impl PhantomState {
+    /// True while the haptic side is busy with a copy in real time (a tree building or the bot
+    /// exploring): a test stepping the clock by hand should keep to wall-clock time meanwhile.
+    pub fn busy(&self) -> bool {
+        self.exploration.is_some() || self.copy.is_some_and(|c| self.judged != Some(c.0))
+    }
+}
+
+/// Adds the Phantom client to `app` (after the client core): opens the device, starts the haptic loop
+/// and audio, and adds the plugin.
+pub fn start(app: &mut App, settings: PhantomSettings) -> Result<(), ClientError> {
+    let haptics = Haptics::start(settings.haptics.clone())?;
+    let audio = AudioEngine::new(&settings.audio)?;
+    app.insert_non_send(haptics).insert_non_send(audio).insert_non_send(Speaker::new());
+    app.add_plugins(PhantomClientPlugin { settings });
+    Ok(())
+}
+
+/// The Phantom client's systems (see the module docs; use [`start`]).
+pub struct PhantomClientPlugin {
+    /// Settings.
+    pub settings: PhantomSettings,
+}
+
+impl Plugin for PhantomClientPlugin {
+    fn build(&self, app: &mut App) {
+        app.insert_resource(self.settings.clone())
+            .init_resource::<PhantomState>()
+            .init_resource::<BenchView>()
+            .add_message::<HeistEvent>()
+            .configure_sets(Update, (PhantomSystems::Receive, PhantomSystems::Play, PhantomSystems::Sound).chain())
+            .add_systems(Update, (receive, poll_haptics).chain().in_set(PhantomSystems::Receive))
+            .add_systems(Update, (lobby, keys, device_buttons, after_verdict, touch_bot).chain().in_set(PhantomSystems::Play))
+            .add_systems(
+                Update,
+                (announce_events, museum_sounds, contact_sound, speak, send_tool_pose).chain().in_set(PhantomSystems::Sound),
+            );
+    }
+}
+
+fn kind_of(items: &Query<&ItemView>, item: ItemId) -> Option<ArtifactKind> {
+    items.iter().find(|i| i.id == item).and_then(|i| match i.kind {
+        ItemKind::Copy { artifact, .. } => Some(artifact),
+        ItemKind::Prop => None,
+    })
+}
+
+/// Server events become [`HeistEvent`]s; a copy on the workbench goes to the haptic rig.
+fn receive(
+    mut inbox: ResMut<Inbox>,
+    mut events: MessageWriter<HeistEvent>,
+    mut state: ResMut<PhantomState>,
+    mut haptics: NonSendMut<Haptics>,
+    mut speaker: NonSendMut<Speaker>,
+    mut audio: NonSendMut<AudioEngine>,
+    mut bench: ResMut<BenchView>,
+    items: Query<&ItemView>,
+) {
+    for e in std::mem::take(&mut inbox.events) {
+        events.write(HeistEvent(e));
+    }
+    if let Some(copy) = inbox.workbench.take() {
+        let kind = kind_of(&items, copy.item);
+        haptics.place(&copy);
+        let colour = kind.map_or([200, 200, 200], |k| heist_shared::artifact::look(k).colour_srgb);
+        bench.copy = Some((copy.item, copy.mesh.clone(), colour));
+        state.copy = Some((copy.item, kind));
+        state.copy_feel = Some(MaterialClass::nearest(&copy.material));
+        state.exploration = None;
+        audio.earcon(Earcon::CopyArrived);
+        speaker.say(status::copy_arrived(kind));
+    }
+    // The item's replication may come a frame after the copy.
+    if let Some((item, None)) = state.copy
+        && let Some(kind) = kind_of(&items, item)
+    {
+        state.copy = Some((item, Some(kind)));
+        if let Some(view) = bench.copy.as_mut() {
+            view.2 = heist_shared::artifact::look(kind).colour_srgb;
+        }
+    }
+}
+
+/// Polls the tree build and the rig's rings; announces when the copy can be felt.
+fn poll_haptics(
+    mut haptics: NonSendMut<Haptics>,
+    mut speaker: NonSendMut<Speaker>,
+    mut audio: NonSendMut<AudioEngine>,
+    settings: Res<PhantomSettings>,
+) {
+    match haptics.poll() {
+        Some(Ok(on)) => {
+            log::info!("copy {} on the bench: {} spheres{}", on.item.0, on.spheres, if on.cached { " (cached)" } else { "" });
+            audio.earcon(Earcon::ReadyToFeel);
+            if !settings.bot {
+                speaker.say("You can feel it now. Y if it is real, N if it is fake.");
+            }
+        }
+        Some(Err(e)) => {
+            log::error!("{e}");
+            speaker.say("This copy cannot be felt: its shape is broken.");
+        }
+        None => {}
+    }
+}
+
+fn session(q: &Query<&SessionView>) -> Option<SessionView> {
+    q.iter().next().cloned()
+}
+
+fn send_verdict(state: &mut PhantomState, out: &mut MessageWriter<ClientMsg>, speaker: &mut Speaker, item: ItemId, real: bool, findings: Option<Findings>) {
+    out.write(ClientMsg::Phantom(PhantomMsg::Verdict { item, real }));
+    speaker.say(if real { "You say: real." } else { "You say: fake." });
+    state.last_verdict = Some((item, real));
+    state.verdicts.push(VerdictRecord { item, real, findings });
+}
+
+/// Greets, reads the menu, and (bot) readies up.
+fn lobby(
+    mut state: ResMut<PhantomState>,
+    inbox: Res<Inbox>,
+    q: Query<&SessionView>,
+    settings: Res<PhantomSettings>,
+    mut speaker: NonSendMut<Speaker>,
+    mut out: MessageWriter<ClientMsg>,
+) {
+    let Some(s) = session(&q) else { return };
+    if inbox.role.is_none() {
+        return;
+    }
+    if !state.greeted {
+        state.greeted = true;
+        speaker.say("Welcome to Phantom Heist. You are Phantom, at the workbench. Up and down read the menu; Enter chooses.");
+        speaker.say(MenuItem::ALL[0].label());
+    }
+    if settings.bot && s.phase == Phase::Lobby && !state.ready_sent {
+        out.write(ClientMsg::Lobby(LobbyMsg::Ready));
+        state.ready_sent = true;
+    }
+    if s.phase == Phase::Heist && !state.briefed && !inbox.briefings.is_empty() {
+        state.briefed = true;
+        for b in &inbox.briefings {
+            speaker.say(b.text.clone());
+        }
+    }
+}
+
+/// Keyboard: menu, verdicts, status, briefing, repeat, warnings, and the simulated hand.
+#[allow(clippy::too_many_arguments)]
+fn keys(
+    keys: Option<Res<ButtonInput<KeyCode>>>,
+    time: Res<Time<Real>>,
+    mut state: ResMut<PhantomState>,
+    inbox: Res<Inbox>,
+    q: Query<&SessionView>,
+    guards: Query<&GuardView>,
+    vive: Query<&ViveAvatar>,
+    mut speaker: NonSendMut<Speaker>,
+    mut haptics: NonSendMut<Haptics>,
+    mut out: MessageWriter<ClientMsg>,
+) {
+    let Some(keys) = keys else { return };
+    let Some(s) = session(&q) else { return };
+    let status_line = |_: &PhantomState| {
+        let g: Vec<&GuardView> = guards.iter().collect();
+        status::status(&s, &g, vive.iter().next().map(|v| v.position))
+    };
+    let briefing = || inbox.briefings.iter().map(|b| b.text.as_str()).collect::<Vec<_>>().join(" ");
+    if s.phase == Phase::Lobby {
+        let n = MenuItem::ALL.len();
+        if keys.just_pressed(KeyCode::ArrowDown) {
+            state.menu = (state.menu + 1) % n;
+            speaker.say(MenuItem::ALL[state.menu].label());
+        }
+        if keys.just_pressed(KeyCode::ArrowUp) {
+            state.menu = (state.menu + n - 1) % n;
+            speaker.say(MenuItem::ALL[state.menu].label());
+        }
+        if keys.just_pressed(KeyCode::Enter) {
+            match MenuItem::ALL[state.menu] {
+                MenuItem::Ready if !state.ready_sent => {
+                    out.write(ClientMsg::Lobby(LobbyMsg::Ready));
+                    state.ready_sent = true;
+                    speaker.say("Ready. Waiting for Vive.");
+                }
+                MenuItem::Ready => speaker.say("You are ready. Waiting for Vive."),
+                MenuItem::Briefing => speaker.say("The briefing comes when the heist begins."),
+                MenuItem::Status => speaker.say(status_line(&state)),
+                MenuItem::Help => speaker.say(status::HELP),
+            }
+        }
+    }
+    if keys.just_pressed(KeyCode::KeyR) {
+        speaker.repeat();
+    }
+    if keys.just_pressed(KeyCode::KeyS) {
+        speaker.say(status_line(&state));
+    }
+    if keys.just_pressed(KeyCode::KeyB) {
+        let b = briefing();
+        speaker.say(if b.is_empty() { "No briefing yet.".to_owned() } else { b });
+    }
+    if s.phase == Phase::Heist {
+        for (key, w) in [(KeyCode::KeyH, WarningKind::Hide), (KeyCode::KeyG, WarningKind::Go), (KeyCode::KeyC, WarningKind::ComeBack)] {
+            if keys.just_pressed(key) {
+                out.write(ClientMsg::Phantom(PhantomMsg::Warn(w)));
+            }
+        }
+        if let Some((item, _)) = state.copy
+            && haptics.on_bench.as_ref().is_some_and(|o| o.item == item)
+        {
+            for (key, real) in [(KeyCode::KeyY, true), (KeyCode::KeyN, false)] {
+                if keys.just_pressed(key) {
+                    send_verdict(&mut state, &mut out, &mut speaker, item, real, None);
+                }
+            }
+        }
+    }
+    // Arrow keys move the simulated hand in the horizontal plane, page up/down vertically (10 cm/s).
+    let mut d = Vec3::ZERO;
+    for (key, dir) in [
+        (KeyCode::ArrowLeft, Vec3::NEG_X),
+        (KeyCode::ArrowRight, Vec3::X),
+        (KeyCode::ArrowUp, Vec3::NEG_Z),
+        (KeyCode::ArrowDown, Vec3::Z),
+        (KeyCode::PageUp, Vec3::Y),
+        (KeyCode::PageDown, Vec3::NEG_Y),
+    ] {
+        if keys.pressed(key) && s.phase != Phase::Lobby {
+            d += dir;
+        }
+    }
+    if d != Vec3::ZERO && !state.exploration.is_some() {
+        let map = haptics.map;
+        let at = *state.hand_target.get_or_insert(Vec3::new(0.0, 0.06, 0.07));
+        let next = (at + d * 0.1 * time.delta_secs()).clamp(Vec3::splat(-0.12), Vec3::splat(0.12));
+        state.hand_target = Some(next);
+        if let Some(hand) = haptics.hand.as_mut() {
+            hand.set(to_device(&map, HandGoal::Hold(haptic_common::Pose::from_translation(next))));
+        }
+    }
+}
+
+/// Device buttons: the first says real, the second fake (on press).
+fn device_buttons(
+    mut state: ResMut<PhantomState>,
+    haptics: NonSend<Haptics>,
+    settings: Res<PhantomSettings>,
+    mut speaker: NonSendMut<Speaker>,
+    mut out: MessageWriter<ClientMsg>,
+) {
+    let buttons = haptics.telemetry().device.buttons.0;
+    let pressed = buttons & !state.buttons;
+    state.buttons = buttons;
+    if settings.bot || pressed == 0 {
+        return;
+    }
+    if let Some((item, _)) = state.copy
+        && haptics.on_bench.as_ref().is_some_and(|o| o.item == item)
+    {
+        if pressed & 1 != 0 {
+            send_verdict(&mut state, &mut out, &mut speaker, item, true, None);
+        } else if pressed & 2 != 0 {
+            send_verdict(&mut state, &mut out, &mut speaker, item, false, None);
+        }
+    }
+}
+
+/// A right verdict takes the copy off the bench; a wrong one leaves it there, and the bot says the
+/// other thing.
+fn after_verdict(
+    mut events: MessageReader<HeistEvent>,
+    mut state: ResMut<PhantomState>,
+    settings: Res<PhantomSettings>,
+    mut haptics: NonSendMut<Haptics>,
+    mut bench: ResMut<BenchView>,
+    mut speaker: NonSendMut<Speaker>,
+    mut out: MessageWriter<ClientMsg>,
+) {
+    for HeistEvent(e) in events.read() {
+        if let GameEvent::Verdict { item, declared_real, outcome } = e {
+            if *outcome != VerdictOutcome::Wrong {
+                if state.copy.is_some_and(|c| c.0 == *item) {
+                    state.copy = None;
+                    state.exploration = None;
+                    haptics.clear();
+                    bench.copy = None;
+                }
+                continue;
+            }
+            if settings.bot && state.last_verdict == Some((*item, *declared_real)) {
+                send_verdict(&mut state, &mut out, &mut speaker, *item, !declared_real, None);
+            }
+        }
+    }
+}
+
+/// The touch bot: explores the copy with the simulated hand and gives its verdict from what it felt.
+fn touch_bot(
+    mut state: ResMut<PhantomState>,
+    mut haptics: NonSendMut<Haptics>,
+    inbox: Res<Inbox>,
+    settings: Res<PhantomSettings>,
+    mut speaker: NonSendMut<Speaker>,
+    mut out: MessageWriter<ClientMsg>,
+) {
+    if !settings.bot {
+        return;
+    }
+    let now = haptics.now_us();
+    let map = haptics.map;
+    // Start on a copy that can be felt, whose kind is known, and that was not judged yet.
+    if state.exploration.is_none()
+        && let Some((item, Some(kind))) = state.copy
+        && haptics.on_bench.as_ref().is_some_and(|o| o.item == item)
+        && state.judged != Some(item)
+    {
+        let ex = Exploration::new(kind, now);
+        if let Some(hand) = haptics.hand.as_mut() {
+            hand.set(to_device(&map, ex.goal()));
+        }
+        state.exploration = Some(ex);
+    }
+    let Some(ex) = state.exploration.as_mut() else { return };
+    let changed = ex.step(now, &haptics.samples);
+    if changed && let Some(hand) = haptics.hand.as_mut() {
+        hand.set(to_device(&map, ex.goal()));
+    }
+    if !ex.done() {
+        return;
+    }
+    let Some(findings) = ex.findings().cloned() else { return };
+    let Some((item, Some(kind))) = state.copy else { return };
+    state.exploration = None;
+    state.judged = Some(item);
+    let briefing = inbox.briefings.iter().find(|b| b.kind == kind);
+    let real = briefing.is_some_and(|b| findings.matches(b));
+    log::info!("touch bot: copy {} of the {}: felt {} -> {}", item.0, kind.name(), findings.describe(), if real { "real" } else { "fake" });
+    speaker.say(format!("I feel {}.", findings.spoken(kind)));
+    send_verdict(&mut state, &mut out, &mut speaker, item, real, Some(findings));
+}
+
+/// Speaks what happened and plays the earcons.
+fn announce_events(
+    mut events: MessageReader<HeistEvent>,
+    guards: Query<&GuardView>,
+    mut spoken_alerts: Local<HashMap<u16, GuardAlert>>,
+    mut speaker: NonSendMut<Speaker>,
+    mut audio: NonSendMut<AudioEngine>,
+) {
+    for HeistEvent(e) in events.read() {
+        // A guard's alert is said once per change.
+        if let GameEvent::GuardAlert { guard, alert, .. } = e
+            && spoken_alerts.insert(guard.0, *alert) == Some(*alert)
+        {
+            continue;
+        }
+        let name = |id: u16| guards.iter().find(|g| g.id.0 == id).map(|g| g.name.clone());
+        if let Some(text) = status::announce(e, name) {
+            speaker.say(text);
+        }
+        match e {
+            GameEvent::Verdict { outcome: VerdictOutcome::Wrong, .. } => audio.earcon(Earcon::Wrong),
+            GameEvent::Verdict { .. } => audio.earcon(Earcon::Right),
+            GameEvent::Alarm(_) => audio.earcon(Earcon::AlarmUp),
+            GameEvent::PhaseChanged(Phase::Won) => audio.earcon(Earcon::Won),
+            GameEvent::PhaseChanged(Phase::Lost(_)) => audio.earcon(Earcon::Lost),
+            _ => {}
+        }
+    }
+}
+
+/// The museum around Phantom's workbench: noises, guards' steps and barks, Vive's steps, the alarm.
+fn museum_sounds(
+    mut events: MessageReader<HeistEvent>,
+    mut state: ResMut<PhantomState>,
+    inbox: Res<Inbox>,
+    guards: Query<&GuardView>,
+    vive: Query<&ViveAvatar>,
+    mut audio: NonSendMut<AudioEngine>,
+) {
+    let Some(bench) = inbox.level.as_ref().map(|l| l.workbench) else { return };
+    let at = |p: Vec2, h: f32| listener_offset(bench, p, h);
+    for HeistEvent(e) in events.read() {
+        match e {
+            GameEvent::Noise { kind: NoiseKind::Glass, position, .. } => audio.glass(at(*position, 1.0)),
+            GameEvent::Noise { kind: NoiseKind::Thud, position, .. } => audio.thud(at(*position, 0.0)),
+            GameEvent::Noise { kind: NoiseKind::Alarm, position, .. } => audio.alarm(at(*position, 2.5)),
+            GameEvent::Noise { kind: NoiseKind::Footsteps, position, loudness } => {
+                audio.footstep(at(*position, 0.0), *loudness, "vive footstep")
+            }
+            GameEvent::GuardAlert { guard, alert, position } => {
+                state.alerts.insert(guard.0, *alert);
+                if matches!(alert, GuardAlert::Suspicious | GuardAlert::Chasing) {
+                    audio.play_at(crate::audio::synth::bark(*alert == GuardAlert::Chasing), at(*position, 1.7), "guard bark");
+                }
+            }
+            _ => {}
+        }
+    }
+    // A step every 0.7 m a guard walks; Vive's steps are quiet unless she runs.
+    for g in &guards {
+        let last = state.steps.entry(g.id.0).or_insert(g.position);
+        if g.position.distance(*last) > 0.7 {
+            *last = g.position;
+            audio.footstep(at(g.position, 0.0), 0.5, "guard footstep");
+        }
+    }
+    if let Some(v) = vive.iter().next() {
+        let last = *state.vive_step.get_or_insert(v.position);
+        if v.position.distance(last) > 0.7 {
+            state.vive_step = Some(v.position);
+            let loud = match v.stance {
+                heist_shared::protocol::Stance::Crouching => 0.1,
+                heist_shared::protocol::Stance::Running => 0.6,
+                heist_shared::protocol::Stance::Standing => 0.25,
+            };
+            audio.footstep(at(v.position, 0.0), loud, "vive footstep");
+        }
+    }
+}
+
+/// Drives the contact sound from this frame's haptic samples: force and sliding speed, taps on impact.
+fn contact_sound(mut state: ResMut<PhantomState>, haptics: NonSend<Haptics>, mut audio: NonSendMut<AudioEngine>) {
+    let feel = state.copy_feel;
+    let params = contact_params(&haptics.samples, &mut state.last_tool, feel);
+    let touching = params.force_n > 0.05;
+    if touching && !state.touching {
+        audio.tap((params.force_n / 2.0).min(1.0));
+    }
+    state.touching = touching;
+    audio.contact(params);
+}
+
+/// The contact sound's parameters from force samples (mean contact force and sliding speed of the
+/// stylus); `last` carries the previous sample between frames; `feel` sets hardness and roughness.
+pub fn contact_params(samples: &[haptic_rig::ForceSample], last: &mut Option<(u64, Vec3)>, feel: Option<MaterialClass>) -> ContactParams {
+    let (mut force, mut speed, mut n) = (0.0, 0.0, 0u32);
+    for s in samples {
+        let f = s.contact_force.length();
+        if let Some((t, p)) = *last
+            && s.t_us > t
+        {
+            let v = (s.tool_position - p) / ((s.t_us - t) as f32 * 1e-6);
+            let normal = s.contact_force.normalize_or_zero();
+            speed += (v - normal * v.dot(normal)).length();
+        }
+        *last = Some((s.t_us, s.tool_position));
+        force += f;
+        n += 1;
+    }
+    if n == 0 {
+        return ContactParams::default();
+    }
+    let feel = feel.unwrap_or(MaterialClass::HardSmooth);
+    ContactParams {
+        force_n: force / n as f32,
+        slip_m_per_s: speed / n as f32,
+        hardness: if feel.is_hard() { 1.0 } else { 0.2 },
+        roughness: if feel.is_rough() { 1.0 } else { 0.1 },
+    }
+}
+
+/// Plays speech as it becomes ready.
+fn speak(mut speaker: NonSendMut<Speaker>, mut audio: NonSendMut<AudioEngine>) {
+    for s in speaker.ready() {
+        audio.speak(s);
+    }
+}
+
+/// Tells the server where the stylus is (20 times a second, during the heist) so Vive sees it move.
+fn send_tool_pose(mut state: ResMut<PhantomState>, haptics: NonSend<Haptics>, q: Query<&SessionView>, mut out: MessageWriter<ClientMsg>) {
+    state.frame += 1;
+    if session(&q).is_none_or(|s| s.phase != Phase::Heist) || !state.frame.is_multiple_of(3) {
+        return;
+    }
+    let pose = haptics.telemetry().tool_pose;
+    out.write(ClientMsg::Phantom(PhantomMsg::ToolPose { position: pose.translation, rotation: pose.rotation }));
+}

@@ -1,0 +1,32 @@
+//! The touch bot judges copies from what it feels through the real haptic loop (sim device, collision
+//! thread, force stage), never from their data.
+
+use std::time::Duration;
+
+use client_haptic::explore::feel;
+use client_haptic::haptics::{Haptics, HapticsSettings};
+use heist_shared::artifact::{ArtifactKind, build_mesh, generate_copies};
+use heist_shared::protocol::{ItemId, WorkbenchCopy};
+
+#[test]
+fn the_touch_bot_tells_every_copy_of_each_kind_by_touch() {
+    let mut h = Haptics::start(HapticsSettings::default()).expect("the haptic loop starts");
+    std::thread::sleep(Duration::from_millis(2500)); // the safety layer ramps forces in
+    let mut wrong = Vec::new();
+    let mut item = 0;
+    // Seeds not used to set the thresholds.
+    for (kind, seed) in [(ArtifactKind::Crown, 21), (ArtifactKind::Amphora, 22), (ArtifactKind::Idol, 23)] {
+        let (copies, _) = generate_copies(kind, seed, 3);
+        for traits in &copies {
+            item += 1;
+            let copy = WorkbenchCopy { item: ItemId(item), mesh: build_mesh(traits, seed), material: traits.material.material() };
+            let f = feel(&mut h, &copy, kind).expect("the copy is explored");
+            println!("{kind:?} {} {:?}: felt {}", traits.feature_count, traits.material, f.describe());
+            if f.feature_count != traits.feature_count || f.material != traits.material {
+                wrong.push((kind, traits.feature_count, traits.material, f.feature_count, f.material));
+            }
+        }
+    }
+    h.stop();
+    assert!(wrong.is_empty(), "misjudged: {wrong:?}");
+}
