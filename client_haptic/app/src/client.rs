@@ -578,3 +578,41 @@ fn send_tool_pose(mut state: ResMut<PhantomState>, haptics: NonSend<Haptics>, q:
     let pose = haptics.telemetry().tool_pose;
     out.write(ClientMsg::Phantom(PhantomMsg::ToolPose { position: pose.translation, rotation: pose.rotation }));
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::audio::{AudioOutput, SpatialMode};
+    use haptic_rig::ForceSample;
+
+    /// A second of 1 kHz samples of the stylus sliding along +x at `speed` m/s, pushed with `force` N.
+    fn stroke(force: f32, speed: f32) -> Vec<ForceSample> {
+        (0..1000u64)
+            .map(|i| ForceSample {
+                t_us: 1_000_000 + i * 1000,
+                contact_force: Vec3::Y * force,
+                tool_position: Vec3::X * speed * i as f32 * 1e-3,
+                contacts: if force > 0.0 { 12 } else { 0 },
+                ..Default::default()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn haptic_contact_drives_the_contact_sound_and_free_space_leaves_it_silent() {
+        let mut audio = AudioEngine::new(&AudioSettings { output: AudioOutput::Manual, spatial: SpatialMode::Hrtf, ..Default::default() })
+            .expect("audio starts");
+        let capture = audio.capture().expect("memory output").clone();
+        let energy = |frames: Vec<(f32, f32)>| frames.iter().map(|f| f.0 * f.0 + f.1 * f.1).sum::<f32>();
+        let mut last = None;
+        let free = contact_params(&stroke(0.0, 0.05), &mut last, Some(MaterialClass::HardRough));
+        assert_eq!(free.force_n, 0.0);
+        audio.contact(free);
+        assert!(energy(capture.render(24_000)) < 1e-9, "free space is silent");
+        let mut last = None;
+        let sliding = contact_params(&stroke(1.2, 0.05), &mut last, Some(MaterialClass::HardRough));
+        assert!((sliding.force_n - 1.2).abs() < 1e-4 && (sliding.slip_m_per_s - 0.05).abs() < 1e-3, "{sliding:?}");
+        audio.contact(sliding);
+        assert!(energy(capture.render(24_000)) > 1e-2, "the stylus sliding on a copy is heard");
+    }
+}

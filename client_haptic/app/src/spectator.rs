@@ -66,11 +66,13 @@ impl Plugin for SpectatorPlugin {
 
 fn setup(mut commands: Commands, mut meshes: ResMut<Assets<Mesh>>, mut materials: ResMut<Assets<StandardMaterial>>) {
     commands.spawn((Camera3d::default(), Transform::from_xyz(0.16, 0.14, 0.26).looking_at(Vec3::new(0.0, -0.01, 0.0), Vec3::Y)));
+    // A key light from the upper left and a weak ambient, so the copy's features read as shading.
     commands.spawn((
-        DirectionalLight { illuminance: 9_000.0, shadow_maps_enabled: false, ..default() },
-        Transform::from_xyz(0.3, 0.6, 0.4).looking_at(Vec3::ZERO, Vec3::Y),
+        DirectionalLight { illuminance: 12_000.0, shadow_maps_enabled: false, ..default() },
+        Transform::from_xyz(-0.4, 0.7, 0.5).looking_at(Vec3::ZERO, Vec3::Y),
     ));
-    commands.insert_resource(GlobalAmbientLight { brightness: 400.0, ..default() });
+    commands.insert_resource(GlobalAmbientLight { brightness: 120.0, ..default() });
+    commands.spawn((PointLight { intensity: 20_000.0, range: 3.0, shadow_maps_enabled: false, ..default() }, Transform::from_xyz(0.25, 0.25, 0.2)));
     // The workbench top, under the copies (they stand on y ≈ −0.06).
     commands.spawn((
         Mesh3d(meshes.add(Cuboid::new(0.5, 0.02, 0.35))),
@@ -103,18 +105,21 @@ fn show_copy(
     let Some((item, mesh, colour)) = bench.copy.as_ref() else { return };
     let positions: Vec<[f32; 3]> = mesh.vertices.clone();
     let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
-    let m = Mesh::new(PrimitiveTopology::TriangleList, RenderAssetUsages::default())
+    // Flat normals: the features read as facets.
+    let mut m = Mesh::new(PrimitiveTopology::TriangleList, RenderAssetUsages::default())
         .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, positions)
-        .with_inserted_indices(Indices::U32(indices))
-        .with_computed_smooth_normals();
+        .with_inserted_indices(Indices::U32(indices));
+    m.duplicate_vertices();
+    m.compute_flat_normals();
     let [r, g, b] = *colour;
     commands.spawn((
         CopyMesh(item.0),
         Mesh3d(meshes.add(m)),
         MeshMaterial3d(materials.add(StandardMaterial {
             base_color: Color::srgb_u8(r, g, b),
-            perceptual_roughness: 0.5,
-            metallic: 0.2,
+            perceptual_roughness: 0.6,
+            double_sided: true,
+            cull_mode: None,
             ..default()
         })),
         Transform::IDENTITY,

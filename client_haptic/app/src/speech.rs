@@ -163,6 +163,29 @@ mod tests {
     }
 
     #[test]
+    fn a_menu_item_is_spoken_and_heard() {
+        use crate::audio::{AudioEngine, AudioOutput, AudioSettings};
+        let mut audio = AudioEngine::new(&AudioSettings { output: AudioOutput::Manual, ..Default::default() }).expect("audio starts");
+        let capture = audio.capture().expect("memory output").clone();
+        let mut speaker = Speaker::new();
+        speaker.say(crate::status::MenuItem::Ready.label());
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(20);
+        let speech = loop {
+            if let Some(s) = speaker.ready().pop() {
+                break s;
+            }
+            assert!(std::time::Instant::now() < deadline, "espeak-ng (scripts/deps.sh installs it) gave no speech");
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        };
+        assert!(speech.duration().as_secs_f64() > 1.0, "a sentence lasts over a second: {:?}", speech.duration());
+        audio.speak(speech);
+        let frames = capture.render(48_000);
+        let loud = frames.iter().filter(|f| f.0.abs().max(f.1.abs()) > 0.02).count();
+        assert!(loud > 4_800, "only {loud} audible frames in the first second");
+        assert_eq!(speaker.said, vec![crate::status::MenuItem::Ready.label().to_owned()]);
+    }
+
+    #[test]
     fn a_broken_wav_says_what_is_wrong() {
         let err = decode_wav(b"RIFX....WAVE").unwrap_err().to_string();
         assert!(err.contains("no RIFF/WAVE header"), "{err}");
