@@ -91,7 +91,7 @@ pub struct ClientArgs {
     /// The haptic device: sim (keyboard moves its hand), trace:FILE (replay), hid or hid:/dev/hidrawN.
     #[arg(long, default_value = "sim")]
     pub device: DeviceChoice,
-    /// Device preset the sim device copies (e.g. touch, falcon, phantom-premium-6dof); default Phantom Desktop.
+    /// Device preset the sim device copies (e.g. touch, falcon, premium); default Phantom Desktop.
     #[arg(long)]
     pub preset: Option<String>,
     /// No window: sound and touch only.

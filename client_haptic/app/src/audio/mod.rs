@@ -311,8 +311,9 @@ impl AudioEngine {
         self.note(&format!("earcon {e:?}"), Vec3::ZERO);
     }
 
-    /// Speech, from just ahead.
-    pub fn speak(&mut self, sound: StaticSoundData) {
+    /// Speech, from just ahead, 6 dB down (espeak-ng speaks at full scale; earcons and the museum mix in).
+    pub fn speak(&mut self, mut sound: StaticSoundData) {
+        sound.settings.volume = kira::Value::Fixed(kira::Decibels(-6.0));
         if let Err(e) = self.speech.track.play(sound) {
             log::warn!("audio: {e}");
         }
