@@ -94,7 +94,6 @@ pub struct PhantomState {
     frame: u64,
     steps: HashMap<u16, Vec2>,
     vive_step: Option<Vec2>,
-    alerts: HashMap<u16, GuardAlert>,
     /// The hand target moved by the keys (sim device), scene frame.
     hand_target: Option<Vec3>,
 }
@@ -490,8 +489,7 @@ fn museum_sounds(
             GameEvent::Noise { kind: NoiseKind::Footsteps, position, loudness } => {
                 audio.footstep(at(*position, 0.0), *loudness, "vive footstep")
             }
-            GameEvent::GuardAlert { guard, alert, position } => {
-                state.alerts.insert(guard.0, *alert);
+            GameEvent::GuardAlert { alert, position, .. } => {
                 if matches!(alert, GuardAlert::Suspicious | GuardAlert::Chasing) {
                     audio.play_at(crate::audio::synth::bark(*alert == GuardAlert::Chasing), at(*position, 1.7), "guard bark");
                 }
