@@ -20,8 +20,8 @@ pub enum ClientError {
         reason: String,
     },
     /// Audio could not start.
-    #[error("audio: {0}")]
-    Audio(String),
+    #[error(transparent)]
+    Audio(#[from] heist_audio::AudioError),
     /// Speech could not be synthesized.
     #[error("speech: {0}")]
     Speech(String),

@@ -7,7 +7,6 @@
 //! (a window for sighted onlookers).
 #![warn(missing_docs)]
 
-pub mod audio;
 pub mod cli;
 pub mod client;
 pub mod device;
@@ -21,5 +20,7 @@ pub mod speech;
 pub mod status;
 pub mod terminal;
 
+/// The sounds (the shared `heist_audio` crate).
+pub use heist_audio as audio;
 pub use client::{PhantomClientPlugin, PhantomSettings, PhantomState, start};
 pub use error::ClientError;

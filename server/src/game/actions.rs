@@ -13,12 +13,7 @@ impl Game {
     pub(super) fn apply_vive(&mut self, msg: &ViveMsg) -> Result<(), Refusal> {
         match *msg {
             ViveMsg::Move { seq, direction, gait, facing } => {
-                let speed = match gait {
-                    Gait::Walk => rules::WALK_SPEED,
-                    Gait::Run => rules::RUN_SPEED,
-                    Gait::Crouch => rules::CROUCH_SPEED,
-                };
-                self.vive.intent = (direction, speed);
+                self.vive.intent = (direction, rules::gait_speed(gait));
                 self.vive.stance = match gait {
                     Gait::Run => Stance::Running,
                     Gait::Crouch => Stance::Crouching,

@@ -254,9 +254,8 @@ impl Game {
 
     fn move_vive(&mut self, dt: f32) {
         let (dir, speed) = self.vive.intent;
-        let delta = dir * speed * dt;
         let before = self.vive.position;
-        self.vive.position = self.walls.slide(before, delta, rules::BODY_RADIUS);
+        self.vive.position = rules::move_body(&self.walls, before, dir, speed, dt);
         self.vive.velocity = (self.vive.position - before) / dt.max(1e-6);
         if self.vive.stance == Stance::Running && self.vive.velocity.length() > 0.5 {
             self.vive.footstep_timer -= dt;

@@ -66,7 +66,7 @@ pub struct ViveBotPlugin {
 
 impl Plugin for ViveBotPlugin {
     fn build(&self, app: &mut App) {
-        app.insert_resource(ViveBrain { style: self.style, ..Default::default() }).add_systems(Update, play);
+        app.insert_resource(ViveBrain::new(self.style)).add_systems(Update, play);
     }
 }
 
@@ -94,6 +94,98 @@ enum Goal {
     Rest,
 }
 
+/// What the bot decided in one frame.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Turn {
+    /// Say "ready" in the lobby now.
+    pub ready: bool,
+    /// Where to go: direction (|d| ≤ 1, museum floor), gait and facing (radians); `None` outside the heist.
+    pub movement: Option<(Vec2, Gait, f32)>,
+    /// What to do besides moving (break, pick up, throw, place…).
+    pub action: Option<ViveMsg>,
+}
+
+/// Everything the bot may look at in one frame (the replicated state, or a client's predicted view of it).
+pub struct Sight<'a> {
+    /// The level, once the server has sent it.
+    pub level: Option<&'a heist_shared::level::Level>,
+    /// Whether the server has granted the role.
+    pub joined: bool,
+    /// The session.
+    pub session: &'a SessionView,
+    /// Vive as the bot should see itself.
+    pub me: &'a ViveAvatar,
+    /// The guards.
+    pub guards: Vec<&'a GuardView>,
+    /// The display cases.
+    pub cases: Vec<&'a CaseView>,
+    /// The items.
+    pub items: Vec<&'a ItemView>,
+}
+
+impl ViveBrain {
+    /// A fresh brain playing `style`.
+    pub fn new(style: ViveStyle) -> Self {
+        Self { style, ..Default::default() }
+    }
+
+    /// Thinks for one frame of `dt` seconds: what to say, where to go, what to do. The bot plugin sends
+    /// the result as messages; the Vive client turns it into the same intents a player's input makes.
+    pub fn think(&mut self, sight: &Sight<'_>, dt: f32) -> Turn {
+        let mut turn = Turn::default();
+        let (session, me) = (sight.session, sight.me);
+        if self.map.is_none()
+            && let Some(level) = sight.level
+        {
+            self.map = Some((NavGraph::new(level), WallSet::new(level), level.workbench));
+            self.level = Some(level.clone());
+        }
+        if session.phase == Phase::Lobby && !self.ready_sent && sight.joined {
+            turn.ready = true;
+            self.ready_sent = true;
+        }
+        if session.phase != Phase::Heist || self.style == ViveStyle::Idle || self.map.is_none() {
+            return turn;
+        }
+        let view = View {
+            me,
+            alarm: session.alarm,
+            guards: sight.guards.clone(),
+            cases: sight.cases.clone(),
+            items: sight.items.clone(),
+            secured: session.targets.iter().filter(|t| t.1).map(|t| t.0).collect(),
+        };
+        self.clock_s += dt;
+        let now = self.clock_s;
+        self.avoid.retain(|(_, until)| *until > now);
+        let goal = choose_goal(self, &view);
+        self.committed = match &goal {
+            Goal::Break(_, _, item) | Goal::Take(_, item) => Some(*item),
+            _ => None,
+        };
+        let (direction, gait, action) = steer(self, &view, goal, dt);
+        // Waiting on one goal for too long: try another item for a while.
+        if direction == Vec2::ZERO && action.is_none() {
+            self.stuck_s += dt;
+            if self.stuck_s > GIVE_UP_AFTER_S
+                && let Some(item) = self.committed.take()
+            {
+                self.avoid.push((item, now + 60.0));
+                self.stuck_s = 0.0;
+            }
+        } else {
+            self.stuck_s = 0.0;
+        }
+        if let Some(action) = &action {
+            self.actions.push(format!("{action:?}"));
+        }
+        let facing = if direction.length_squared() > 0.0 { direction.y.atan2(direction.x) } else { me.facing };
+        turn.movement = Some((direction, gait, facing));
+        turn.action = action;
+        turn
+    }
+}
+
 #[allow(clippy::too_many_arguments)]
 fn play(
     mut brain: ResMut<ViveBrain>,
@@ -107,56 +199,26 @@ fn play(
     mut out: MessageWriter<ClientMsg>,
 ) {
     let (Ok(session), Ok(me)) = (session.single(), avatar.single()) else { return };
-    if brain.map.is_none()
-        && let Some(level) = &inbox.level
-    {
-        brain.map = Some((NavGraph::new(level), WallSet::new(level), level.workbench));
-        brain.level = Some(level.clone());
-    }
-    if session.phase == Phase::Lobby && !brain.ready_sent && inbox.role.is_some() {
-        out.write(ClientMsg::Lobby(LobbyMsg::Ready));
-        brain.ready_sent = true;
-    }
-    if session.phase != Phase::Heist || brain.style == ViveStyle::Idle || brain.map.is_none() {
-        return;
-    }
-    let dt = time.delta_secs();
-    let view = View {
+    let sight = Sight {
+        level: inbox.level.as_ref(),
+        joined: inbox.role.is_some(),
+        session,
         me,
-        alarm: session.alarm,
         guards: guards.iter().collect(),
         cases: cases.iter().collect(),
         items: items.iter().collect(),
-        secured: session.targets.iter().filter(|t| t.1).map(|t| t.0).collect(),
     };
-    brain.clock_s += dt;
-    let now = brain.clock_s;
-    brain.avoid.retain(|(_, until)| *until > now);
-    let goal = choose_goal(&brain, &view);
-    brain.committed = match &goal {
-        Goal::Break(_, _, item) | Goal::Take(_, item) => Some(*item),
-        _ => None,
-    };
-    let (direction, gait, action) = steer(&mut brain, &view, goal, dt);
-    // Waiting on one goal for too long: try another item for a while.
-    if direction == Vec2::ZERO && action.is_none() {
-        brain.stuck_s += dt;
-        if brain.stuck_s > GIVE_UP_AFTER_S
-            && let Some(item) = brain.committed.take()
-        {
-            brain.avoid.push((item, now + 60.0));
-            brain.stuck_s = 0.0;
-        }
-    } else {
-        brain.stuck_s = 0.0;
+    let turn = brain.think(&sight, time.delta_secs());
+    if turn.ready {
+        out.write(ClientMsg::Lobby(LobbyMsg::Ready));
     }
-    if let Some(action) = action {
-        brain.actions.push(format!("{action:?}"));
+    if let Some(action) = turn.action {
         out.write(ClientMsg::Vive(action));
     }
-    brain.seq += 1;
-    let facing = if direction.length_squared() > 0.0 { direction.y.atan2(direction.x) } else { me.facing };
-    out.write(ClientMsg::Vive(ViveMsg::Move { seq: brain.seq, direction, gait, facing }));
+    if let Some((direction, gait, facing)) = turn.movement {
+        brain.seq += 1;
+        out.write(ClientMsg::Vive(ViveMsg::Move { seq: brain.seq, direction, gait, facing }));
+    }
 }
 
 fn is_copy(view: &View<'_>, id: ItemId) -> bool {

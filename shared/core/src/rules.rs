@@ -24,3 +24,20 @@ pub const RUN_LOUDNESS: f32 = 6.0;
 pub const ALARM_LOCKDOWN: u8 = 3;
 /// Distance at which a guard catches Vive, metres.
 pub const CATCH_DISTANCE: f32 = 0.9;
+
+/// Top speed of `gait`, m/s.
+pub fn gait_speed(gait: crate::protocol::Gait) -> f32 {
+    use crate::protocol::Gait;
+    match gait {
+        Gait::Walk => WALK_SPEED,
+        Gait::Run => RUN_SPEED,
+        Gait::Crouch => CROUCH_SPEED,
+    }
+}
+
+/// Where Vive's body ends up after `dt` seconds of moving along `direction` (|d| ≤ 1) at `speed` m/s from
+/// `from`, sliding along walls. The server moves Vive with this and the Vive client predicts with it, so
+/// both agree to the bit when they see the same inputs.
+pub fn move_body(walls: &crate::level::WallSet, from: glam::Vec2, direction: glam::Vec2, speed: f32, dt: f32) -> glam::Vec2 {
+    walls.slide(from, direction * speed * dt, BODY_RADIUS)
+}

@@ -1,15 +1,22 @@
-//! Phantom's ears: kira 0.12 used directly, with binaural placement, synthesized sounds and speech.
+//! The museum's sounds for both Phantom Heist clients: kira 0.12 used directly, with binaural placement
+//! and synthesized sounds.
 //!
-//! You need this module to play anything. [`AudioEngine`] owns kira's manager (sound card, or memory
+//! You need this crate to play anything. [`AudioEngine`] owns kira's manager (sound card, or memory
 //! when there is none or in tests), a pool of binaural voices (sub-tracks with the [`binaural`] effect),
 //! one voice for speech straight ahead, and the endless contact sound placed at the workbench. The game
 //! side calls [`AudioEngine::play_at`] with an offset in the listener's frame; [`listener_offset`] turns
 //! a museum floor position into one.
+#![warn(missing_docs)]
 
 pub mod backend;
 pub mod binaural;
 pub mod hrir;
 pub mod synth;
+
+/// Audio could not start (the reason, for the player).
+#[derive(Debug, thiserror::Error)]
+#[error("audio: {0}")]
+pub struct AudioError(pub String);
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -25,7 +32,7 @@ use kira::{AudioManager, AudioManagerSettings};
 use self::backend::{Capture, CaptureBackend, CaptureSettings};
 use self::binaural::{BinauralBuilder, BinauralHandle, Placement, Spatializer};
 use self::synth::{ContactHandle, ContactParams, ContactSoundData, Earcon};
-use crate::error::ClientError;
+
 
 /// Where the sound goes.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -73,13 +80,13 @@ enum Manager {
 }
 
 impl Manager {
-    fn add_sub_track(&mut self, builder: TrackBuilder) -> Result<TrackHandle, ClientError> {
+    fn add_sub_track(&mut self, builder: TrackBuilder) -> Result<TrackHandle, AudioError> {
         let r = match self {
             Self::Memory(m) => m.add_sub_track(builder),
             #[cfg(feature = "sound-card")]
             Self::Card(m) => m.add_sub_track(builder),
         };
-        r.map_err(|e| ClientError::Audio(format!("no room for a track: {e}")))
+        r.map_err(|e| AudioError(format!("no room for a track: {e}")))
     }
 
     fn play_main(&mut self, sound: StaticSoundData) {
@@ -184,7 +191,7 @@ pub const CONTACT_OFFSET: Vec3 = Vec3::new(0.0, -0.3, -0.45);
 
 impl AudioEngine {
     /// Starts the engine.
-    pub fn new(settings: &AudioSettings) -> Result<Self, ClientError> {
+    pub fn new(settings: &AudioSettings) -> Result<Self, AudioError> {
         let spatializer = match settings.spatial {
             SpatialMode::Hrtf => {
                 let bytes = hrir::sphere_bytes(settings.sample_rate);
@@ -199,7 +206,7 @@ impl AudioEngine {
             SpatialMode::TimeLevel => Spatializer::TimeLevel,
         };
         let (mut manager, capture, pump) = Self::open(settings)?;
-        let voice = |manager: &mut Manager, at: Vec3| -> Result<Voice, ClientError> {
+        let voice = |manager: &mut Manager, at: Vec3| -> Result<Voice, AudioError> {
             let mut builder = TrackBuilder::new();
             let place = builder.add_effect(BinauralBuilder::new(spatializer.clone(), Placement { offset: at }));
             Ok(Voice { track: manager.add_sub_track(builder)?, place })
@@ -227,8 +234,8 @@ impl AudioEngine {
         })
     }
 
-    fn open(settings: &AudioSettings) -> Result<(Manager, Option<Capture>, Option<Pump>), ClientError> {
-        let memory = |pump: Option<Option<PathBuf>>| -> Result<(Manager, Option<Capture>, Option<Pump>), ClientError> {
+    fn open(settings: &AudioSettings) -> Result<(Manager, Option<Capture>, Option<Pump>), AudioError> {
+        let memory = |pump: Option<Option<PathBuf>>| -> Result<(Manager, Option<Capture>, Option<Pump>), AudioError> {
             let (backend_settings, capture) = CaptureSettings::new(settings.sample_rate);
             let manager = AudioManager::<CaptureBackend>::new(AudioManagerSettings {
                 backend_settings,
@@ -236,7 +243,7 @@ impl AudioEngine {
                 main_track_builder: Default::default(),
                 internal_buffer_size: 128,
             })
-            .map_err(|e| ClientError::Audio(format!("{e:?}")))?;
+            .map_err(|e| AudioError(format!("{e:?}")))?;
             let pump = pump.map(|wav| Pump::start(capture.clone(), wav));
             Ok((Manager::Memory(manager), Some(capture), pump))
         };
