@@ -86,8 +86,8 @@ impl Heist {
                     .map(|gd| format!("{}({:.1},{:.1} f{:.1} {:?})", gd.name, gd.position.x, gd.position.y, gd.facing, gd.alert))
                     .collect();
                 println!(
-                    "  t={:.1} vive=({:.1},{:.1}) {:?} seq={} intent={:?} carry={:?} | {}",
-                    g.elapsed_s, g.vive.position.x, g.vive.position.y, g.vive.stance, g.vive.last_input_seq, g.vive.intent, g.vive.carrying, guards.join(" ")
+                    "  t={:.1} vive=({:.1},{:.1}) {:?} seq={} queued={} carry={:?} | {}",
+                    g.elapsed_s, g.vive.position.x, g.vive.position.y, g.vive.stance, g.vive.last_input_seq, g.vive.inputs.len(), g.vive.carrying, guards.join(" ")
                 );
             }
             if !self.server.game().is_running() {

@@ -55,6 +55,9 @@ pub struct ServerOptions {
     pub echo_log: bool,
     /// Refused messages tolerated per client before disconnecting it (default 50).
     pub abuse_limit: u32,
+    /// The game address clients are told to use when it differs from the bound one (a relay, a NAT);
+    /// `None` advertises the bound address.
+    pub advertise: Option<SocketAddr>,
 }
 
 impl ServerOptions {
@@ -70,6 +73,7 @@ impl ServerOptions {
             clock: Clock::Stepped,
             echo_log: false,
             abuse_limit: 50,
+            advertise: None,
         }
     }
 }
@@ -111,7 +115,7 @@ pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
         let session: u64 = rand::random();
         let service = TokenService::spawn(
             options.token_bind,
-            TokenConfig { code: join_code.clone(), private_key, server_addr: addr, session, roles: roles.clone() },
+            TokenConfig { code: join_code.clone(), private_key, server_addr: options.advertise.unwrap_or(addr), session, roles: roles.clone() },
         )
         .with_context(|| format!("cannot bind the token endpoint on TCP {}", options.token_bind))?;
         (Auth::Secure { private_key, session }, Some(service))
@@ -134,7 +138,7 @@ pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
         .add_plugins(SessionPlugin)
         .add_plugins(ServerNetPlugin {
             socket: std::sync::Mutex::new(Some(socket)),
-            settings: NetSettings { auth, roles, abuse_limit: options.abuse_limit },
+            settings: NetSettings { auth, roles, abuse_limit: options.abuse_limit, advertise: options.advertise },
         });
     if options.clock == Clock::Stepped {
         app.finish();

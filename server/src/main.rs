@@ -144,6 +144,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 clock: Clock::RealTime,
                 echo_log: true,
                 abuse_limit: 50,
+                advertise: None,
             };
             let mut server = build_server(options)?;
             println!("hosting on {} (UDP game, TCP tokens)", server.addr);

@@ -13,16 +13,33 @@ impl Game {
     pub(super) fn apply_vive(&mut self, msg: &ViveMsg) -> Result<(), Refusal> {
         match *msg {
             ViveMsg::Move { seq, direction, gait, facing } => {
-                self.vive.intent = (direction, rules::gait_speed(gait));
-                self.vive.stance = match gait {
+                let newest = self.vive.inputs.back().map_or(self.vive.last_input_seq, |i| i.seq);
+                if seq <= newest {
+                    return Ok(()); // old or repeated: already applied or queued
+                }
+                let stance = match gait {
                     Gait::Run => Stance::Running,
                     Gait::Crouch => Stance::Crouching,
                     Gait::Walk => Stance::Standing,
                 };
-                self.vive.facing = facing;
-                self.vive.last_input_seq = self.vive.last_input_seq.max(seq);
+                if self.vive.inputs.len() >= super::MAX_QUEUED_INPUTS {
+                    self.vive.inputs.pop_front();
+                }
+                let speed = rules::gait_speed(gait);
+                self.vive.inputs.push_back(super::MoveInput { seq, direction, speed, stance, facing });
                 Ok(())
             }
+            _ if self.phase != Phase::Heist => self.apply_vive_action(msg),
+            _ => {
+                self.fast_forward_inputs(super::TICK_S);
+                self.apply_vive_action(msg)
+            }
+        }
+    }
+
+    fn apply_vive_action(&mut self, msg: &ViveMsg) -> Result<(), Refusal> {
+        match *msg {
+            ViveMsg::Move { .. } => Ok(()),
             ViveMsg::Break(case) => self.break_case(case),
             ViveMsg::PickUp(item) => self.pick_up(item),
             ViveMsg::Drop(item) => {

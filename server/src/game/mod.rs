@@ -57,10 +57,40 @@ pub struct Vive {
     pub carrying: Vec<ItemId>,
     /// Last applied input sequence number.
     pub last_input_seq: u32,
-    /// Current movement intent (direction with |d| <= 1, speed in m/s).
-    pub intent: (Vec2, f32),
+    /// Movement inputs received and not yet applied, oldest first: one moves the body for one tick.
+    pub inputs: std::collections::VecDeque<MoveInput>,
+    /// Ticks of movement the client may still catch up on (see [`MAX_MOVE_CREDIT`]); negative after a
+    /// fast-forward for an action, repaid by later ticks.
+    pub move_credit: i32,
     footstep_timer: f32,
 }
+
+/// One movement input: a tick's worth of walking.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MoveInput {
+    /// Its sequence number.
+    pub seq: u32,
+    /// Direction, |d| ≤ 1.
+    pub direction: Vec2,
+    /// Speed, m/s.
+    pub speed: f32,
+    /// Stance.
+    pub stance: Stance,
+    /// Facing yaw, radians.
+    pub facing: f32,
+}
+
+/// One server tick, seconds (what one movement input is worth).
+pub const TICK_S: f32 = (1.0 / heist_shared::protocol::TICK_HZ) as f32;
+
+/// Inputs that may wait; older ones are dropped beyond this (the client reconciles).
+pub const MAX_QUEUED_INPUTS: usize = 60;
+/// Ticks of movement a client can bank while its inputs are late (half a second), to catch up on later —
+/// so inputs bunched by jitter or a resend are all applied and the backlog drains, but a client sending
+/// faster than the tick rate gains no speed.
+pub const MAX_MOVE_CREDIT: i32 = 30;
+/// Inputs applied in one tick at most (catching up).
+pub const MAX_INPUTS_PER_TICK: usize = 4;
 
 /// A display case.
 #[derive(Clone, Debug)]
@@ -252,10 +282,16 @@ impl Game {
         }
     }
 
+    /// Applies one queued input per tick (more when catching up on banked credit): the server moves
+    /// the body exactly as the client predicted it, input by input, whatever the network did to their
+    /// timing. With no input waiting, the body stands.
     fn move_vive(&mut self, dt: f32) {
-        let (dir, speed) = self.vive.intent;
         let before = self.vive.position;
-        self.vive.position = rules::move_body(&self.walls, before, dir, speed, dt);
+        self.vive.move_credit = (self.vive.move_credit + 1).min(MAX_MOVE_CREDIT);
+        let mut applied = 0;
+        while applied < MAX_INPUTS_PER_TICK && self.vive.move_credit > 0 && self.apply_next_input(dt) {
+            applied += 1;
+        }
         self.vive.velocity = (self.vive.position - before) / dt.max(1e-6);
         if self.vive.stance == Stance::Running && self.vive.velocity.length() > 0.5 {
             self.vive.footstep_timer -= dt;
@@ -265,6 +301,23 @@ impl Game {
                 self.noise(NoiseKind::Footsteps, at, rules::RUN_LOUDNESS);
             }
         }
+    }
+
+    /// Moves the body by the oldest queued input; false when none waits.
+    fn apply_next_input(&mut self, dt: f32) -> bool {
+        let Some(input) = self.vive.inputs.pop_front() else { return false };
+        self.vive.position = rules::move_body(&self.walls, self.vive.position, input.direction, input.speed, dt);
+        self.vive.stance = input.stance;
+        self.vive.facing = input.facing;
+        self.vive.last_input_seq = input.seq;
+        self.vive.move_credit -= 1;
+        true
+    }
+
+    /// Applies every queued input now: an action arrived after them, so the player meant it from where
+    /// they lead.
+    pub(super) fn fast_forward_inputs(&mut self, dt: f32) {
+        while self.apply_next_input(dt) {}
     }
 
     fn step_guards(&mut self, dt: f32) {

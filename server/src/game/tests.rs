@@ -162,8 +162,8 @@ fn walking_into_a_guard_gets_vive_caught() {
     let guard_at = g.guards[0].position;
     g.vive.position = guard_at + Vec2::new(2.0, 0.0);
     let toward = (guard_at - g.vive.position).normalize();
-    vive(&mut g, ViveMsg::Move { seq: 1, direction: toward, gait: Default::default(), facing: 0.0 }).unwrap();
-    for _ in 0..600 {
+    for seq in 1..=600 {
+        vive(&mut g, ViveMsg::Move { seq, direction: toward, gait: Default::default(), facing: 0.0 }).unwrap();
         g.step(1.0 / 60.0);
         if g.phase != Phase::Heist {
             break;
@@ -182,3 +182,81 @@ fn the_same_seed_gives_the_same_session() {
     assert_ne!(reals(&a), reals(&started(10)), "another seed shuffles the copies");
 }
 
+
+fn walk(seq: u32, direction: Vec2) -> ViveMsg {
+    ViveMsg::Move { seq, direction, gait: Default::default(), facing: 0.0 }
+}
+
+/// Where the body would be after `n` ticks of walking east from `from` (open floor).
+fn east_of(from: Vec2, n: u32) -> Vec2 {
+    from + Vec2::X * heist_shared::rules::WALK_SPEED * TICK_S * n as f32
+}
+
+#[test]
+fn each_input_moves_the_body_one_tick_and_no_input_stands_still() {
+    let mut g = started(3);
+    let start = g.vive.position;
+    vive(&mut g, walk(1, Vec2::X)).unwrap();
+    g.step(TICK_S);
+    assert!(g.vive.position.distance(east_of(start, 1)) < 1e-5);
+    assert_eq!(g.vive.last_input_seq, 1);
+    // No new input: the body does not keep walking on an old one.
+    for _ in 0..10 {
+        g.step(TICK_S);
+    }
+    assert!(g.vive.position.distance(east_of(start, 1)) < 1e-5);
+    // A repeated or older input is ignored.
+    vive(&mut g, walk(1, Vec2::X)).unwrap();
+    g.step(TICK_S);
+    assert!(g.vive.position.distance(east_of(start, 1)) < 1e-5);
+}
+
+#[test]
+fn inputs_bunched_by_the_network_are_all_applied_in_order() {
+    let mut g = started(3);
+    let start = g.vive.position;
+    // Three ticks without input (a resend in flight), then six inputs at once.
+    for _ in 0..3 {
+        g.step(TICK_S);
+    }
+    for seq in 1..=6 {
+        vive(&mut g, walk(seq, Vec2::X)).unwrap();
+    }
+    for _ in 0..4 {
+        g.step(TICK_S);
+    }
+    assert_eq!(g.vive.last_input_seq, 6, "caught up on banked ticks");
+    assert!(g.vive.position.distance(east_of(start, 6)) < 1e-4, "exactly six ticks of walking");
+}
+
+#[test]
+fn sending_faster_than_the_tick_rate_gains_no_speed() {
+    let mut g = started(3);
+    let start = g.vive.position;
+    let mut seq = 0;
+    for _ in 0..60 {
+        for _ in 0..3 {
+            seq += 1;
+            vive(&mut g, walk(seq, Vec2::X)).unwrap();
+        }
+        g.step(TICK_S);
+    }
+    let walked = g.vive.position.distance(start);
+    let one_second = heist_shared::rules::WALK_SPEED;
+    assert!(walked <= one_second * (60.0 + MAX_MOVE_CREDIT as f32) / 60.0 + 1e-3, "walked {walked} m in a second");
+    assert!(g.vive.inputs.len() <= MAX_QUEUED_INPUTS);
+}
+
+#[test]
+fn an_action_applies_the_inputs_sent_before_it_first() {
+    let mut g = started(3);
+    let case = g.cases[0].position;
+    // Put the body 2 m from the case; two queued inputs bring it within reach.
+    let dir = Vec2::X;
+    g.vive.position = case - dir * (heist_shared::rules::REACH + 0.05);
+    for seq in 1..=10 {
+        vive(&mut g, walk(seq, dir)).unwrap();
+    }
+    assert_eq!(vive(&mut g, ViveMsg::Break(heist_shared::protocol::CaseId(0))), Ok(()), "in reach after the queued steps");
+    assert_eq!(g.vive.last_input_seq, 10);
+}

@@ -45,6 +45,8 @@ pub struct NetSettings {
     pub roles: RoleTable,
     /// Refused messages (leaking one per second) tolerated per client before it is disconnected for abuse.
     pub abuse_limit: u32,
+    /// The address put in tokens and checked in connection requests, when not the bound one.
+    pub advertise: Option<std::net::SocketAddr>,
 }
 
 /// The bound game socket, waiting for the transport to be created at start-up.
@@ -114,7 +116,7 @@ fn start_transport(
         // Room for a third client, so it can be told why it is refused.
         max_clients: 4,
         protocol_id: PROTOCOL_ID,
-        public_addresses: vec![addr],
+        public_addresses: vec![settings.advertise.unwrap_or(addr)],
         authentication,
     };
     match NetcodeServerTransport::new(config, socket) {
