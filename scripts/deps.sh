@@ -2,9 +2,11 @@
 # Installs the system packages the workspace needs to build and test (Debian/Ubuntu).
 # Safe to run repeatedly: it only calls apt-get when something is missing.
 set -euo pipefail
-# Phantom client: espeak-ng (speech), ALSA headers (sound card), X/Vulkan runtime + Xvfb (spectator window and its test).
+# Clients: espeak-ng (speech), ALSA headers (sound card), X/Vulkan runtime + Xvfb (windows and their tests),
+# the OpenXR loader (the Vive client probes it; its tests check the fallback without a runtime).
 packages=(pkg-config libudev-dev libfontconfig1-dev libfreetype-dev fonts-dejavu-core
-    espeak-ng libasound2-dev libxkbcommon-x11-0 libvulkan1 mesa-vulkan-drivers xvfb xauth)
+    espeak-ng libasound2-dev libxkbcommon-x11-0 libvulkan1 mesa-vulkan-drivers xvfb xauth
+    libopenxr-loader1 libopenxr-dev)
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

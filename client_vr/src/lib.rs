@@ -1,0 +1,25 @@
+//! The Vive client: join a heist as the sighted player, in a headset through OpenXR or on a desktop.
+//!
+//! The tree: [`client`] (the game logic every mode shares: session, prediction, interpolation, events),
+//! [`intent`] (game-level intents and what they are about), [`predict`] and [`interp`] (the body's
+//! prediction and reconciliation; smooth motion for the rest), the inputs — [`xr`] (headset and
+//! controllers, and the probe that decides whether XR can run), [`desktop`] (keyboard and mouse),
+//! [`bot`] (the Vive bot's brain) — and the presentation: [`world`] (the museum), [`hud`], [`sound`].
+//! [`cli`] assembles them into one app per mode (headless, desktop, XR).
+#![warn(missing_docs)]
+
+pub mod bot;
+pub mod cli;
+pub mod client;
+pub mod desktop;
+pub mod hud;
+pub mod intent;
+pub mod interp;
+pub mod predict;
+pub mod sound;
+pub mod space;
+pub mod world;
+pub mod xr;
+
+pub use client::{ViveClientPlugin, ViveSettings, ViveState};
+pub use intent::{Action, InputSource, Intent};

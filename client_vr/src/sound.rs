@@ -1,0 +1,97 @@
+//! Spatial sound for Vive (kira through `heist_audio`): footsteps, glass, thuds, barks and the alarm,
+//! placed around the listener at the predicted body, turned with the view.
+
+use bevy::prelude::*;
+use glam::Vec2;
+use heist_audio::{AudioEngine, AudioSettings};
+use heist_shared::protocol::{GameEvent, GuardAlert, GuardView, NoiseKind, Phase, Stance, ViveAvatar};
+
+use crate::client::{Happened, ViveState, ViveSystems};
+use crate::intent::Intent;
+use crate::space;
+
+/// Farthest a footstep is played from, metres.
+pub const STEP_RANGE_M: f32 = 20.0;
+/// Seconds between repeats of the alarm while it is raised.
+pub const ALARM_EVERY_S: f32 = 3.0;
+
+/// Starts the engine and adds the sound systems.
+pub fn add(app: &mut App, settings: &AudioSettings) -> Result<(), heist_audio::AudioError> {
+    let engine = AudioEngine::new(settings)?;
+    app.insert_non_send(engine).init_resource::<Steps>().add_systems(Update, play.in_set(ViveSystems::Present));
+    Ok(())
+}
+
+#[derive(Resource, Default)]
+struct Steps {
+    guards: Vec<(u16, Vec2)>,
+    own: Option<Vec2>,
+    alarm_s: f32,
+}
+
+#[allow(clippy::too_many_arguments)]
+fn play(
+    mut happened: MessageReader<Happened>,
+    mut audio: NonSendMut<AudioEngine>,
+    mut steps: ResMut<Steps>,
+    state: Res<ViveState>,
+    intent: Res<Intent>,
+    guards: Query<&GuardView>,
+    avatar: Query<&ViveAvatar>,
+    time: Res<Time>,
+) {
+    let Some(me) = state.body() else { return };
+    let ears = space::EYE_HEIGHT_M;
+    let at = |p: Vec2, h: f32| space::listener_offset(me, intent.facing, ears, p, h);
+    for Happened(e) in happened.read() {
+        match e {
+            GameEvent::Noise { kind: NoiseKind::Glass, position, .. } => audio.glass(at(*position, 1.2)),
+            GameEvent::Noise { kind: NoiseKind::Thud, position, .. } => audio.thud(at(*position, 0.0)),
+            GameEvent::Noise { kind: NoiseKind::Alarm, position, .. } => audio.alarm(at(*position, 2.8)),
+            GameEvent::GuardAlert { alert, position, .. } if matches!(alert, GuardAlert::Suspicious | GuardAlert::Chasing) => {
+                audio.play_at(heist_audio::synth::bark(*alert == GuardAlert::Chasing), at(*position, 1.7), "guard bark");
+            }
+            _ => {}
+        }
+    }
+    // A step every 0.7 m a guard walks, when near enough to hear.
+    for g in &guards {
+        let slot = match steps.guards.iter().position(|(id, _)| *id == g.id.0) {
+            Some(i) => i,
+            None => {
+                steps.guards.push((g.id.0, g.position));
+                steps.guards.len() - 1
+            }
+        };
+        let last = steps.guards[slot].1;
+        if g.position.distance(last) > 0.7 {
+            steps.guards[slot].1 = g.position;
+            if g.position.distance(me) < STEP_RANGE_M {
+                audio.footstep(at(g.position, 0.0), 0.6, "guard footstep");
+            }
+        }
+    }
+    // Vive's own steps, soft unless running.
+    if let Ok(v) = avatar.single() {
+        let last = *steps.own.get_or_insert(me);
+        if me.distance(last) > 0.7 {
+            steps.own = Some(me);
+            let loud = match v.stance {
+                Stance::Crouching => 0.08,
+                Stance::Running => 0.5,
+                Stance::Standing => 0.2,
+            };
+            audio.footstep(at(me, 0.0), loud, "own footstep");
+        }
+    }
+    // The alarm keeps ringing while raised.
+    if state.alarm > 0 && state.phase == Phase::Heist {
+        steps.alarm_s += time.delta_secs();
+        if steps.alarm_s > ALARM_EVERY_S
+            && let Some(level) = state.level.as_ref()
+        {
+            steps.alarm_s = 0.0;
+            audio.alarm(at(level.workbench, 2.8));
+        }
+    }
+}

@@ -1,0 +1,404 @@
+//! The museum Vive sees: built from the level file, with the replicated cases, items, guards and the
+//! Phantom's tool dressed as meshes and moved every frame.
+//!
+//! Rooms are floors and 3 m walls without ceilings (the sky shows above); display cases are pedestals
+//! with a glass box that shatters into falling shards; every copy of one artifact is drawn from the same
+//! [`ArtifactLook`](heist_shared::artifact::ArtifactLook) — the client cannot tell the real one; guards
+//! carry a lamp over the head in their alert colour; Phantom sits at the workbench with his tool.
+
+use bevy::prelude::*;
+use glam::{Vec2, Vec3};
+use heist_shared::artifact::ArtifactLook;
+use heist_shared::level::Level;
+use heist_shared::protocol::{CaseView, GuardAlert, GuardView, ItemKind, ItemPlace, ItemView, PhantomTool};
+
+use crate::client::{ViveState, ViveSystems};
+use crate::interp::{DELAY_S, Track};
+use crate::space::{self, BENCH_TOP_M};
+
+/// Height of the walls, metres.
+pub const WALL_HEIGHT_M: f32 = 3.0;
+/// Height of a case's pedestal top, metres.
+pub const PEDESTAL_M: f32 = 1.0;
+/// The sky's colour (the screenshot test looks for it).
+pub const SKY: Color = Color::srgb(0.45, 0.65, 0.92);
+/// The floor's colour.
+pub const FLOOR: Color = Color::srgb(0.55, 0.45, 0.35);
+
+/// Where carried items are held, world positions (the desktop camera's or the controllers').
+#[derive(Resource, Clone, Copy, Debug, Default)]
+pub struct Hands {
+    /// The main hand.
+    pub main: Vec3,
+    /// The other hand.
+    pub other: Vec3,
+}
+
+/// The world's systems (in `ViveSystems::Present`).
+#[derive(SystemSet, Debug, Clone, PartialEq, Eq, Hash)]
+pub struct WorldSystems;
+
+/// Builds and moves the museum.
+pub struct WorldPlugin;
+
+impl Plugin for WorldPlugin {
+    fn build(&self, app: &mut App) {
+        app.insert_resource(ClearColor(SKY))
+            .init_resource::<Hands>()
+            .insert_resource(GlobalAmbientLight { color: Color::WHITE, brightness: 1500.0, ..default() })
+            .add_systems(
+                Update,
+                (build_museum, dress_cases, dress_items, dress_guards, dress_tool, shatter, move_items, move_guards, move_tool, fall)
+                    .chain()
+                    .in_set(ViveSystems::Present)
+                    .in_set(WorldSystems),
+            );
+    }
+}
+
+#[derive(Component)]
+struct Museum;
+
+#[derive(Component)]
+struct Glass;
+
+#[derive(Component)]
+struct Shard {
+    velocity: Vec3,
+    spin: Vec3,
+}
+
+#[derive(Component)]
+struct AlertLamp;
+
+#[derive(Component)]
+struct Dressed;
+
+fn build_museum(
+    mut commands: Commands,
+    state: Res<ViveState>,
+    built: Query<(), With<Museum>>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    let Some(level) = state.level.as_ref() else { return };
+    if !built.is_empty() {
+        return;
+    }
+    spawn_museum(&mut commands, level, state.walls.as_ref(), &mut meshes, &mut materials);
+}
+
+fn spawn_museum(
+    commands: &mut Commands,
+    level: &Level,
+    walls: Option<&heist_shared::level::WallSet>,
+    meshes: &mut Assets<Mesh>,
+    materials: &mut Assets<StandardMaterial>,
+) {
+    let root = commands.spawn((Museum, Transform::default(), Visibility::default())).id();
+    let floor = materials.add(StandardMaterial { base_color: FLOOR, perceptual_roughness: 0.9, ..default() });
+    let wall = materials.add(StandardMaterial { base_color: Color::srgb(0.86, 0.84, 0.78), ..default() });
+    let door = materials.add(StandardMaterial { base_color: Color::srgb(0.45, 0.28, 0.15), ..default() });
+    let wood = materials.add(StandardMaterial { base_color: Color::srgb(0.5, 0.33, 0.2), ..default() });
+    let cloth = materials.add(StandardMaterial { base_color: Color::srgb(0.15, 0.15, 0.2), ..default() });
+    let exit = materials.add(StandardMaterial {
+        base_color: Color::srgb(0.1, 0.8, 0.3),
+        emissive: LinearRgba::rgb(0.0, 2.0, 0.5),
+        ..default()
+    });
+    commands.entity(root).with_children(|museum| {
+        for room in &level.rooms {
+            let size = room.max - room.min;
+            let centre = room.centre();
+            museum.spawn((
+                Mesh3d(meshes.add(Cuboid::new(size.x, 0.1, size.y))),
+                MeshMaterial3d(floor.clone()),
+                Transform::from_translation(space::world(centre, -0.05)),
+                Name::new(format!("floor {}", room.id)),
+            ));
+        }
+        if let Some(walls) = walls {
+            for (segments, material, height) in [(&walls.walls, &wall, WALL_HEIGHT_M), (&walls.closed_doors, &door, 2.2)] {
+                for s in segments {
+                    let d = s.b - s.a;
+                    let len = d.length();
+                    if len < 1e-3 {
+                        continue;
+                    }
+                    let mid = (s.a + s.b) * 0.5;
+                    museum.spawn((
+                        Mesh3d(meshes.add(Cuboid::new(len + 0.15, height, 0.15))),
+                        MeshMaterial3d(material.clone()),
+                        Transform::from_translation(space::world(mid, height * 0.5))
+                            .with_rotation(Quat::from_rotation_y(d.y.atan2(d.x))),
+                    ));
+                }
+            }
+        }
+        // The workbench, Phantom at it, and the exit marker.
+        museum.spawn((
+            Mesh3d(meshes.add(Cuboid::new(1.4, BENCH_TOP_M, 0.8))),
+            MeshMaterial3d(wood.clone()),
+            Transform::from_translation(space::world(level.workbench, BENCH_TOP_M * 0.5)),
+            Name::new("workbench"),
+        ));
+        let phantom_at = level.workbench + Vec2::new(0.0, 0.75);
+        museum.spawn((
+            Mesh3d(meshes.add(Capsule3d::new(0.25, 0.7))),
+            MeshMaterial3d(cloth.clone()),
+            Transform::from_translation(space::world(phantom_at, 0.75)),
+            Name::new("Phantom"),
+        ));
+        museum.spawn((
+            Mesh3d(meshes.add(Sphere::new(0.13))),
+            MeshMaterial3d(cloth.clone()),
+            Transform::from_translation(space::world(phantom_at, 1.45)),
+        ));
+        museum.spawn((
+            Mesh3d(meshes.add(Cylinder::new(0.5, 0.02))),
+            MeshMaterial3d(exit),
+            Transform::from_translation(space::world(level.exit, 0.01)),
+            Name::new("exit"),
+        ));
+    });
+    // Light from above, like a skylight.
+    commands.spawn((
+        DirectionalLight { illuminance: 7000.0, shadow_maps_enabled: false, ..default() },
+        Transform::from_xyz(-3.0, 10.0, 6.0).looking_at(Vec3::ZERO, Vec3::Y),
+        ChildOf(root),
+    ));
+}
+
+/// The mesh of an artifact's look: every copy of a kind gets the same one.
+pub fn look_mesh(look: &ArtifactLook) -> Mesh {
+    let [w, h, _] = look.size_m;
+    match look.style_id {
+        0 => Torus::new(w * 0.35, w * 0.5).into(),
+        1 => Capsule3d::new(w * 0.5, (h - w).max(0.01)).into(),
+        _ => Cuboid::new(w, h, w * 0.6).into(),
+    }
+}
+
+fn dress_cases(
+    mut commands: Commands,
+    cases: Query<(Entity, &CaseView), Without<Dressed>>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    for (e, case) in &cases {
+        let pedestal = materials.add(StandardMaterial { base_color: Color::srgb(0.92, 0.92, 0.9), ..default() });
+        let glass = materials.add(StandardMaterial {
+            base_color: Color::srgba(0.7, 0.9, 1.0, 0.25),
+            alpha_mode: AlphaMode::Blend,
+            perceptual_roughness: 0.05,
+            ..default()
+        });
+        commands
+            .entity(e)
+            .insert((Dressed, Transform::from_translation(space::world(case.position, 0.0)), Visibility::default()))
+            .with_children(|c| {
+                c.spawn((
+                    Mesh3d(meshes.add(Cuboid::new(0.6, PEDESTAL_M, 0.6))),
+                    MeshMaterial3d(pedestal),
+                    Transform::from_xyz(0.0, PEDESTAL_M * 0.5, 0.0),
+                ));
+                if !case.broken {
+                    c.spawn((
+                        Glass,
+                        Mesh3d(meshes.add(Cuboid::new(0.5, 0.45, 0.5))),
+                        MeshMaterial3d(glass),
+                        Transform::from_xyz(0.0, PEDESTAL_M + 0.225, 0.0),
+                    ));
+                }
+            });
+    }
+}
+
+/// A case turned broken: its glass becomes shards that fly and fall.
+fn shatter(
+    mut commands: Commands,
+    cases: Query<(&CaseView, &Children), Changed<CaseView>>,
+    glass: Query<(Entity, &GlobalTransform, &MeshMaterial3d<StandardMaterial>), With<Glass>>,
+    mut meshes: ResMut<Assets<Mesh>>,
+) {
+    for (case, children) in &cases {
+        if !case.broken {
+            continue;
+        }
+        for child in children.iter() {
+            let Ok((e, at, material)) = glass.get(child) else { continue };
+            let centre = at.translation();
+            commands.entity(e).despawn();
+            let shard = meshes.add(Cuboid::new(0.08, 0.005, 0.06));
+            for i in 0..24u32 {
+                // A fixed spray pattern: the look, not physics, is the point.
+                let a = i as f32 * 2.399_963;
+                let r = 0.5 + (i % 5) as f32 * 0.25;
+                let velocity = Vec3::new(a.cos() * r, 1.0 + (i % 3) as f32 * 0.6, a.sin() * r);
+                commands.spawn((
+                    Shard { velocity, spin: Vec3::new(3.0 + i as f32 * 0.3, 5.0, 2.0) },
+                    Mesh3d(shard.clone()),
+                    MeshMaterial3d(material.0.clone()),
+                    Transform::from_translation(centre + Vec3::new(a.cos(), 0.0, a.sin()) * 0.2),
+                ));
+            }
+        }
+    }
+}
+
+fn fall(mut shards: Query<(&mut Shard, &mut Transform)>, time: Res<Time>) {
+    let dt = time.delta_secs();
+    for (mut s, mut t) in &mut shards {
+        if t.translation.y <= 0.003 {
+            continue;
+        }
+        s.velocity.y -= 9.81 * dt;
+        t.translation += s.velocity * dt;
+        let spin = s.spin * dt;
+        t.rotate(Quat::from_euler(EulerRot::XYZ, spin.x, spin.y, spin.z));
+        if t.translation.y <= 0.003 {
+            t.translation.y = 0.003;
+            t.rotation = Quat::from_rotation_y(t.rotation.to_euler(EulerRot::YXZ).0);
+        }
+    }
+}
+
+fn dress_items(
+    mut commands: Commands,
+    items: Query<(Entity, &ItemView), Without<Dressed>>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    for (e, item) in &items {
+        let (mesh, colour) = match &item.kind {
+            ItemKind::Copy { look, .. } => {
+                let [r, g, b] = look.colour_srgb;
+                (look_mesh(look), Color::srgb_u8(r, g, b))
+            }
+            ItemKind::Prop => (Cuboid::new(0.15, 0.15, 0.15).into(), Color::srgb(0.35, 0.35, 0.38)),
+        };
+        commands.entity(e).insert((
+            Dressed,
+            Mesh3d(meshes.add(mesh)),
+            MeshMaterial3d(materials.add(StandardMaterial { base_color: colour, metallic: 0.3, ..default() })),
+            Transform::default(),
+            Visibility::Hidden,
+        ));
+    }
+}
+
+fn move_items(
+    mut items: Query<(&ItemView, &mut Transform, &mut Visibility), Without<CaseView>>,
+    cases: Query<&CaseView>,
+    state: Res<ViveState>,
+    hands: Res<Hands>,
+) {
+    let bench = state.level.as_ref().map_or(Vec2::ZERO, |l| l.workbench);
+    for (item, mut t, mut vis) in &mut items {
+        let at = match item.place {
+            ItemPlace::InCase(c) => cases.iter().find(|cv| cv.id == c).map(|cv| space::world(cv.position, PEDESTAL_M + 0.1)),
+            ItemPlace::Floor(p) => Some(space::world(p, 0.08)),
+            ItemPlace::Carried => {
+                let slot = state.carrying.iter().position(|i| *i == item.id).unwrap_or(0);
+                Some(if slot == 0 { hands.main } else { hands.other })
+            }
+            ItemPlace::Workbench => Some(space::world(bench, BENCH_TOP_M + 0.08)),
+            ItemPlace::Secured | ItemPlace::Discarded => None,
+        };
+        match at {
+            Some(p) => {
+                t.translation = p;
+                *vis = Visibility::Inherited;
+            }
+            None => *vis = Visibility::Hidden,
+        }
+    }
+}
+
+/// The colour of a guard's alert lamp.
+pub fn alert_colour(alert: GuardAlert) -> Color {
+    match alert {
+        GuardAlert::Patrolling => Color::srgb(0.2, 0.9, 0.3),
+        GuardAlert::Suspicious => Color::srgb(1.0, 0.85, 0.1),
+        GuardAlert::Investigating => Color::srgb(1.0, 0.5, 0.05),
+        GuardAlert::Chasing => Color::srgb(1.0, 0.1, 0.1),
+        GuardAlert::Returning => Color::srgb(0.3, 0.6, 1.0),
+    }
+}
+
+fn dress_guards(
+    mut commands: Commands,
+    guards: Query<(Entity, &GuardView), Without<Dressed>>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    for (e, g) in &guards {
+        let uniform = materials.add(StandardMaterial { base_color: Color::srgb(0.1, 0.12, 0.3), ..default() });
+        let skin = materials.add(StandardMaterial { base_color: Color::srgb(0.85, 0.7, 0.6), ..default() });
+        let colour = alert_colour(g.alert);
+        let lamp = materials.add(StandardMaterial { base_color: colour, emissive: colour.to_linear() * 4.0, ..default() });
+        commands
+            .entity(e)
+            .insert((Dressed, Transform::from_translation(space::world(g.position, 0.0)), Visibility::default()))
+            .with_children(|c| {
+                c.spawn((Mesh3d(meshes.add(Capsule3d::new(0.25, 0.9))), MeshMaterial3d(uniform), Transform::from_xyz(0.0, 0.7, 0.0)));
+                c.spawn((Mesh3d(meshes.add(Sphere::new(0.14))), MeshMaterial3d(skin.clone()), Transform::from_xyz(0.0, 1.5, 0.0)));
+                // The nose shows where the guard looks.
+                c.spawn((Mesh3d(meshes.add(Cuboid::new(0.06, 0.06, 0.12))), MeshMaterial3d(skin), Transform::from_xyz(0.0, 1.5, -0.16)));
+                c.spawn((AlertLamp, Mesh3d(meshes.add(Sphere::new(0.08))), MeshMaterial3d(lamp), Transform::from_xyz(0.0, 1.9, 0.0)));
+            });
+    }
+}
+
+fn move_guards(
+    mut guards: Query<(&GuardView, &Track, &mut Transform, &Children)>,
+    lamps: Query<&MeshMaterial3d<StandardMaterial>, With<AlertLamp>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+    time: Res<Time>,
+) {
+    let t = time.elapsed_secs_f64() - DELAY_S;
+    for (g, track, mut transform, children) in &mut guards {
+        if let Some((p, r)) = track.sample(t) {
+            transform.translation = p;
+            transform.rotation = r;
+        }
+        let c = alert_colour(g.alert);
+        for child in children.iter() {
+            if let Ok(m) = lamps.get(child)
+                && let Some(mut mat) = materials.get_mut(&m.0)
+                && mat.base_color != c
+            {
+                mat.base_color = c;
+                mat.emissive = c.to_linear() * 4.0;
+            }
+        }
+    }
+}
+
+fn dress_tool(
+    mut commands: Commands,
+    tool: Query<Entity, (With<PhantomTool>, Without<Dressed>)>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    for e in &tool {
+        let steel = materials.add(StandardMaterial { base_color: Color::srgb(0.8, 0.8, 0.85), metallic: 0.9, ..default() });
+        commands.entity(e).insert((
+            Dressed,
+            Mesh3d(meshes.add(Cylinder::new(0.006, 0.14))),
+            MeshMaterial3d(steel),
+            Transform::default(),
+            Visibility::default(),
+        ));
+    }
+}
+
+fn move_tool(mut tool: Query<(&Track, &mut Transform), With<PhantomTool>>, time: Res<Time>) {
+    let t = time.elapsed_secs_f64() - DELAY_S;
+    for (track, mut transform) in &mut tool {
+        if let Some((p, r)) = track.sample(t) {
+            transform.translation = p;
+            transform.rotation = r;
+        }
+    }
+}

@@ -1,0 +1,505 @@
+//! XR mode: the headset and its controllers through OpenXR (bevy_mod_openxr 0.6).
+//!
+//! [`probe`] decides at start-up whether XR can run at all (with one log line saying why not). In XR mode
+//! `bevy_mod_openxr` renders both eyes from cameras under its tracking root; this module binds one action
+//! set for the Vive wands, Oculus Touch and Index controllers and turns the hands into [`Intent`]s:
+//!
+//! - grip: pick up what the hand is at (the item nearest the hand within reach), hold to carry; release
+//!   over the workbench places a copy there, elsewhere it drops;
+//! - trigger: with an empty hand, break the case the hand points at; holding an item, throw it on release
+//!   — the landing point follows the hand's velocity (ballistic, capped at the throw range);
+//! - the off hand's stick (trackpad on a Vive): teleport by default — point, release, and the body walks
+//!   there under the server's authority while the view fades down; or smooth locomotion with a comfort
+//!   vignette (`--locomotion smooth`); clicking it toggles running;
+//! - the main hand's stick: snap turn (30°);
+//! - walking in the room moves the body too (the head pulls it); walls hold the view back;
+//! - crouching in the room crouches (standing mode); seated mode lifts the view to standing height;
+//! - holding both grips with empty hands for 1.5 s recentres.
+//!
+//! Controllers pulse on a grab and on breaking glass ([`Pulse`]).
+
+pub mod probe;
+
+use std::borrow::Cow;
+
+use bevy::math::Isometry3d;
+use bevy::prelude::*;
+use bevy_mod_openxr::action_binding::{OxrSendActionBindings, OxrSuggestActionBinding};
+use bevy_mod_openxr::action_set_attaching::OxrAttachActionSet;
+use bevy_mod_openxr::action_set_syncing::{OxrActionSetSyncSet, OxrSyncActionSet};
+use bevy_mod_openxr::helper_traits::{ToQuat, ToVec2, ToVec3};
+use bevy_mod_openxr::resources::{OxrInstance, OxrViews};
+use bevy_mod_openxr::session::OxrSession;
+use bevy_mod_openxr::{openxr_session_available, openxr_session_running};
+use bevy_mod_xr::session::{XrPreDestroySession, XrSessionCreated, XrTrackingRoot};
+use glam::{Vec2, Vec3};
+use heist_shared::protocol::{CaseView, Gait, ItemPlace, ItemView};
+use heist_shared::rules;
+use openxr::{Action, ActionSet, Haptic, Path, Posef, Vector2f};
+
+pub use probe::{XrProbe, probe, probe_from_env};
+
+use crate::client::{Pulse, ViveState};
+use crate::intent::{Action as Do, Aim, Intent, IntentSystems};
+use crate::space;
+use crate::world::Hands;
+
+/// How the sticks move the player.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum Locomotion {
+    /// Point and release; the view fades while the body walks there.
+    #[default]
+    Teleport,
+    /// Continuous movement with a comfort vignette.
+    Smooth,
+}
+
+/// Which hand is the main one.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum Handedness {
+    /// Right-handed.
+    #[default]
+    Right,
+    /// Left-handed.
+    Left,
+}
+
+/// XR comfort and play settings.
+#[derive(Resource, Clone, Copy, Debug, Default)]
+pub struct XrOptions {
+    /// Locomotion.
+    pub locomotion: Locomotion,
+    /// Seated play (no room crouch; view lifted to standing height).
+    pub seated: bool,
+    /// The main hand.
+    pub hand: Handedness,
+}
+
+/// Snap-turn angle, radians.
+pub const SNAP_TURN: f32 = std::f32::consts::PI / 6.0;
+/// Farthest teleport, metres.
+pub const TELEPORT_RANGE_M: f32 = 4.0;
+/// How far the head may lead the body before walls hold the view back, metres.
+pub const HEAD_LEASH_M: f32 = 0.6;
+/// Head height below which a standing player crouches, metres.
+pub const CROUCH_BELOW_M: f32 = 1.15;
+
+/// The action set and its actions.
+#[derive(Resource)]
+pub struct XrActions {
+    set: ActionSet,
+    hands: [Path; 2],
+    grip_pose: Action<Posef>,
+    aim_pose: Action<Posef>,
+    squeeze: Action<bool>,
+    trigger: Action<f32>,
+    stick: Action<Vector2f>,
+    stick_click: Action<bool>,
+    haptic: Action<Haptic>,
+}
+
+#[derive(Component)]
+struct Grip(usize);
+
+#[derive(Component)]
+struct Pointer(usize);
+
+#[derive(Component)]
+struct Head;
+
+/// The comfort sphere around the head: fades for teleports, darkens with smooth motion.
+#[derive(Component)]
+struct Comfort;
+
+/// What the hands are doing, frame to frame.
+#[derive(Resource, Default)]
+struct HandState {
+    squeezed: [bool; 2],
+    triggered: [bool; 2],
+    positions: [[Vec3; 6]; 2],
+    holding: [Option<heist_shared::protocol::ItemId>; 2],
+    stick_was: [Vec2; 2],
+    running: bool,
+    travel: Option<Vec2>,
+    recentre_s: f32,
+    recentred: bool,
+    last_body: Option<Vec2>,
+    locomoting: bool,
+    fade: f32,
+}
+
+/// Adds XR input to an app built with `bevy_mod_openxr::add_xr_plugins`.
+pub struct XrInputPlugin {
+    /// Settings.
+    pub options: XrOptions,
+}
+
+impl Plugin for XrInputPlugin {
+    fn build(&self, app: &mut App) {
+        app.insert_resource(self.options)
+            .init_resource::<HandState>()
+            .insert_resource(bevy::winit::WinitSettings::continuous())
+            .add_systems(Startup, create_actions.run_if(openxr_session_available))
+            .add_systems(OxrSendActionBindings, suggest_bindings)
+            .add_systems(XrSessionCreated, (attach_set, spawn_tracked))
+            .add_systems(XrPreDestroySession, despawn_tracked)
+            .add_systems(PreUpdate, sync_set.before(OxrActionSetSyncSet).run_if(openxr_session_running))
+            .add_systems(RunFixedMainLoop, (read_hands, comfort).chain().in_set(IntentSystems::Gather).run_if(openxr_session_running))
+            .add_systems(Update, pulse.in_set(crate::client::ViveSystems::Present).run_if(openxr_session_running));
+    }
+}
+
+fn create_actions(instance: Res<OxrInstance>, mut commands: Commands) {
+    let make = || -> openxr::Result<XrActions> {
+        let hands = [instance.string_to_path("/user/hand/left")?, instance.string_to_path("/user/hand/right")?];
+        let set = instance.create_action_set("heist", "Heist", 0)?;
+        Ok(XrActions {
+            grip_pose: set.create_action("grip_pose", "Grip pose", &hands)?,
+            aim_pose: set.create_action("aim_pose", "Aim pose", &hands)?,
+            squeeze: set.create_action("grab", "Grab and carry", &hands)?,
+            trigger: set.create_action("use", "Break, throw", &hands)?,
+            stick: set.create_action("move", "Teleport, turn", &hands)?,
+            stick_click: set.create_action("run", "Run", &hands)?,
+            haptic: set.create_action("pulse", "Pulse", &hands)?,
+            hands,
+            set,
+        })
+    };
+    match make() {
+        Ok(actions) => {
+            commands.insert_resource(actions);
+        }
+        Err(e) => error!("XR: the controller actions could not be created ({e}); controllers will do nothing"),
+    }
+}
+
+fn both(p: &str) -> Vec<Cow<'static, str>> {
+    vec![format!("/user/hand/left{p}").into(), format!("/user/hand/right{p}").into()]
+}
+
+fn suggest_bindings(actions: Option<Res<XrActions>>, mut out: MessageWriter<OxrSuggestActionBinding>) {
+    let Some(a) = actions else { return };
+    // (profile, squeeze, stick, stick click) — every path exists on both hands of its profile.
+    for (profile, squeeze, stick, click) in [
+        ("/interaction_profiles/htc/vive_controller", "/input/squeeze/click", "/input/trackpad", "/input/trackpad/click"),
+        ("/interaction_profiles/oculus/touch_controller", "/input/squeeze/value", "/input/thumbstick", "/input/thumbstick/click"),
+        ("/interaction_profiles/valve/index_controller", "/input/squeeze/value", "/input/thumbstick", "/input/thumbstick/click"),
+    ] {
+        let mut bind = |action: openxr::sys::Action, path: &str| {
+            out.write(OxrSuggestActionBinding { action, interaction_profile: profile.into(), bindings: both(path) });
+        };
+        bind(a.grip_pose.as_raw(), "/input/grip/pose");
+        bind(a.aim_pose.as_raw(), "/input/aim/pose");
+        bind(a.squeeze.as_raw(), squeeze);
+        bind(a.trigger.as_raw(), "/input/trigger/value");
+        bind(a.stick.as_raw(), stick);
+        bind(a.stick_click.as_raw(), click);
+        bind(a.haptic.as_raw(), "/output/haptic");
+    }
+}
+
+fn attach_set(actions: Option<Res<XrActions>>, mut out: MessageWriter<OxrAttachActionSet>) {
+    if let Some(a) = actions {
+        out.write(OxrAttachActionSet(a.set.clone()));
+    }
+}
+
+fn sync_set(actions: Option<Res<XrActions>>, mut out: MessageWriter<OxrSyncActionSet>) {
+    if let Some(a) = actions {
+        out.write(OxrSyncActionSet(a.set.clone()));
+    }
+}
+
+fn spawn_tracked(
+    actions: Option<Res<XrActions>>,
+    session: Option<Res<OxrSession>>,
+    mut commands: Commands,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    let (Some(a), Some(session)) = (actions, session) else { return };
+    let glove = materials.add(StandardMaterial { base_color: Color::srgb(0.2, 0.2, 0.22), ..default() });
+    let glove_mesh = meshes.add(Cuboid::new(0.08, 0.04, 0.14));
+    match session.create_reference_space(openxr::ReferenceSpaceType::VIEW, Isometry3d::IDENTITY) {
+        Ok(head) => {
+            let comfort = materials.add(StandardMaterial {
+                base_color: Color::srgba(0.0, 0.0, 0.0, 0.0),
+                alpha_mode: AlphaMode::Blend,
+                unlit: true,
+                cull_mode: None,
+                ..default()
+            });
+            let sphere = meshes.add(Sphere::new(0.3));
+            commands.spawn((head.0, Head)).with_children(|h| {
+                h.spawn((Comfort, Mesh3d(sphere), MeshMaterial3d(comfort), Transform::default()));
+            });
+        }
+        Err(e) => error!("XR: no head space ({e})"),
+    }
+    for (i, hand) in a.hands.into_iter().enumerate() {
+        match session.create_action_space(&a.grip_pose, hand, Isometry3d::IDENTITY) {
+            Ok(space) => {
+                commands.spawn((space, Grip(i), Mesh3d(glove_mesh.clone()), MeshMaterial3d(glove.clone())));
+            }
+            Err(e) => error!("XR: no grip space for hand {i} ({e})"),
+        }
+        match session.create_action_space(&a.aim_pose, hand, Isometry3d::IDENTITY) {
+            Ok(space) => {
+                commands.spawn((space, Pointer(i)));
+            }
+            Err(e) => error!("XR: no aim space for hand {i} ({e})"),
+        }
+    }
+}
+
+fn despawn_tracked(q: Query<Entity, Or<(With<Head>, With<Grip>, With<Pointer>)>>, mut commands: Commands) {
+    for e in &q {
+        commands.entity(e).despawn();
+    }
+}
+
+/// Where a throw from `hand` (world) at `velocity` (world, m/s) lands on the floor: ballistic flight,
+/// capped at the throw range.
+pub fn throw_landing(hand: Vec3, velocity: Vec3) -> Vec2 {
+    let g = 9.81;
+    let h = hand.y.max(0.0);
+    let vy = velocity.y;
+    let t = (vy + (vy * vy + 2.0 * g * h).sqrt()) / g;
+    let from = space::floor(hand);
+    let flight = space::floor(Vec3::new(velocity.x, 0.0, velocity.z)) * t;
+    from + flight.clamp_length_max(rules::THROW_RANGE)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn read_hands(
+    actions: Option<Res<XrActions>>,
+    session: Res<OxrSession>,
+    views: Res<OxrViews>,
+    options: Res<XrOptions>,
+    time: Res<Time>,
+    mut hs: ResMut<HandState>,
+    mut intent: ResMut<Intent>,
+    mut hands_out: ResMut<Hands>,
+    state: Res<ViveState>,
+    grips: Query<(&Grip, &GlobalTransform)>,
+    pointers: Query<(&Pointer, &GlobalTransform)>,
+    mut root: Query<&mut Transform, With<XrTrackingRoot>>,
+    cases: Query<&CaseView>,
+    items: Query<&ItemView>,
+) {
+    let (Some(a), Ok(mut root), Some(view), Some(body)) = (actions, root.single_mut(), views.first(), state.body()) else {
+        return;
+    };
+    let dt = time.delta_secs().max(1e-4);
+    let (main, off) = match options.hand {
+        Handedness::Right => (1, 0),
+        Handedness::Left => (0, 1),
+    };
+    let head_local = view.pose.position.to_vec3();
+    let head = root.transform_point(head_local);
+    let head_rot = root.rotation * view.pose.orientation.to_quat();
+    intent.facing = space::facing(head_rot);
+
+    // Keep the body under the head: on joining, recentre on the body.
+    if !hs.recentred {
+        recentre(&mut root, head_local, view.pose.orientation.to_quat(), body, intent.facing, options.seated);
+        hs.recentred = true;
+    }
+    // The body moved because of the sticks: carry the room along.
+    if let (Some(last), true) = (hs.last_body, hs.locomoting) {
+        let d = body - last;
+        root.translation += space::world(d, 0.0);
+    }
+    hs.last_body = Some(body);
+
+    let state_of = |hand: usize| {
+        let p = a.hands[hand];
+        (
+            a.squeeze.state(&session, p).map(|s| s.current_state).unwrap_or(false),
+            a.trigger.state(&session, p).map(|s| s.current_state).unwrap_or(0.0) > 0.6,
+            a.stick.state(&session, p).map(|s| s.current_state.to_vec2()).unwrap_or_default(),
+            a.stick_click.state(&session, p).is_ok_and(|s| s.current_state && s.changed_since_last_sync),
+        )
+    };
+    let mut hand_pos = [head; 2];
+    for (g, t) in &grips {
+        hand_pos[g.0.min(1)] = t.translation();
+    }
+    let mut pointing = [Vec2::new(intent.facing.cos(), intent.facing.sin()); 2];
+    for (p, t) in &pointers {
+        let f = space::floor(t.forward().as_vec3());
+        if f.length() > 0.1 {
+            pointing[p.0.min(1)] = f;
+        }
+    }
+    hands_out.main = hand_pos[main];
+    hands_out.other = hand_pos[off];
+    let case_refs: Vec<&CaseView> = cases.iter().collect();
+
+    for hand in 0..2 {
+        let (squeeze, trigger, stick, click) = state_of(hand);
+        let history = &mut hs.positions[hand];
+        history.rotate_left(1);
+        history[5] = hand_pos[hand];
+        let velocity = (history[5] - history[0]) / (5.0 * dt);
+        let aim = Aim { from: space::floor(hand_pos[hand]), towards: pointing[hand] };
+        if squeeze && !hs.squeezed[hand] && hs.holding[hand].is_none() {
+            if let Some(item) = aim.item(items.iter(), &case_refs) {
+                intent.actions.push(Do::PickUp(item));
+                hs.holding[hand] = Some(item);
+            }
+        }
+        if !squeeze && hs.squeezed[hand] && !hs.triggered[hand] {
+            if let Some(item) = hs.holding[hand].take() {
+                let bench = state.level.as_ref().map(|l| l.workbench);
+                let at_bench = bench.is_some_and(|b| b.distance(space::floor(hand_pos[hand])) < rules::REACH);
+                intent.actions.push(if at_bench { Do::Place(item) } else { Do::Drop(item) });
+            }
+        }
+        if trigger && !hs.triggered[hand] && hs.holding[hand].is_none() {
+            if let Some(case) = aim.case(&cases) {
+                intent.actions.push(Do::Break(case));
+            }
+        }
+        if !trigger && hs.triggered[hand] {
+            if let Some(item) = hs.holding[hand].take() {
+                intent.actions.push(Do::Throw { item, target: throw_landing(hand_pos[hand], velocity) });
+            }
+        }
+        hs.squeezed[hand] = squeeze;
+        hs.triggered[hand] = trigger;
+        if click && hand == off {
+            hs.running = !hs.running;
+        }
+        if hand == main {
+            let was = hs.stick_was[main];
+            if stick.x.abs() > 0.7 && was.x.abs() <= 0.7 {
+                let angle = -stick.x.signum() * SNAP_TURN;
+                root.rotate_around(head, Quat::from_rotation_y(angle));
+            }
+        }
+        // Let go of an item the server took away (delivered, secured).
+        if let Some(item) = hs.holding[hand]
+            && items.iter().any(|i| i.id == item && i.place != ItemPlace::Carried)
+            && !squeeze
+        {
+            hs.holding[hand] = None;
+        }
+        hs.stick_was[hand] = stick;
+    }
+
+    // Recentre: both grips held with empty hands.
+    if hs.squeezed == [true, true] && hs.holding == [None, None] {
+        hs.recentre_s += dt;
+        if hs.recentre_s > 1.5 {
+            recentre(&mut root, head_local, view.pose.orientation.to_quat(), body, intent.facing, options.seated);
+            hs.recentre_s = f32::NEG_INFINITY;
+        }
+    } else {
+        hs.recentre_s = 0.0;
+    }
+
+    // Locomotion.
+    let stick = hs.stick_was[off];
+    let yaw_dir = Vec2::new(intent.facing.cos(), intent.facing.sin());
+    let right = Vec2::new(intent.facing.sin(), -intent.facing.cos());
+    let crouching = !options.seated && head.y < CROUCH_BELOW_M;
+    let gait = if crouching {
+        Gait::Crouch
+    } else if hs.running {
+        Gait::Run
+    } else {
+        Gait::Walk
+    };
+    intent.gait = gait;
+    hs.locomoting = false;
+    match options.locomotion {
+        Locomotion::Smooth => {
+            hs.locomoting = stick.length() > 0.1;
+            intent.movement = (yaw_dir * stick.y + right * stick.x).clamp_length_max(1.0);
+            hs.fade = 0.45 * intent.movement.length();
+        }
+        Locomotion::Teleport => {
+            if stick.y > 0.6 {
+                // Aiming: the target is along the off hand's pointer, up to the range.
+                let target = space::floor(hand_pos[off]) + pointing[off].normalize_or_zero() * TELEPORT_RANGE_M * stick.y;
+                hs.travel = Some(target);
+                hs.fade = 0.0;
+            } else if let Some(target) = hs.travel {
+                let d = target - body;
+                if d.length() < 0.1 {
+                    hs.travel = None;
+                    hs.fade = 0.0;
+                } else {
+                    intent.movement = d.normalize();
+                    hs.fade = 0.85;
+                    hs.locomoting = true;
+                }
+            }
+        }
+    }
+    // Walking in the room pulls the body along; walls hold the head back.
+    let lead = space::floor(head) - body;
+    if intent.movement == Vec2::ZERO && lead.length() > 0.15 {
+        intent.movement = (lead / (rules::gait_speed(gait) * dt)).clamp_length_max(1.0);
+    }
+    if lead.length() > HEAD_LEASH_M {
+        let back = lead - lead.normalize() * HEAD_LEASH_M;
+        root.translation -= space::world(back, 0.0);
+    }
+}
+
+fn recentre(root: &mut Transform, head_local: Vec3, head_rot_local: Quat, body: Vec2, facing: f32, seated: bool) {
+    let (head_yaw, _, _) = head_rot_local.to_euler(EulerRot::YXZ);
+    let (want_yaw, _, _) = space::rotation(facing).to_euler(EulerRot::YXZ);
+    root.rotation = Quat::from_rotation_y(want_yaw - head_yaw);
+    let off = root.rotation * head_local;
+    let lift = if seated { space::EYE_HEIGHT_M - head_local.y } else { 0.0 };
+    let at = space::world(body, lift);
+    root.translation = Vec3::new(at.x - off.x, lift, at.z - off.z);
+}
+
+fn comfort(hs: Res<HandState>, q: Query<&MeshMaterial3d<StandardMaterial>, With<Comfort>>, mut materials: ResMut<Assets<StandardMaterial>>) {
+    for m in &q {
+        if let Some(mut mat) = materials.get_mut(&m.0) {
+            let alpha = hs.fade.clamp(0.0, 0.95);
+            if (mat.base_color.alpha() - alpha).abs() > 0.01 {
+                mat.base_color = Color::srgba(0.0, 0.0, 0.0, alpha);
+            }
+        }
+    }
+}
+
+fn pulse(actions: Option<Res<XrActions>>, session: Res<OxrSession>, options: Res<XrOptions>, mut pulses: MessageReader<Pulse>) {
+    let Some(a) = actions else { return };
+    let main = match options.hand {
+        Handedness::Right => a.hands[1],
+        Handedness::Left => a.hands[0],
+    };
+    for p in pulses.read() {
+        let v = openxr::HapticVibration::new()
+            .amplitude(p.amplitude.clamp(0.0, 1.0))
+            .frequency(openxr::FREQUENCY_UNSPECIFIED)
+            .duration(openxr::Duration::from_nanos((p.seconds * 1e9) as i64));
+        if let Err(e) = a.haptic.apply_feedback(&session, main, &v) {
+            warn!("XR: controller pulse failed ({e})");
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_throw_lands_along_the_hands_velocity_within_range() {
+        // From 1.2 m, thrown level at 4 m/s towards −z (north): about 2 m north.
+        let at = throw_landing(Vec3::new(0.0, 1.2, 0.0), Vec3::new(0.0, 0.0, -4.0));
+        assert!(at.x.abs() < 1e-5 && (at.y - 4.0 * (2.0 * 1.2 / 9.81f32).sqrt()).abs() < 1e-3, "{at}");
+        // A hard throw is capped at the range.
+        let far = throw_landing(Vec3::new(0.0, 1.5, 0.0), Vec3::new(30.0, 5.0, 0.0));
+        assert!((far.length() - rules::THROW_RANGE).abs() < 1e-3, "{far}");
+        // Dropped (no velocity): lands under the hand.
+        assert_eq!(throw_landing(Vec3::new(2.0, 1.0, -3.0), Vec3::ZERO), Vec2::new(2.0, 3.0));
+    }
+}

@@ -1,0 +1,72 @@
+//! End to end: the real server, this client in bot mode (`--headless --bot`: the Vive bot's brain
+//! driving intents, prediction and reconciliation) and a Phantom bot win a heist over loopback UDP.
+
+mod common;
+
+use common::{join_args, quantile, vive_client};
+use heist_bots::PhantomBotPlugin;
+use heist_server::{ServerOptions, build_server, demo};
+use heist_shared::protocol::{Phase, Role, TICK_HZ};
+use client_vr::{Action, ViveState};
+use client_vr::client::PulseReason;
+
+#[test]
+fn the_vive_client_in_bot_mode_and_a_phantom_bot_win_a_heist() {
+    let seed = 10;
+    let mut server = build_server(ServerOptions::local_test(seed)).expect("server starts");
+    let args = join_args(&["--headless", "--bot"]);
+    let mut vive = vive_client(&server, &args, |_| {});
+    let mut phantom = demo::join(&server, Role::Phantom, |app| {
+        app.add_plugins(PhantomBotPlugin::default());
+    })
+    .expect("Phantom bot joins");
+    let limit = server.game().level.time_limit_s;
+    let max_ticks = ((f64::from(limit) + 40.0) * TICK_HZ) as u64;
+    let mut ticks = 0;
+    while ticks < max_ticks {
+        server.app.update();
+        vive.update();
+        phantom.update();
+        ticks += 1;
+        if !server.game().is_running() && server.game().phase != Phase::Lobby {
+            for _ in 0..10 {
+                server.app.update();
+                vive.update();
+                phantom.update();
+            }
+            break;
+        }
+    }
+    let game = server.game();
+    let state = vive.world().resource::<ViveState>();
+    let predictor = state.predictor.as_ref().expect("the client predicted");
+    let errors: Vec<f32> = predictor.errors.iter().copied().collect();
+    let sent = vive.world().resource::<client_vr::intent::Sent>();
+    println!(
+        "seed {seed}: {:?} after {:.1} s of game time; {} moves sent, actions {:?}",
+        game.phase,
+        game.elapsed_s,
+        sent.seq,
+        sent.actions
+    );
+    println!(
+        "reconciliations {}, prediction error at ack over the last {}: p50 {:.4} m, p99 {:.4} m, max {:.4} m; pulses {:?}",
+        state.reconciliations,
+        errors.len(),
+        quantile(&errors, 0.5),
+        quantile(&errors, 0.99),
+        errors.iter().copied().fold(0.0, f32::max),
+        state.pulses
+    );
+    for line in server.log().iter().rev().take(8).rev() {
+        println!("  server: {line}");
+    }
+    assert_eq!(game.phase, Phase::Won, "the heist was won");
+    assert_eq!(state.phase, Phase::Won, "the client saw the win");
+    assert!(sent.actions.iter().any(|a| matches!(a, Action::Place(_))), "copies went to the workbench through intents");
+    assert!(sent.actions.iter().any(|a| matches!(a, Action::Break(_))), "cases were broken through intents");
+    assert!(state.reconciliations > 1000, "the server's state reconciled the prediction");
+    assert!(state.pulses.contains(&PulseReason::Grab), "a grab pulses the controller");
+    assert!(state.pulses.contains(&PulseReason::Glass), "breaking glass pulses the controller");
+    assert!(!errors.is_empty() && quantile(&errors, 0.99) < 0.05, "prediction agreed with the server on loopback");
+}
