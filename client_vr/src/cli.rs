@@ -236,7 +236,10 @@ pub fn app(args: &JoinArgs, mode: &Mode) -> anyhow::Result<App> {
     }
     match mode {
         Mode::Desktop => {
-            app.add_plugins(crate::desktop::DesktopPlugin);
+            app.add_plugins(crate::desktop::DesktopPlugin { input: !args.bot });
+        }
+        Mode::Xr if args.bot => {
+            warn!("--bot in XR: the bot plays; the headset shows the museum from the room's origin");
         }
         Mode::Xr => {
             let options = XrOptions { locomotion: args.locomotion, seated: args.seated, hand: args.hand };

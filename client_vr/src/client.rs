@@ -255,7 +255,10 @@ fn events(
             GameEvent::Verdict { outcome, .. } => Some(format!("Phantom's verdict: {outcome:?}")),
             GameEvent::Alarm(n) => Some(format!("ALARM level {n}")),
             GameEvent::Warning(w) => Some(format!("Phantom warns: {w:?}")),
-            GameEvent::GuardAlert { guard, alert, .. } => Some(format!("Guard {} is {alert:?}", guard.0)),
+            GameEvent::GuardAlert { guard, alert, .. } => {
+                let name = state.level.as_ref().and_then(|l| l.guards.get(usize::from(guard.0))).map(|g| g.name.clone());
+                Some(format!("{} is {}", name.unwrap_or_else(|| format!("Guard {}", guard.0)), format!("{alert:?}").to_lowercase()))
+            }
             GameEvent::Noise { .. } | GameEvent::PhaseChanged(_) => None,
         };
         if let GameEvent::Noise { kind: heist_shared::protocol::NoiseKind::Glass, position, .. } = &e

@@ -36,15 +36,20 @@ impl Default for Look {
     }
 }
 
-/// Keyboard, mouse and the first-person camera.
-pub struct DesktopPlugin;
+/// The first-person camera, and keyboard and mouse when they drive the player.
+pub struct DesktopPlugin {
+    /// Keyboard and mouse write the intents (off when the bot plays and the window only watches).
+    pub input: bool,
+}
 
 impl Plugin for DesktopPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<Look>()
             .add_systems(Startup, spawn_camera)
-            .add_systems(RunFixedMainLoop, (capture_cursor, look, keys).chain().in_set(IntentSystems::Gather))
             .add_systems(Update, follow_body.in_set(ViveSystems::Present).before(crate::world::WorldSystems));
+        if self.input {
+            app.add_systems(RunFixedMainLoop, (capture_cursor, look, keys).chain().in_set(IntentSystems::Gather));
+        }
     }
 }
 

@@ -44,6 +44,16 @@ impl Track {
         self.snapshots.push_back(s);
     }
 
+    /// Snapshots kept.
+    pub fn len(&self) -> usize {
+        self.snapshots.len()
+    }
+
+    /// Whether no snapshot has arrived.
+    pub fn is_empty(&self) -> bool {
+        self.snapshots.is_empty()
+    }
+
     /// The newest snapshot.
     pub fn latest(&self) -> Option<&Snapshot> {
         self.snapshots.back()

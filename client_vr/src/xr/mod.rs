@@ -107,9 +107,18 @@ struct Pointer(usize);
 #[derive(Component)]
 struct Head;
 
-/// The comfort sphere around the head: fades for teleports, darkens with smooth motion.
+/// The fade sphere around the head (teleports).
 #[derive(Component)]
 struct Comfort;
+
+/// The comfort vignette: a black ring just ahead of the eyes whose opening narrows with smooth motion.
+#[derive(Component)]
+struct Vignette;
+
+/// The vignette ring's opening at rest and at full speed, metres at [`VIGNETTE_DISTANCE_M`].
+pub const VIGNETTE_OPEN_M: (f32, f32) = (0.25, 0.07);
+/// How far ahead of the eyes the ring sits, metres.
+pub const VIGNETTE_DISTANCE_M: f32 = 0.15;
 
 /// What the hands are doing, frame to frame.
 #[derive(Resource, Default)]
@@ -126,6 +135,7 @@ struct HandState {
     last_body: Option<Vec2>,
     locomoting: bool,
     fade: f32,
+    vignette: f32,
 }
 
 /// Adds XR input to an app built with `bevy_mod_openxr::add_xr_plugins`.
@@ -230,8 +240,23 @@ fn spawn_tracked(
                 ..default()
             });
             let sphere = meshes.add(Sphere::new(0.3));
+            let ring = meshes.add(Annulus::new(0.5, 5.0));
+            let black = materials.add(StandardMaterial {
+                base_color: Color::srgba(0.0, 0.0, 0.0, 0.92),
+                alpha_mode: AlphaMode::Blend,
+                unlit: true,
+                cull_mode: None,
+                ..default()
+            });
             commands.spawn((head.0, Head)).with_children(|h| {
                 h.spawn((Comfort, Mesh3d(sphere), MeshMaterial3d(comfort), Transform::default()));
+                h.spawn((
+                    Vignette,
+                    Mesh3d(ring),
+                    MeshMaterial3d(black),
+                    Transform::from_xyz(0.0, 0.0, -VIGNETTE_DISTANCE_M).with_scale(Vec3::splat(VIGNETTE_OPEN_M.0 / 0.5)),
+                    Visibility::Hidden,
+                ));
             });
         }
         Err(e) => error!("XR: no head space ({e})"),
@@ -417,7 +442,7 @@ fn read_hands(
         Locomotion::Smooth => {
             hs.locomoting = stick.length() > 0.1;
             intent.movement = (yaw_dir * stick.y + right * stick.x).clamp_length_max(1.0);
-            hs.fade = 0.45 * intent.movement.length();
+            hs.vignette = intent.movement.length();
         }
         Locomotion::Teleport => {
             if stick.y > 0.6 {
@@ -459,7 +484,22 @@ fn recentre(root: &mut Transform, head_local: Vec3, head_rot_local: Quat, body: 
     root.translation = Vec3::new(at.x - off.x, lift, at.z - off.z);
 }
 
-fn comfort(hs: Res<HandState>, q: Query<&MeshMaterial3d<StandardMaterial>, With<Comfort>>, mut materials: ResMut<Assets<StandardMaterial>>) {
+/// The opening of the vignette ring for smooth motion at `strength` (0 at rest, 1 at full speed), metres.
+pub fn vignette_opening(strength: f32) -> f32 {
+    let (rest, full) = VIGNETTE_OPEN_M;
+    rest + (full - rest) * strength.clamp(0.0, 1.0)
+}
+
+fn comfort(
+    hs: Res<HandState>,
+    q: Query<&MeshMaterial3d<StandardMaterial>, With<Comfort>>,
+    mut ring: Query<(&mut Transform, &mut Visibility), With<Vignette>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    for (mut t, mut vis) in &mut ring {
+        t.scale = Vec3::splat(vignette_opening(hs.vignette) / 0.5);
+        *vis = if hs.vignette > 0.05 { Visibility::Inherited } else { Visibility::Hidden };
+    }
     for m in &q {
         if let Some(mut mat) = materials.get_mut(&m.0) {
             let alpha = hs.fade.clamp(0.0, 0.95);
@@ -490,6 +530,14 @@ fn pulse(actions: Option<Res<XrActions>>, session: Res<OxrSession>, options: Res
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_vignette_narrows_with_speed() {
+        assert_eq!(vignette_opening(0.0), VIGNETTE_OPEN_M.0);
+        assert!((vignette_opening(1.0) - VIGNETTE_OPEN_M.1).abs() < 1e-6);
+        assert!(vignette_opening(0.5) < VIGNETTE_OPEN_M.0 && vignette_opening(0.5) > VIGNETTE_OPEN_M.1);
+        assert!((vignette_opening(3.0) - VIGNETTE_OPEN_M.1).abs() < 1e-6, "clamped");
+    }
 
     #[test]
     fn a_throw_lands_along_the_hands_velocity_within_range() {
