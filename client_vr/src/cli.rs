@@ -232,7 +232,7 @@ pub fn app(args: &JoinArgs, mode: &Mode) -> anyhow::Result<App> {
     }
     app.add_plugins(ClientNetPlugin).add_plugins(ViveClientPlugin { settings });
     if *mode != Mode::Headless {
-        app.add_plugins((crate::world::WorldPlugin, crate::hud::HudPlugin));
+        app.add_plugins((crate::world::WorldPlugin, crate::hud::HudPlugin { wrist: *mode == Mode::Xr }));
     }
     match mode {
         Mode::Desktop => {
@@ -342,7 +342,7 @@ mod tests {
 
     #[test]
     fn a_bad_window_size_is_a_clear_usage_error() {
-        let err = Cli::try_parse_from(["client_vr", "join", "127.0.0.1:1", "--code", "A", "--size", "big"]).unwrap_err().to_string();
+        let err = Cli::try_parse_from(["client_vr", "join", "127.0.0.1:1", "--code", "A", "--size", "big"]).expect_err("a usage error").to_string();
         assert!(err.contains("expected WIDTHxHEIGHT"), "{err}");
         assert_eq!(parse_size("640x480"), Ok((640, 480)));
         assert!(parse_size("0x480").is_err());

@@ -133,7 +133,7 @@ fn keys(
     let aim = Aim { from: body, towards: Vec2::new(intent.facing.cos(), intent.facing.sin()) };
     let case_refs: Vec<&CaseView> = cases.iter().collect();
     if keys.just_pressed(KeyCode::KeyE)
-        && let Some(case) = aim.case(&cases)
+        && let Some(case) = aim.case(cases)
     {
         intent.actions.push(Action::Break(case));
     }

@@ -1,6 +1,10 @@
-//! The HUD: time left, alarm level, targets, what is carried, and the latest messages.
+//! The HUD: time left, alarm level, targets, what is carried, and the latest messages — over the desktop
+//! window, or in XR on a panel strapped to the off hand's wrist (the UI is drawn into an image that the
+//! panel shows; look at your wrist to read it).
 
+use bevy::camera::RenderTarget;
 use bevy::prelude::*;
+use bevy::render::render_resource::TextureFormat;
 use heist_shared::protocol::{ItemKind, ItemView, Phase, SessionView};
 
 use crate::client::{ViveState, ViveSystems};
@@ -14,32 +18,73 @@ struct Status;
 #[derive(Component)]
 struct Feed;
 
-/// The HUD overlay (desktop window; in XR it shows on the desktop mirror).
-pub struct HudPlugin;
+/// The wrist panel's picture, in pixels.
+pub const WRIST_PX: (u32, u32) = (640, 320);
+
+/// The image the wrist HUD is drawn into (XR mode).
+#[derive(Resource, Clone)]
+pub struct WristHud {
+    /// The image.
+    pub image: Handle<Image>,
+}
+
+/// The HUD.
+pub struct HudPlugin {
+    /// Draw into [`WristHud`] for a wrist panel instead of over the window.
+    pub wrist: bool,
+}
 
 impl Plugin for HudPlugin {
     fn build(&self, app: &mut App) {
-        app.add_systems(Startup, spawn).add_systems(Update, update.in_set(ViveSystems::Present));
+        if self.wrist {
+            app.add_systems(Startup, spawn_wrist);
+        } else {
+            app.add_systems(Startup, spawn_window);
+        }
+        app.add_systems(Update, update.in_set(ViveSystems::Present));
     }
 }
 
-fn spawn(mut commands: Commands) {
-    let font = TextFont { font_size: FontSize::Px(18.0), ..default() };
-    commands.spawn((
+fn spawn_window(mut commands: Commands) {
+    spawn(&mut commands, None);
+}
+
+fn spawn_wrist(mut commands: Commands, mut images: ResMut<Assets<Image>>) {
+    let image = Image::new_target_texture(WRIST_PX.0, WRIST_PX.1, TextureFormat::Rgba8UnormSrgb, None);
+    let image = images.add(image);
+    let camera = commands
+        .spawn((
+            Camera2d,
+            Camera { order: -1, clear_color: ClearColorConfig::Custom(Color::srgba(0.02, 0.02, 0.05, 0.85)), ..default() },
+            RenderTarget::Image(image.clone().into()),
+        ))
+        .id();
+    commands.insert_resource(WristHud { image });
+    spawn(&mut commands, Some(camera));
+}
+
+fn spawn(commands: &mut Commands, target: Option<Entity>) {
+    let font = TextFont { font_size: FontSize::Px(if target.is_some() { 26.0 } else { 18.0 }), ..default() };
+    let status = commands.spawn((
         Status,
         Text::new("Joining..."),
         font.clone(),
         TextColor(Color::WHITE),
         Node { position_type: PositionType::Absolute, top: Val::Px(8.0), left: Val::Px(10.0), ..default() },
-    ));
-    commands.spawn((
+    )).id();
+    let feed = commands.spawn((
         Feed,
         Text::new(""),
         font,
         TextColor(Color::srgb(1.0, 0.95, 0.7)),
         Node { position_type: PositionType::Absolute, bottom: Val::Px(8.0), left: Val::Px(10.0), ..default() },
-    ));
-    // The crosshair.
+    )).id();
+    if let Some(camera) = target {
+        commands.entity(status).insert(UiTargetCamera(camera));
+        commands.entity(feed).insert(UiTargetCamera(camera));
+        return;
+    }
+    // The crosshair (desktop).
     commands.spawn((
         Text::new("+"),
         TextFont { font_size: FontSize::Px(22.0), ..default() },
@@ -111,8 +156,7 @@ mod tests {
 
     #[test]
     fn the_status_shows_time_alarm_targets_and_what_is_carried() {
-        let mut state = ViveState::default();
-        state.carrying = vec![ItemId(4)];
+        let state = ViveState { carrying: vec![ItemId(4)], ..Default::default() };
         let session = SessionView {
             phase: Phase::Heist,
             time_left_s: 125.0,

@@ -90,9 +90,9 @@ mod tests {
         track.push(at(1.0, 0.0));
         track.push(at(1.1, 1.0));
         track.push(at(1.3, 3.0));
-        let (p, _) = track.sample(1.05).unwrap();
+        let (p, _) = track.sample(1.05).expect("a pose");
         assert!((p.x - 0.5).abs() < 1e-5);
-        let (p, r) = track.sample(1.2).unwrap();
+        let (p, r) = track.sample(1.2).expect("a pose");
         assert!((p.x - 2.0).abs() < 1e-5);
         assert!(r.angle_between(Quat::from_rotation_y(2.0)) < 1e-3);
     }
@@ -103,8 +103,8 @@ mod tests {
         assert!(track.sample(0.0).is_none());
         track.push(at(1.0, 0.0));
         track.push(at(2.0, 1.0));
-        assert_eq!(track.sample(0.5).unwrap().0.x, 0.0);
-        assert_eq!(track.sample(9.0).unwrap().0.x, 1.0);
+        assert_eq!(track.sample(0.5).expect("a pose").0.x, 0.0);
+        assert_eq!(track.sample(9.0).expect("a pose").0.x, 1.0);
     }
 
     #[test]
@@ -112,7 +112,7 @@ mod tests {
         let mut track = Track::default();
         track.push(at(2.0, 2.0));
         track.push(at(1.0, 1.0));
-        assert_eq!(track.latest().unwrap().t, 2.0);
+        assert_eq!(track.latest().expect("a snapshot").t, 2.0);
         for i in 0..100 {
             track.push(at(3.0 + f64::from(i), 0.0));
         }
@@ -127,10 +127,10 @@ mod tests {
         for &t in &arrivals {
             track.push(at(t, t as f32 * 1.6));
         }
-        let mut last = track.sample(0.1).unwrap().0.x;
+        let mut last = track.sample(0.1).expect("a pose").0.x;
         for i in 1..=10 {
             let t = 0.1 + f64::from(i) * 0.02;
-            let x = track.sample(t).unwrap().0.x;
+            let x = track.sample(t).expect("a pose").0.x;
             let v = (x - last) / 0.02;
             assert!((v - 1.6).abs() < 0.05, "speed {v} at {t}");
             last = x;

@@ -181,8 +181,8 @@ mod tests {
             server = rules::move_body(&walls, server, dir, rules::WALK_SPEED, dt);
             in_flight.push_back((tick + delay, server, tick + 1));
             while in_flight.front().is_some_and(|m| m.0 <= tick) {
-                let (_, pos, ack) = in_flight.pop_front().unwrap();
-                let e = client.reconcile(pos, ack).unwrap();
+                let (_, pos, ack) = in_flight.pop_front().expect("a state is due");
+                let e = client.reconcile(pos, ack).expect("the input was pending");
                 assert!(e < 1e-5, "error {e} at tick {tick}");
             }
             assert!(client.pending() <= delay as usize + 1);
@@ -199,7 +199,7 @@ mod tests {
             client.apply(seq, Vec2::X, rules::WALK_SPEED, dt);
         }
         // The server says the body stood still until input 5 (say, its first inputs were lost).
-        let e = client.reconcile(spawn, 5).unwrap();
+        let e = client.reconcile(spawn, 5).expect("input 5 was pending");
         assert!((e - 5.0 * rules::WALK_SPEED * dt).abs() < 1e-4);
         let expected = spawn + Vec2::X * 5.0 * rules::WALK_SPEED * dt;
         assert!(client.position().distance(expected) < 1e-4, "replayed inputs 6..=10");

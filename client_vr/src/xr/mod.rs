@@ -107,6 +107,14 @@ struct Pointer(usize);
 #[derive(Component)]
 struct Head;
 
+/// The desktop window's view of what the headset sees (a mirror for onlookers).
+#[derive(Component)]
+struct Mirror;
+
+/// The wrist panel showing the HUD.
+#[derive(Component)]
+struct WristPanel;
+
 /// The fade sphere around the head (teleports).
 #[derive(Component)]
 struct Comfort;
@@ -155,7 +163,11 @@ impl Plugin for XrInputPlugin {
             .add_systems(XrPreDestroySession, despawn_tracked)
             .add_systems(PreUpdate, sync_set.before(OxrActionSetSyncSet).run_if(openxr_session_running))
             .add_systems(RunFixedMainLoop, (read_hands, comfort).chain().in_set(IntentSystems::Gather).run_if(openxr_session_running))
-            .add_systems(Update, pulse.in_set(crate::client::ViveSystems::Present).run_if(openxr_session_running));
+            .add_systems(Startup, spawn_mirror)
+            .add_systems(
+                Update,
+                (pulse, strap_wrist_panel, follow_head).in_set(crate::client::ViveSystems::Present).run_if(openxr_session_running),
+            );
     }
 }
 
@@ -277,6 +289,57 @@ fn spawn_tracked(
     }
 }
 
+fn spawn_mirror(mut commands: Commands) {
+    commands.spawn((Mirror, Camera3d::default(), IsDefaultUiCamera, Transform::from_xyz(0.0, space::EYE_HEIGHT_M, 0.0)));
+}
+
+fn follow_head(head: Query<&GlobalTransform, With<Head>>, mut mirror: Query<&mut Transform, With<Mirror>>) {
+    if let (Ok(head), Ok(mut m)) = (head.single(), mirror.single_mut()) {
+        let (_, rotation, translation) = head.to_scale_rotation_translation();
+        m.translation = translation;
+        m.rotation = rotation;
+    }
+}
+
+/// Straps the HUD panel to the off hand's wrist once that hand's grip is tracked.
+fn strap_wrist_panel(
+    mut commands: Commands,
+    grips: Query<(Entity, &Grip)>,
+    panels: Query<(), With<WristPanel>>,
+    hud: Option<Res<crate::hud::WristHud>>,
+    options: Res<XrOptions>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    let Some(hud) = hud else { return };
+    if !panels.is_empty() {
+        return;
+    }
+    let off = match options.hand {
+        Handedness::Right => 0,
+        Handedness::Left => 1,
+    };
+    let Some((grip, _)) = grips.iter().find(|(_, g)| g.0 == off) else { return };
+    let material = materials.add(StandardMaterial {
+        base_color_texture: Some(hud.image.clone()),
+        unlit: true,
+        alpha_mode: AlphaMode::Blend,
+        cull_mode: None,
+        ..default()
+    });
+    let (w, h) = crate::hud::WRIST_PX;
+    let panel = commands
+        .spawn((
+            WristPanel,
+            Mesh3d(meshes.add(Rectangle::new(0.16, 0.16 * h as f32 / w as f32))),
+            MeshMaterial3d(material),
+            // On the inside of the forearm, tilted towards the eyes.
+            Transform::from_xyz(0.0, 0.03, 0.12).with_rotation(Quat::from_rotation_x(-1.0)),
+        ))
+        .id();
+    commands.entity(grip).add_child(panel);
+}
+
 fn despawn_tracked(q: Query<Entity, Or<(With<Head>, With<Grip>, With<Pointer>)>>, mut commands: Commands) {
     for e in &q {
         commands.entity(e).despawn();
@@ -368,29 +431,25 @@ fn read_hands(
         history[5] = hand_pos[hand];
         let velocity = (history[5] - history[0]) / (5.0 * dt);
         let aim = Aim { from: space::floor(hand_pos[hand]), towards: pointing[hand] };
-        if squeeze && !hs.squeezed[hand] && hs.holding[hand].is_none() {
-            if let Some(item) = aim.item(items.iter(), &case_refs) {
+        if squeeze && !hs.squeezed[hand] && hs.holding[hand].is_none()
+            && let Some(item) = aim.item(items.iter(), &case_refs) {
                 intent.actions.push(Do::PickUp(item));
                 hs.holding[hand] = Some(item);
             }
-        }
-        if !squeeze && hs.squeezed[hand] && !hs.triggered[hand] {
-            if let Some(item) = hs.holding[hand].take() {
+        if !squeeze && hs.squeezed[hand] && !hs.triggered[hand]
+            && let Some(item) = hs.holding[hand].take() {
                 let bench = state.level.as_ref().map(|l| l.workbench);
                 let at_bench = bench.is_some_and(|b| b.distance(space::floor(hand_pos[hand])) < rules::REACH);
                 intent.actions.push(if at_bench { Do::Place(item) } else { Do::Drop(item) });
             }
-        }
-        if trigger && !hs.triggered[hand] && hs.holding[hand].is_none() {
-            if let Some(case) = aim.case(&cases) {
+        if trigger && !hs.triggered[hand] && hs.holding[hand].is_none()
+            && let Some(case) = aim.case(cases) {
                 intent.actions.push(Do::Break(case));
             }
-        }
-        if !trigger && hs.triggered[hand] {
-            if let Some(item) = hs.holding[hand].take() {
+        if !trigger && hs.triggered[hand]
+            && let Some(item) = hs.holding[hand].take() {
                 intent.actions.push(Do::Throw { item, target: throw_landing(hand_pos[hand], velocity) });
             }
-        }
         hs.squeezed[hand] = squeeze;
         hs.triggered[hand] = trigger;
         if click && hand == off {
