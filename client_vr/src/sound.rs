@@ -95,3 +95,46 @@ fn play(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use heist_audio::{AudioOutput, SpatialMode};
+    use heist_shared::level::WallSet;
+
+    fn energy(frames: &[(f32, f32)]) -> (f32, f32) {
+        frames.iter().fold((0.0, 0.0), |(l, r), f| (l + f.0 * f.0, r + f.1 * f.1))
+    }
+
+    /// Glass breaking at `glass` heard by Vive at the origin facing `facing`: (left, right) energy.
+    fn hear_glass(facing: f32, glass: Vec2) -> (f32, f32) {
+        let mut app = App::new();
+        app.add_plugins(MinimalPlugins).add_message::<Happened>();
+        let state = ViveState { predictor: Some(crate::predict::Predictor::new(WallSet::default(), Vec2::ZERO)), ..Default::default() };
+        app.insert_resource(state).insert_resource(Intent { facing, ..Default::default() });
+        let settings = AudioSettings { output: AudioOutput::Manual, spatial: SpatialMode::Hrtf, ..Default::default() };
+        add(&mut app, &settings).expect("audio starts");
+        app.world_mut().write_message(Happened(GameEvent::Noise { kind: NoiseKind::Glass, position: glass, loudness: 16.0 }));
+        app.update();
+        let engine = app.world().non_send_resource::<AudioEngine>();
+        assert!(engine.played.iter().any(|c| c.what == "glass"), "the glass was played");
+        energy(&engine.capture().expect("memory output").render(24_000))
+    }
+
+    #[test]
+    fn glass_on_the_right_of_where_vive_looks_is_louder_in_the_right_ear() {
+        // Facing north, glass to the east is on the right.
+        let (l, r) = hear_glass(std::f32::consts::FRAC_PI_2, Vec2::new(4.0, 0.0));
+        assert!(r > 2.0 * l, "right {r} left {l}");
+        // Turned to face south, the same glass is on the left.
+        let (l, r) = hear_glass(-std::f32::consts::FRAC_PI_2, Vec2::new(4.0, 0.0));
+        assert!(l > 2.0 * r, "right {r} left {l}");
+    }
+
+    #[test]
+    fn far_glass_is_quieter_than_near_glass() {
+        let near = hear_glass(0.0, Vec2::new(2.0, 0.0));
+        let far = hear_glass(0.0, Vec2::new(12.0, 0.0));
+        assert!(near.0 + near.1 > 3.0 * (far.0 + far.1), "near {near:?} far {far:?}");
+    }
+}
