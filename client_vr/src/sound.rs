@@ -116,7 +116,7 @@ mod tests {
         add(&mut app, &settings).expect("audio starts");
         app.world_mut().write_message(Happened(GameEvent::Noise { kind: NoiseKind::Glass, position: glass, loudness: 16.0 }));
         app.update();
-        let engine = app.world().non_send_resource::<AudioEngine>();
+        let engine = app.world().non_send::<AudioEngine>();
         assert!(engine.played.iter().any(|c| c.what == "glass"), "the glass was played");
         energy(&engine.capture().expect("memory output").render(24_000))
     }
