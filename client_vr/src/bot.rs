@@ -5,9 +5,7 @@
 //! pipeline are the ones a player uses. `--headless --bot` runs exactly this without rendering.
 
 use bevy::prelude::*;
-use heist_bots::{Sight, ViveBrain, ViveStyle};
-use heist_client::Inbox;
-use heist_shared::protocol::{CaseView, GuardView, ItemView, SessionView, ViveAvatar};
+use heist_bots::{Seen, ViveBrain, ViveStyle};
 
 use crate::client::ViveState;
 use crate::intent::{Action, Intent, IntentSystems};
@@ -26,35 +24,15 @@ impl Plugin for BotInputPlugin {
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-fn think(
-    mut brain: ResMut<ViveBrain>,
-    mut intent: ResMut<Intent>,
-    state: Res<ViveState>,
-    inbox: Res<Inbox>,
-    time: Res<Time>,
-    session: Query<&SessionView>,
-    avatar: Query<&ViveAvatar>,
-    guards: Query<&GuardView>,
-    cases: Query<&CaseView>,
-    items: Query<&ItemView>,
-) {
-    let (Ok(session), Ok(avatar)) = (session.single(), avatar.single()) else { return };
+fn think(mut brain: ResMut<ViveBrain>, mut intent: ResMut<Intent>, state: Res<ViveState>, time: Res<Time>, seen: Seen) {
+    let Some(avatar) = seen.avatar() else { return };
     // The brain sees the body where the client predicts it.
     let mut me = avatar.clone();
     if let Some(p) = state.predictor.as_ref() {
         me.position = p.position();
     }
     me.facing = intent.facing;
-    let sight = Sight {
-        level: inbox.level.as_ref(),
-        joined: inbox.role.is_some(),
-        session,
-        me: &me,
-        guards: guards.iter().collect(),
-        cases: cases.iter().collect(),
-        items: items.iter().collect(),
-    };
+    let Some(sight) = seen.sight(&me) else { return };
     let turn = brain.think(&sight, time.delta_secs());
     if turn.ready {
         intent.actions.push(Action::Ready);

@@ -212,30 +212,23 @@ fn snapshots(
     mut tool: Query<(Entity, &PhantomTool, Option<&mut Track>), Changed<PhantomTool>>,
 ) {
     let t = time.elapsed_secs_f64();
-    for (e, g, track) in &mut guards {
-        let s = Snapshot { t, position: space::world(g.position, 0.0), rotation: space::rotation(g.facing) };
-        match track {
-            Some(mut track) => track.push(s),
-            None => {
-                let mut track = Track::default();
-                track.push(s);
-                commands.entity(e).insert(track);
-            }
+    // The first snapshot of an entity starts its track.
+    let mut record = |e: Entity, track: Option<Mut<Track>>, s: Snapshot| match track {
+        Some(mut track) => track.push(s),
+        None => {
+            let mut track = Track::default();
+            track.push(s);
+            commands.entity(e).insert(track);
         }
+    };
+    for (e, g, track) in &mut guards {
+        record(e, track, Snapshot { t, position: space::world(g.position, 0.0), rotation: space::rotation(g.facing) });
     }
     let bench = state.level.as_ref().map_or(Vec2::ZERO, |l| l.workbench);
     for (e, tool, track) in &mut tool {
         let position = space::world(bench, space::BENCH_TOP_M + 0.15) + tool.position;
         let rotation = if tool.rotation.is_finite() { tool.rotation.normalize() } else { Quat::IDENTITY };
-        let s = Snapshot { t, position, rotation };
-        match track {
-            Some(mut track) => track.push(s),
-            None => {
-                let mut track = Track::default();
-                track.push(s);
-                commands.entity(e).insert(track);
-            }
-        }
+        record(e, track, Snapshot { t, position, rotation });
     }
 }
 

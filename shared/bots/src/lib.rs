@@ -10,4 +10,4 @@ mod phantom;
 mod vive;
 
 pub use phantom::{PhantomBotPlugin, PhantomBrain};
-pub use vive::{Sight, Turn, ViveBotPlugin, ViveBrain, ViveStyle};
+pub use vive::{Seen, Sight, Turn, ViveBotPlugin, ViveBrain, ViveStyle};

@@ -186,28 +186,41 @@ impl ViveBrain {
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-fn play(
-    mut brain: ResMut<ViveBrain>,
-    inbox: Res<Inbox>,
-    time: Res<Time>,
-    session: Query<&SessionView>,
-    avatar: Query<&ViveAvatar>,
-    guards: Query<&GuardView>,
-    cases: Query<&CaseView>,
-    items: Query<&ItemView>,
-    mut out: MessageWriter<ClientMsg>,
-) {
-    let (Ok(session), Ok(me)) = (session.single(), avatar.single()) else { return };
-    let sight = Sight {
-        level: inbox.level.as_ref(),
-        joined: inbox.role.is_some(),
-        session,
-        me,
-        guards: guards.iter().collect(),
-        cases: cases.iter().collect(),
-        items: items.iter().collect(),
-    };
+/// The replicated state a Vive bot looks at, as one system parameter: the bot plugin and the Vive
+/// client (which shows the brain its predicted body) both read the world through it.
+#[derive(bevy::ecs::system::SystemParam)]
+pub struct Seen<'w, 's> {
+    inbox: Res<'w, Inbox>,
+    session: Query<'w, 's, &'static SessionView>,
+    avatar: Query<'w, 's, &'static ViveAvatar>,
+    guards: Query<'w, 's, &'static GuardView>,
+    cases: Query<'w, 's, &'static CaseView>,
+    items: Query<'w, 's, &'static ItemView>,
+}
+
+impl Seen<'_, '_> {
+    /// The replicated avatar, once there is one.
+    pub fn avatar(&self) -> Option<&ViveAvatar> {
+        self.avatar.single().ok()
+    }
+
+    /// What the bot sees, with itself as `me` (the replicated avatar, or a client's prediction of it);
+    /// `None` before the session and the avatar are replicated.
+    pub fn sight<'a>(&'a self, me: &'a ViveAvatar) -> Option<Sight<'a>> {
+        Some(Sight {
+            level: self.inbox.level.as_ref(),
+            joined: self.inbox.role.is_some(),
+            session: self.session.single().ok()?,
+            me,
+            guards: self.guards.iter().collect(),
+            cases: self.cases.iter().collect(),
+            items: self.items.iter().collect(),
+        })
+    }
+}
+
+fn play(mut brain: ResMut<ViveBrain>, time: Res<Time>, seen: Seen, mut out: MessageWriter<ClientMsg>) {
+    let Some(sight) = seen.avatar().and_then(|me| seen.sight(me)) else { return };
     let turn = brain.think(&sight, time.delta_secs());
     if turn.ready {
         out.write(ClientMsg::Lobby(LobbyMsg::Ready));
