@@ -7,7 +7,7 @@ use glam::Vec2;
 use heist_client::JoinError;
 use heist_server::ServerOptions;
 use heist_shared::protocol::{
-    CaseId, ClientMsg, DisconnectReason, ItemId, ItemKind, ItemView, LobbyMsg, Phase, PhantomMsg, Refusal, Role,
+    CaseId, ClientMsg, DisconnectReason, ItemId, ItemKind, ItemView, LobbyMsg, PhantomMsg, Phase, Refusal, Role,
     ViveMsg,
 };
 use heist_tests::{HZ, Session, bot_heist, join};
@@ -69,7 +69,15 @@ fn malformed_and_illegal_messages_are_refused_without_harming_the_session() {
     let (mut s, vive, phantom) = heist_in_progress();
     send_raw(&mut s, vive, &[0xFF, 0xFF, 0xFF, 0x13, 0x37]);
     s.send(vive, ClientMsg::Phantom(PhantomMsg::Verdict { item: ItemId(0), real: true }));
-    s.send(vive, ClientMsg::Vive(ViveMsg::Move { seq: 1, direction: Vec2::new(40.0, 0.0), gait: Default::default(), facing: 0.0 }));
+    s.send(
+        vive,
+        ClientMsg::Vive(ViveMsg::Move {
+            seq: 1,
+            direction: Vec2::new(40.0, 0.0),
+            gait: Default::default(),
+            facing: 0.0,
+        }),
+    );
     s.send(vive, ClientMsg::Vive(ViveMsg::Break(CaseId(0))));
     s.send(vive, ClientMsg::Vive(ViveMsg::Break(CaseId(999))));
     s.send(phantom, ClientMsg::Phantom(PhantomMsg::Verdict { item: ItemId(0), real: false }));
@@ -102,7 +110,8 @@ fn sustained_abuse_disconnects_only_the_abuser() {
 #[test]
 fn no_client_ever_receives_which_copy_is_real() {
     // Bots play a while so copies move, cases break and copies reach the workbench.
-    let mut heist = heist_server::demo::Heist::start(ServerOptions::local_test(6), heist_bots::ViveStyle::Careful).unwrap();
+    let mut heist =
+        heist_server::demo::Heist::start(ServerOptions::local_test(6), heist_bots::ViveStyle::Careful).unwrap();
     for _ in 0..(240 * HZ) {
         heist.step();
         if !heist.server.game().is_running() {
@@ -122,7 +131,8 @@ fn no_client_ever_receives_which_copy_is_real() {
         // All copies of one artifact look the same; nothing replicated mentions realness.
         for a in &items {
             for b in &items {
-                if let (ItemKind::Copy { artifact: x, look: lx }, ItemKind::Copy { artifact: y, look: ly }) = (&a.kind, &b.kind)
+                if let (ItemKind::Copy { artifact: x, look: lx }, ItemKind::Copy { artifact: y, look: ly }) =
+                    (&a.kind, &b.kind)
                     && x == y
                 {
                     assert_eq!(lx, ly);

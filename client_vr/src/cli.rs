@@ -219,14 +219,16 @@ pub fn app(args: &JoinArgs, mode: &Mode) -> anyhow::Result<App> {
         }
         Mode::Xr => {
             app.add_plugins(
-                bevy_mod_openxr::add_xr_plugins(DefaultPlugins.set(WindowPlugin { primary_window: Some(window), ..default() }))
-                    .set(bevy_mod_openxr::init::OxrInitPlugin {
-                        app_info: bevy_mod_openxr::types::AppInfo {
-                            name: "Phantom Heist".into(),
-                            version: bevy_mod_openxr::types::Version(0, 1, 0),
-                        },
-                        ..default()
-                    }),
+                bevy_mod_openxr::add_xr_plugins(
+                    DefaultPlugins.set(WindowPlugin { primary_window: Some(window), ..default() }),
+                )
+                .set(bevy_mod_openxr::init::OxrInitPlugin {
+                    app_info: bevy_mod_openxr::types::AppInfo {
+                        name: "Phantom Heist".into(),
+                        version: bevy_mod_openxr::types::Version(0, 1, 0),
+                    },
+                    ..default()
+                }),
             );
         }
     }
@@ -342,7 +344,9 @@ mod tests {
 
     #[test]
     fn a_bad_window_size_is_a_clear_usage_error() {
-        let err = Cli::try_parse_from(["client_vr", "join", "127.0.0.1:1", "--code", "A", "--size", "big"]).expect_err("a usage error").to_string();
+        let err = Cli::try_parse_from(["client_vr", "join", "127.0.0.1:1", "--code", "A", "--size", "big"])
+            .expect_err("a usage error")
+            .to_string();
         assert!(err.contains("expected WIDTHxHEIGHT"), "{err}");
         assert_eq!(parse_size("640x480"), Ok((640, 480)));
         assert!(parse_size("0x480").is_err());

@@ -8,12 +8,12 @@
 //! controller pulses; only what the mode added).
 
 use bevy::app::AppExit;
+use bevy::app::RunFixedMainLoopSystems;
 use bevy::prelude::*;
 use glam::{Quat, Vec2};
 use heist_client::Inbox;
 use heist_shared::level::{Level, WallSet};
-use heist_shared::protocol::{GameEvent, GuardView, Phase, PhantomTool, SessionView, TICK_HZ, ViveAvatar};
-use bevy::app::RunFixedMainLoopSystems;
+use heist_shared::protocol::{GameEvent, GuardView, PhantomTool, Phase, SessionView, TICK_HZ, ViveAvatar};
 
 use crate::intent::{self, InputSource, Intent, IntentSystems, Sent};
 use crate::interp::{Snapshot, Track};
@@ -163,7 +163,8 @@ fn take_level(inbox: Res<Inbox>, mut state: ResMut<ViveState>, time: Res<Time>) 
     let walls = WallSet::new(&level);
     state.predictor = Some(Predictor::new(walls.clone(), level.vive_spawn));
     let now = time.elapsed_secs_f64();
-    state.say(now, format!("Joined {} as Vive: {} rooms, {} guards", level.name, level.rooms.len(), level.guards.len()));
+    state
+        .say(now, format!("Joined {} as Vive: {} rooms, {} guards", level.name, level.rooms.len(), level.guards.len()));
     state.walls = Some(walls);
     state.level = Some(level);
 }
@@ -249,8 +250,13 @@ fn events(
             GameEvent::Alarm(n) => Some(format!("ALARM level {n}")),
             GameEvent::Warning(w) => Some(format!("Phantom warns: {w:?}")),
             GameEvent::GuardAlert { guard, alert, .. } => {
-                let name = state.level.as_ref().and_then(|l| l.guards.get(usize::from(guard.0))).map(|g| g.name.clone());
-                Some(format!("{} is {}", name.unwrap_or_else(|| format!("Guard {}", guard.0)), format!("{alert:?}").to_lowercase()))
+                let name =
+                    state.level.as_ref().and_then(|l| l.guards.get(usize::from(guard.0))).map(|g| g.name.clone());
+                Some(format!(
+                    "{} is {}",
+                    name.unwrap_or_else(|| format!("Guard {}", guard.0)),
+                    format!("{alert:?}").to_lowercase()
+                ))
             }
             GameEvent::Noise { .. } | GameEvent::PhaseChanged(_) => None,
         };
@@ -292,14 +298,24 @@ fn settle(mut state: ResMut<ViveState>, time: Res<Time>) {
     }
 }
 
-fn ready_at_once(settings: Res<ViveSettings>, state: Res<ViveState>, mut intent: ResMut<Intent>, mut done: Local<bool>) {
+fn ready_at_once(
+    settings: Res<ViveSettings>,
+    state: Res<ViveState>,
+    mut intent: ResMut<Intent>,
+    mut done: Local<bool>,
+) {
     if settings.ready_at_once && !*done && state.level.is_some() && state.phase == Phase::Lobby {
         intent.actions.push(intent::Action::Ready);
         *done = true;
     }
 }
 
-fn quit_after_end(settings: Res<ViveSettings>, state: Res<ViveState>, mut exit: MessageWriter<AppExit>, inbox: Res<Inbox>) {
+fn quit_after_end(
+    settings: Res<ViveSettings>,
+    state: Res<ViveState>,
+    mut exit: MessageWriter<AppExit>,
+    inbox: Res<Inbox>,
+) {
     if let Some(after) = settings.quit_after_end_s
         && (state.ended_s > after || inbox.disconnect.is_some())
     {

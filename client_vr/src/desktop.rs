@@ -153,9 +153,11 @@ fn keys(
         }
     }
     if keys.just_pressed(KeyCode::KeyF) {
-        let copy = state.carrying.iter().copied().find(|c| {
-            items.iter().any(|i| i.id == *c && matches!(i.kind, ItemKind::Copy { .. }))
-        });
+        let copy = state
+            .carrying
+            .iter()
+            .copied()
+            .find(|c| items.iter().any(|i| i.id == *c && matches!(i.kind, ItemKind::Copy { .. })));
         if let Some(item) = copy {
             intent.actions.push(Action::Place(item));
         }

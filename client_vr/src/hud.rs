@@ -55,7 +55,11 @@ fn spawn_wrist(mut commands: Commands, mut images: ResMut<Assets<Image>>) {
     let camera = commands
         .spawn((
             Camera2d,
-            Camera { order: -1, clear_color: ClearColorConfig::Custom(Color::srgba(0.02, 0.02, 0.05, 0.85)), ..default() },
+            Camera {
+                order: -1,
+                clear_color: ClearColorConfig::Custom(Color::srgba(0.02, 0.02, 0.05, 0.85)),
+                ..default()
+            },
             RenderTarget::Image(image.clone().into()),
         ))
         .id();
@@ -65,20 +69,24 @@ fn spawn_wrist(mut commands: Commands, mut images: ResMut<Assets<Image>>) {
 
 fn spawn(commands: &mut Commands, target: Option<Entity>) {
     let font = TextFont { font_size: FontSize::Px(if target.is_some() { 26.0 } else { 18.0 }), ..default() };
-    let status = commands.spawn((
-        Status,
-        Text::new("Joining..."),
-        font.clone(),
-        TextColor(Color::WHITE),
-        Node { position_type: PositionType::Absolute, top: Val::Px(8.0), left: Val::Px(10.0), ..default() },
-    )).id();
-    let feed = commands.spawn((
-        Feed,
-        Text::new(""),
-        font,
-        TextColor(Color::srgb(1.0, 0.95, 0.7)),
-        Node { position_type: PositionType::Absolute, bottom: Val::Px(8.0), left: Val::Px(10.0), ..default() },
-    )).id();
+    let status = commands
+        .spawn((
+            Status,
+            Text::new("Joining..."),
+            font.clone(),
+            TextColor(Color::WHITE),
+            Node { position_type: PositionType::Absolute, top: Val::Px(8.0), left: Val::Px(10.0), ..default() },
+        ))
+        .id();
+    let feed = commands
+        .spawn((
+            Feed,
+            Text::new(""),
+            font,
+            TextColor(Color::srgb(1.0, 0.95, 0.7)),
+            Node { position_type: PositionType::Absolute, bottom: Val::Px(8.0), left: Val::Px(10.0), ..default() },
+        ))
+        .id();
     if let Some(camera) = target {
         commands.entity(status).insert(UiTargetCamera(camera));
         commands.entity(feed).insert(UiTargetCamera(camera));
@@ -165,7 +173,11 @@ mod tests {
             present: (true, true),
         };
         let look = heist_shared::artifact::look(ArtifactKind::Idol);
-        let item = ItemView { id: ItemId(4), kind: ItemKind::Copy { artifact: ArtifactKind::Idol, look }, place: ItemPlace::Carried };
+        let item = ItemView {
+            id: ItemId(4),
+            kind: ItemKind::Copy { artifact: ArtifactKind::Idol, look },
+            place: ItemPlace::Carried,
+        };
         let text = status_text(&state, Some(&session), &[&item]);
         assert!(text.contains("2:05 left"), "{text}");
         assert!(text.contains("alarm 1/3"), "{text}");

@@ -138,11 +138,7 @@ impl Aim {
     }
 
     /// The item to pick up: on the floor, or in a broken case.
-    pub fn item<'a>(
-        &self,
-        items: impl IntoIterator<Item = &'a ItemView>,
-        cases: &[&CaseView],
-    ) -> Option<ItemId> {
+    pub fn item<'a>(&self, items: impl IntoIterator<Item = &'a ItemView>, cases: &[&CaseView]) -> Option<ItemId> {
         items
             .into_iter()
             .filter_map(|i| {
@@ -219,11 +215,8 @@ mod tests {
         let cases = [case(0, 1.0, 0.0, false), case(1, 0.0, 1.0, true)];
         let refs: Vec<&CaseView> = cases.iter().collect();
         let item = |id: u16, place| ItemView { id: ItemId(id), kind: heist_shared::protocol::ItemKind::Prop, place };
-        let items = [
-            item(0, ItemPlace::InCase(CaseId(0))),
-            item(1, ItemPlace::InCase(CaseId(1))),
-            item(2, ItemPlace::Carried),
-        ];
+        let items =
+            [item(0, ItemPlace::InCase(CaseId(0))), item(1, ItemPlace::InCase(CaseId(1))), item(2, ItemPlace::Carried)];
         let aim = Aim { from: Vec2::ZERO, towards: Vec2::X };
         assert_eq!(aim.item(&items, &refs), Some(ItemId(1)), "the closed case's copy is out of the hand's way");
         let on_floor = [item(3, ItemPlace::Floor(Vec2::new(0.5, 0.0)))];

@@ -48,8 +48,14 @@ fn play(
             GameEvent::Noise { kind: NoiseKind::Glass, position, .. } => audio.glass(at(*position, 1.2)),
             GameEvent::Noise { kind: NoiseKind::Thud, position, .. } => audio.thud(at(*position, 0.0)),
             GameEvent::Noise { kind: NoiseKind::Alarm, position, .. } => audio.alarm(at(*position, 2.8)),
-            GameEvent::GuardAlert { alert, position, .. } if matches!(alert, GuardAlert::Suspicious | GuardAlert::Chasing) => {
-                audio.play_at(heist_audio::synth::bark(*alert == GuardAlert::Chasing), at(*position, 1.7), "guard bark");
+            GameEvent::GuardAlert { alert, position, .. }
+                if matches!(alert, GuardAlert::Suspicious | GuardAlert::Chasing) =>
+            {
+                audio.play_at(
+                    heist_audio::synth::bark(*alert == GuardAlert::Chasing),
+                    at(*position, 1.7),
+                    "guard bark",
+                );
             }
             _ => {}
         }
@@ -110,11 +116,18 @@ mod tests {
     fn hear_glass(facing: f32, glass: Vec2) -> (f32, f32) {
         let mut app = App::new();
         app.add_plugins(MinimalPlugins).add_message::<Happened>();
-        let state = ViveState { predictor: Some(crate::predict::Predictor::new(WallSet::default(), Vec2::ZERO)), ..Default::default() };
+        let state = ViveState {
+            predictor: Some(crate::predict::Predictor::new(WallSet::default(), Vec2::ZERO)),
+            ..Default::default()
+        };
         app.insert_resource(state).insert_resource(Intent { facing, ..Default::default() });
         let settings = AudioSettings { output: AudioOutput::Manual, spatial: SpatialMode::Hrtf, ..Default::default() };
         add(&mut app, &settings).expect("audio starts");
-        app.world_mut().write_message(Happened(GameEvent::Noise { kind: NoiseKind::Glass, position: glass, loudness: 16.0 }));
+        app.world_mut().write_message(Happened(GameEvent::Noise {
+            kind: NoiseKind::Glass,
+            position: glass,
+            loudness: 16.0,
+        }));
         app.update();
         let engine = app.world().non_send::<AudioEngine>();
         assert!(engine.played.iter().any(|c| c.what == "glass"), "the glass was played");

@@ -66,6 +66,10 @@ mod tests {
         assert!((ahead - Vec3::new(0.0, -1.6, -3.0)).length() < 1e-5, "{ahead}");
         // Facing north matches heist_audio's north-facing helper.
         let p = Vec2::new(1.0, 5.0);
-        assert!((listener_offset(Vec2::ZERO, FRAC_PI_2, 1.6, p, 0.0) - heist_audio::listener_offset(Vec2::ZERO, p, 0.0)).length() < 1e-5);
+        assert!(
+            (listener_offset(Vec2::ZERO, FRAC_PI_2, 1.6, p, 0.0) - heist_audio::listener_offset(Vec2::ZERO, p, 0.0))
+                .length()
+                < 1e-5
+        );
     }
 }

@@ -48,7 +48,18 @@ impl Plugin for WorldPlugin {
             .insert_resource(GlobalAmbientLight { color: Color::WHITE, brightness: 1500.0, ..default() })
             .add_systems(
                 Update,
-                (build_museum, dress_cases, dress_items, dress_guards, dress_tool, shatter, move_items, move_guards, move_tool, fall)
+                (
+                    build_museum,
+                    dress_cases,
+                    dress_items,
+                    dress_guards,
+                    dress_tool,
+                    shatter,
+                    move_items,
+                    move_guards,
+                    move_tool,
+                    fall,
+                )
                     .chain()
                     .in_set(ViveSystems::Present)
                     .in_set(WorldSystems),
@@ -118,7 +129,9 @@ fn spawn_museum(
             ));
         }
         if let Some(walls) = walls {
-            for (segments, material, height) in [(&walls.walls, &wall, WALL_HEIGHT_M), (&walls.closed_doors, &door, 2.2)] {
+            for (segments, material, height) in
+                [(&walls.walls, &wall, WALL_HEIGHT_M), (&walls.closed_doors, &door, 2.2)]
+            {
                 for s in segments {
                     let d = s.b - s.a;
                     let len = d.length();
@@ -296,7 +309,9 @@ fn move_items(
     let bench = state.level.as_ref().map_or(Vec2::ZERO, |l| l.workbench);
     for (item, mut t, mut vis) in &mut items {
         let at = match item.place {
-            ItemPlace::InCase(c) => cases.iter().find(|cv| cv.id == c).map(|cv| space::world(cv.position, PEDESTAL_M + 0.1)),
+            ItemPlace::InCase(c) => {
+                cases.iter().find(|cv| cv.id == c).map(|cv| space::world(cv.position, PEDESTAL_M + 0.1))
+            }
             ItemPlace::Floor(p) => Some(space::world(p, 0.08)),
             ItemPlace::Carried => {
                 let slot = state.carrying.iter().position(|i| *i == item.id).unwrap_or(0);
@@ -336,16 +351,34 @@ fn dress_guards(
         let uniform = materials.add(StandardMaterial { base_color: Color::srgb(0.1, 0.12, 0.3), ..default() });
         let skin = materials.add(StandardMaterial { base_color: Color::srgb(0.85, 0.7, 0.6), ..default() });
         let colour = alert_colour(g.alert);
-        let lamp = materials.add(StandardMaterial { base_color: colour, emissive: colour.to_linear() * 4.0, ..default() });
+        let lamp =
+            materials.add(StandardMaterial { base_color: colour, emissive: colour.to_linear() * 4.0, ..default() });
         commands
             .entity(e)
             .insert((Dressed, Transform::from_translation(space::world(g.position, 0.0)), Visibility::default()))
             .with_children(|c| {
-                c.spawn((Mesh3d(meshes.add(Capsule3d::new(0.25, 0.9))), MeshMaterial3d(uniform), Transform::from_xyz(0.0, 0.7, 0.0)));
-                c.spawn((Mesh3d(meshes.add(Sphere::new(0.14))), MeshMaterial3d(skin.clone()), Transform::from_xyz(0.0, 1.5, 0.0)));
+                c.spawn((
+                    Mesh3d(meshes.add(Capsule3d::new(0.25, 0.9))),
+                    MeshMaterial3d(uniform),
+                    Transform::from_xyz(0.0, 0.7, 0.0),
+                ));
+                c.spawn((
+                    Mesh3d(meshes.add(Sphere::new(0.14))),
+                    MeshMaterial3d(skin.clone()),
+                    Transform::from_xyz(0.0, 1.5, 0.0),
+                ));
                 // The nose shows where the guard looks.
-                c.spawn((Mesh3d(meshes.add(Cuboid::new(0.06, 0.06, 0.12))), MeshMaterial3d(skin), Transform::from_xyz(0.0, 1.5, -0.16)));
-                c.spawn((AlertLamp, Mesh3d(meshes.add(Sphere::new(0.08))), MeshMaterial3d(lamp), Transform::from_xyz(0.0, 1.9, 0.0)));
+                c.spawn((
+                    Mesh3d(meshes.add(Cuboid::new(0.06, 0.06, 0.12))),
+                    MeshMaterial3d(skin),
+                    Transform::from_xyz(0.0, 1.5, -0.16),
+                ));
+                c.spawn((
+                    AlertLamp,
+                    Mesh3d(meshes.add(Sphere::new(0.08))),
+                    MeshMaterial3d(lamp),
+                    Transform::from_xyz(0.0, 1.9, 0.0),
+                ));
             });
     }
 }
@@ -382,7 +415,8 @@ fn dress_tool(
     mut materials: ResMut<Assets<StandardMaterial>>,
 ) {
     for e in &tool {
-        let steel = materials.add(StandardMaterial { base_color: Color::srgb(0.8, 0.8, 0.85), metallic: 0.9, ..default() });
+        let steel =
+            materials.add(StandardMaterial { base_color: Color::srgb(0.8, 0.8, 0.85), metallic: 0.9, ..default() });
         commands.entity(e).insert((
             Dressed,
             Mesh3d(meshes.add(Cylinder::new(0.006, 0.14))),

@@ -3,14 +3,14 @@
 
 mod common;
 
+use bevy::prelude::*;
+use client_vr::client::PulseReason;
+use client_vr::interp::Track;
+use client_vr::{Action, ViveState};
 use common::{join_args, quantile, vive_client};
 use heist_bots::PhantomBotPlugin;
 use heist_server::{ServerOptions, build_server, demo};
-use bevy::prelude::*;
-use client_vr::interp::Track;
-use heist_shared::protocol::{ClientMsg, GuardView, Phase, PhantomMsg, PhantomTool, Role, SessionView, TICK_HZ};
-use client_vr::{Action, ViveState};
-use client_vr::client::PulseReason;
+use heist_shared::protocol::{ClientMsg, GuardView, PhantomMsg, PhantomTool, Phase, Role, SessionView, TICK_HZ};
 
 /// The Phantom bot does not touch anything; this moves its tool in a circle over the bench, as the
 /// Phantom client reports its stylus.
@@ -53,8 +53,11 @@ fn the_vive_client_in_bot_mode_and_a_phantom_bot_win_a_heist() {
     // What the server moves arrives as snapshots to interpolate: the guards, and the Phantom's tool.
     let world = vive.world_mut();
     let guards: Vec<usize> = world.query::<(&GuardView, &Track)>().iter(world).map(|(_, t)| t.len()).collect();
-    let tool: Vec<(usize, Vec3)> =
-        world.query::<(&PhantomTool, &Track)>().iter(world).map(|(_, t)| (t.len(), t.latest().map_or(Vec3::ZERO, |s| s.position))).collect();
+    let tool: Vec<(usize, Vec3)> = world
+        .query::<(&PhantomTool, &Track)>()
+        .iter(world)
+        .map(|(_, t)| (t.len(), t.latest().map_or(Vec3::ZERO, |s| s.position)))
+        .collect();
     println!("snapshots kept per guard {guards:?}; tool {tool:?}");
     assert_eq!(guards.len(), 3, "every guard is tracked");
     assert!(guards.iter().all(|n| *n >= 2), "guards have snapshots to interpolate between");
@@ -66,10 +69,7 @@ fn the_vive_client_in_bot_mode_and_a_phantom_bot_win_a_heist() {
     let sent = vive.world().resource::<client_vr::intent::Sent>();
     println!(
         "seed {seed}: {:?} after {:.1} s of game time; {} moves sent, actions {:?}",
-        game.phase,
-        game.elapsed_s,
-        sent.seq,
-        sent.actions
+        game.phase, game.elapsed_s, sent.seq, sent.actions
     );
     println!(
         "reconciliations {}, prediction error at ack: p50 {:.4} m, p99 {:.4} m (last {}), max {:.4} m (all {} acks); pulses {:?}",

@@ -8,9 +8,9 @@ mod common;
 use std::time::{Duration, Instant};
 
 use bevy::prelude::*;
-use common::{Link, Relay, join_args, quantile, vive_client};
 use client_vr::intent::IntentSystems;
 use client_vr::{Intent, ViveState};
+use common::{Link, Relay, join_args, quantile, vive_client};
 use glam::Vec2;
 use heist_bots::PhantomBotPlugin;
 use heist_server::{ServerOptions, build_server, demo};
@@ -94,7 +94,16 @@ fn run(link: Link) -> Measured {
     let period = Duration::from_secs_f64(1.0 / TICK_HZ);
     let started = Instant::now();
     let mut next = Instant::now();
-    let mut m = Measured { heist_ticks: 0, errors: Vec::new(), acked: 0, max_error: 0.0, snaps: 0, pending: 0, ahead: Vec::new(), walked_m: 0.0 };
+    let mut m = Measured {
+        heist_ticks: 0,
+        errors: Vec::new(),
+        acked: 0,
+        max_error: 0.0,
+        snaps: 0,
+        pending: 0,
+        ahead: Vec::new(),
+        walked_m: 0.0,
+    };
     let mut last = server.game().vive.position;
     while started.elapsed() < Duration::from_secs(40) && m.heist_ticks < 14 * 60 {
         server.app.update();

@@ -48,7 +48,9 @@ fn debians_loader_without_a_runtime_means_desktop_mode_with_the_reason() {
     let loader = debian_loader();
     let p = probe(Some(&loader));
     match &p {
-        XrProbe::NoRuntime { reason } => assert!(reason.contains("RUNTIME_UNAVAILABLE") || reason.contains("RUNTIME_FAILURE"), "{reason}"),
+        XrProbe::NoRuntime { reason } => {
+            assert!(reason.contains("RUNTIME_UNAVAILABLE") || reason.contains("RUNTIME_FAILURE"), "{reason}")
+        }
         other => panic!("expected no runtime, got {other:?}"),
     }
     let line = xr_check(Some(&loader));

@@ -83,11 +83,23 @@ impl Heist {
                 let guards: Vec<String> = g
                     .guards
                     .iter()
-                    .map(|gd| format!("{}({:.1},{:.1} f{:.1} {:?})", gd.name, gd.position.x, gd.position.y, gd.facing, gd.alert))
+                    .map(|gd| {
+                        format!(
+                            "{}({:.1},{:.1} f{:.1} {:?})",
+                            gd.name, gd.position.x, gd.position.y, gd.facing, gd.alert
+                        )
+                    })
                     .collect();
                 println!(
                     "  t={:.1} vive=({:.1},{:.1}) {:?} seq={} queued={} carry={:?} | {}",
-                    g.elapsed_s, g.vive.position.x, g.vive.position.y, g.vive.stance, g.vive.last_input_seq, g.vive.inputs.len(), g.vive.carrying, guards.join(" ")
+                    g.elapsed_s,
+                    g.vive.position.x,
+                    g.vive.position.y,
+                    g.vive.stance,
+                    g.vive.last_input_seq,
+                    g.vive.inputs.len(),
+                    g.vive.carrying,
+                    guards.join(" ")
                 );
             }
             if !self.server.game().is_running() {
@@ -120,7 +132,11 @@ pub fn run_demo(options: ServerOptions, style: ViveStyle) -> anyhow::Result<Phas
     for (name, app) in [("Vive", &heist.vive), ("Phantom", &heist.phantom)] {
         let inbox = app.world().resource::<heist_client::Inbox>();
         if !inbox.refusals.is_empty() {
-            println!("{name} bot had {} refusals, first: {:?}", inbox.refusals.len(), &inbox.refusals[..inbox.refusals.len().min(5)]);
+            println!(
+                "{name} bot had {} refusals, first: {:?}",
+                inbox.refusals.len(),
+                &inbox.refusals[..inbox.refusals.len().min(5)]
+            );
         }
     }
     println!("{result} after {:.1} s of game time", game.elapsed_s);
@@ -155,7 +171,11 @@ impl std::fmt::Display for Tally {
 
 /// Plays one whole heist per seed on the shipped museum and tallies the outcomes; `each` gets every
 /// seed's result line as it finishes.
-pub fn sweep(seeds: impl IntoIterator<Item = u64>, style: ViveStyle, mut each: impl FnMut(u64, &str)) -> anyhow::Result<Tally> {
+pub fn sweep(
+    seeds: impl IntoIterator<Item = u64>,
+    style: ViveStyle,
+    mut each: impl FnMut(u64, &str),
+) -> anyhow::Result<Tally> {
     let mut tally = Tally::default();
     for seed in seeds {
         let (heist, phase, result) = play_to_the_end(ServerOptions::local_test(seed), style)?;

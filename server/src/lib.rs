@@ -115,7 +115,13 @@ pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
         let session: u64 = rand::random();
         let service = TokenService::spawn(
             options.token_bind,
-            TokenConfig { code: join_code.clone(), private_key, server_addr: options.advertise.unwrap_or(addr), session, roles: roles.clone() },
+            TokenConfig {
+                code: join_code.clone(),
+                private_key,
+                server_addr: options.advertise.unwrap_or(addr),
+                session,
+                roles: roles.clone(),
+            },
         )
         .with_context(|| format!("cannot bind the token endpoint on TCP {}", options.token_bind))?;
         (Auth::Secure { private_key, session }, Some(service))

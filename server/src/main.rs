@@ -127,7 +127,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         }
         Command::Sweep { from, to, vive } => {
             anyhow::ensure!(from <= to, "--from {from} is after --to {to}");
-            let tally = heist_server::demo::sweep(from..=to, vive.into(), |seed, line| println!("seed {seed:>4}: {line}"))?;
+            let tally =
+                heist_server::demo::sweep(from..=to, vive.into(), |seed, line| println!("seed {seed:>4}: {line}"))?;
             println!("{tally}");
             Ok(())
         }
@@ -158,8 +159,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let token = heist_client::request_token(addr, &code, role, Duration::from_secs(5))
                 .with_context(|| format!("joining {addr} as {role}"))?;
             let mut app = App::new();
-            app.add_plugins(MinimalPlugins.set(bevy::app::ScheduleRunnerPlugin::run_loop(Duration::from_secs_f64(1.0 / 60.0))))
-                .add_plugins(heist_client::ClientNetPlugin);
+            app.add_plugins(
+                MinimalPlugins.set(bevy::app::ScheduleRunnerPlugin::run_loop(Duration::from_secs_f64(1.0 / 60.0))),
+            )
+            .add_plugins(heist_client::ClientNetPlugin);
             match role {
                 Role::Vive => app.add_plugins(ViveBotPlugin { style: vive.into() }),
                 Role::Phantom => app.add_plugins(PhantomBotPlugin::default()),

@@ -4,8 +4,7 @@
 use bevy::prelude::*;
 use bevy_replicon::prelude::*;
 use heist_shared::protocol::{
-    Audience, CaseId, CaseView, GameEvent, GuardView, ItemId, ItemView, Phase, PhantomTool, SessionView,
-    ViveAvatar,
+    Audience, CaseId, CaseView, GameEvent, GuardView, ItemId, ItemView, PhantomTool, Phase, SessionView, ViveAvatar,
 };
 
 use crate::game::Game;

@@ -12,7 +12,10 @@ fn write(name: &str, text: &str) -> std::path::PathBuf {
 
 #[test]
 fn the_server_binary_refuses_a_bad_level_with_a_clear_message() {
-    let path = write("bin.ron", &include_str!("../../assets/levels/museum.ron").replace("time_limit_s: 600.0", "time_limit_s: -5.0"));
+    let path = write(
+        "bin.ron",
+        &include_str!("../../assets/levels/museum.ron").replace("time_limit_s: 600.0", "time_limit_s: -5.0"),
+    );
     let out = Command::new(env!("CARGO_BIN_EXE_heist-server"))
         .args(["demo", "--level"])
         .arg(&path)
@@ -47,9 +50,14 @@ fn a_sweep_tallies_every_seed() {
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("seed    1: RESULT: Lost(caught)"), "{stdout}");
     assert!(stdout.contains("seed    2: RESULT: Lost(caught)"), "{stdout}");
-    assert_eq!(stdout.lines().last(), Some("won 0 of 2 (0.0%), caught 2, other losses 0; winning seeds: []"), "{stdout}");
+    assert_eq!(
+        stdout.lines().last(),
+        Some("won 0 of 2 (0.0%), caught 2, other losses 0; winning seeds: []"),
+        "{stdout}"
+    );
 
-    let bad = Command::new(env!("CARGO_BIN_EXE_heist-server")).args(["sweep", "--from", "5", "--to", "2"]).output().unwrap();
+    let bad =
+        Command::new(env!("CARGO_BIN_EXE_heist-server")).args(["sweep", "--from", "5", "--to", "2"]).output().unwrap();
     assert!(!bad.status.success());
     assert!(String::from_utf8_lossy(&bad.stderr).contains("--from 5 is after --to 2"));
 }

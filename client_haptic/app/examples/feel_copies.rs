@@ -19,11 +19,18 @@ fn main() -> anyhow::Result<()> {
             let (copies, _) = generate_copies(kind, seed, 3);
             for t in &copies {
                 item += 1;
-                let copy = WorkbenchCopy { item: ItemId(item), mesh: build_mesh(t, seed), material: t.material.material() };
+                let copy =
+                    WorkbenchCopy { item: ItemId(item), mesh: build_mesh(t, seed), material: t.material.material() };
                 let f = feel(&mut h, &copy, kind).map_err(anyhow::Error::msg)?;
                 println!(
                     "{kind:?},{seed},{},{:?},{},{:?},{:.0},{:.0},{:.2}",
-                    t.feature_count, t.material, f.feature_count, f.material, f.stiffness_n_per_m, f.pressure_n_per_m2, f.friction
+                    t.feature_count,
+                    t.material,
+                    f.feature_count,
+                    f.material,
+                    f.stiffness_n_per_m,
+                    f.pressure_n_per_m2,
+                    f.friction
                 );
             }
         }

@@ -20,7 +20,10 @@ use crate::haptics::HapticsSettings;
 
 /// The command line.
 #[derive(Parser, Debug)]
-#[command(name = "client_haptic", about = "Phantom Heist: join as Phantom, the blind player, and play by touch and sound")]
+#[command(
+    name = "client_haptic",
+    about = "Phantom Heist: join as Phantom, the blind player, and play by touch and sound"
+)]
 pub struct Cli {
     /// What to do.
     #[command(subcommand)]
@@ -164,7 +167,11 @@ pub fn default_cache() -> Option<PathBuf> {
 
 /// The Phantom client's Bevy app, not yet connected: headless (60 Hz loop) or with the spectator window;
 /// on the network, or practising offline.
-pub fn app(settings: PhantomSettings, headless: bool, practice: Option<crate::practice::Practice>) -> Result<App, crate::ClientError> {
+pub fn app(
+    settings: PhantomSettings,
+    headless: bool,
+    practice: Option<crate::practice::Practice>,
+) -> Result<App, crate::ClientError> {
     let mut app = App::new();
     if headless {
         app.add_plugins(MinimalPlugins.set(ScheduleRunnerPlugin::run_loop(Duration::from_secs_f64(1.0 / TICK_HZ))))
@@ -198,7 +205,12 @@ pub fn app(settings: PhantomSettings, headless: bool, practice: Option<crate::pr
 }
 
 /// Quits a few seconds after the last practice copy was judged.
-fn quit_when_practice_is_over(p: Res<crate::practice::Practice>, time: Res<Time<Real>>, mut done_at: Local<Option<f32>>, mut exit: MessageWriter<AppExit>) {
+fn quit_when_practice_is_over(
+    p: Res<crate::practice::Practice>,
+    time: Res<Time<Real>>,
+    mut done_at: Local<Option<f32>>,
+    mut exit: MessageWriter<AppExit>,
+) {
     let now = time.elapsed_secs();
     if p.finished() && done_at.is_none() {
         *done_at = Some(now);
@@ -217,7 +229,8 @@ fn quit_when_over(
     state: Res<PhantomState>,
     mut exit: MessageWriter<AppExit>,
 ) {
-    let over = q.iter().next().is_some_and(|s| matches!(s.phase, Phase::Won | Phase::Lost(_))) || inbox.disconnect.is_some();
+    let over =
+        q.iter().next().is_some_and(|s| matches!(s.phase, Phase::Won | Phase::Lost(_))) || inbox.disconnect.is_some();
     let now = time.elapsed_secs();
     if over && over_at.is_none() {
         *over_at = Some(now);
@@ -303,8 +316,17 @@ mod tests {
 
     #[test]
     fn the_bot_refuses_a_device_it_cannot_steer() {
-        let cli = Cli::try_parse_from(["client_haptic", "join", "127.0.0.1:5757", "--code", "ABCD", "--bot", "--device", "hid"])
-            .expect("parses");
+        let cli = Cli::try_parse_from([
+            "client_haptic",
+            "join",
+            "127.0.0.1:5757",
+            "--code",
+            "ABCD",
+            "--bot",
+            "--device",
+            "hid",
+        ])
+        .expect("parses");
         let Command::Join(args) = cli.command else { panic!("join") };
         assert!(args.client.settings().unwrap_err().contains("--device sim"));
     }

@@ -15,7 +15,7 @@ use glam::{Vec2, Vec3};
 use heist_client::Inbox;
 use heist_shared::artifact::{ArtifactKind, MaterialClass};
 use heist_shared::protocol::{
-    ClientMsg, GameEvent, GuardAlert, GuardView, ItemId, ItemKind, ItemView, LobbyMsg, NoiseKind, Phase, PhantomMsg,
+    ClientMsg, GameEvent, GuardAlert, GuardView, ItemId, ItemKind, ItemView, LobbyMsg, NoiseKind, PhantomMsg, Phase,
     SessionView, VerdictOutcome, ViveAvatar, WarningKind,
 };
 
@@ -130,10 +130,15 @@ impl Plugin for PhantomClientPlugin {
             .add_message::<HeistEvent>()
             .configure_sets(Update, (PhantomSystems::Receive, PhantomSystems::Play, PhantomSystems::Sound).chain())
             .add_systems(Update, (receive, poll_haptics).chain().in_set(PhantomSystems::Receive))
-            .add_systems(Update, (lobby, keys, device_buttons, after_verdict, touch_bot).chain().in_set(PhantomSystems::Play))
             .add_systems(
                 Update,
-                (announce_events, museum_sounds, contact_sound, speak, send_tool_pose).chain().in_set(PhantomSystems::Sound),
+                (lobby, keys, device_buttons, after_verdict, touch_bot).chain().in_set(PhantomSystems::Play),
+            )
+            .add_systems(
+                Update,
+                (announce_events, museum_sounds, contact_sound, speak, send_tool_pose)
+                    .chain()
+                    .in_set(PhantomSystems::Sound),
             );
     }
 }
@@ -190,7 +195,12 @@ fn poll_haptics(
 ) {
     match haptics.poll() {
         Some(Ok(on)) => {
-            log::info!("copy {} on the bench: {} spheres{}", on.item.0, on.spheres, if on.cached { " (cached)" } else { "" });
+            log::info!(
+                "copy {} on the bench: {} spheres{}",
+                on.item.0,
+                on.spheres,
+                if on.cached { " (cached)" } else { "" }
+            );
             audio.earcon(Earcon::ReadyToFeel);
             if !settings.bot {
                 speaker.say("You can feel it now. Y if it is real, N if it is fake.");
@@ -208,7 +218,14 @@ fn session(q: &Query<&SessionView>) -> Option<SessionView> {
     q.iter().next().cloned()
 }
 
-fn send_verdict(state: &mut PhantomState, out: &mut MessageWriter<ClientMsg>, speaker: &mut Speaker, item: ItemId, real: bool, findings: Option<Findings>) {
+fn send_verdict(
+    state: &mut PhantomState,
+    out: &mut MessageWriter<ClientMsg>,
+    speaker: &mut Speaker,
+    item: ItemId,
+    real: bool,
+    findings: Option<Findings>,
+) {
     out.write(ClientMsg::Phantom(PhantomMsg::Verdict { item, real }));
     speaker.say(if real { "You say: real." } else { "You say: fake." });
     state.last_verdict = Some((item, real));
@@ -230,7 +247,9 @@ fn lobby(
     }
     if !state.greeted {
         state.greeted = true;
-        speaker.say("Welcome to Phantom Heist. You are Phantom, at the workbench. Up and down read the menu; Enter chooses.");
+        speaker.say(
+            "Welcome to Phantom Heist. You are Phantom, at the workbench. Up and down read the menu; Enter chooses.",
+        );
         speaker.say(MenuItem::ALL[0].label());
     }
     if settings.bot && s.phase == Phase::Lobby && !state.ready_sent {
@@ -301,7 +320,11 @@ fn keys(
         speaker.say(if b.is_empty() { "No briefing yet.".to_owned() } else { b });
     }
     if s.phase == Phase::Heist {
-        for (key, w) in [(KeyCode::KeyH, WarningKind::Hide), (KeyCode::KeyG, WarningKind::Go), (KeyCode::KeyC, WarningKind::ComeBack)] {
+        for (key, w) in [
+            (KeyCode::KeyH, WarningKind::Hide),
+            (KeyCode::KeyG, WarningKind::Go),
+            (KeyCode::KeyC, WarningKind::ComeBack),
+        ] {
             if keys.just_pressed(key) {
                 out.write(ClientMsg::Phantom(PhantomMsg::Warn(w)));
             }
@@ -435,7 +458,13 @@ fn touch_bot(
     state.judged = Some(item);
     let briefing = inbox.briefings.iter().find(|b| b.kind == kind);
     let real = briefing.is_some_and(|b| findings.matches(b));
-    log::info!("touch bot: copy {} of the {}: felt {} -> {}", item.0, kind.name(), findings.describe(), if real { "real" } else { "fake" });
+    log::info!(
+        "touch bot: copy {} of the {}: felt {} -> {}",
+        item.0,
+        kind.name(),
+        findings.describe(),
+        if real { "real" } else { "fake" }
+    );
     speaker.say(format!("I feel {}.", findings.spoken(kind)));
     send_verdict(&mut state, &mut out, &mut speaker, item, real, Some(findings));
 }
@@ -491,7 +520,11 @@ fn museum_sounds(
             }
             GameEvent::GuardAlert { alert, position, .. } => {
                 if matches!(alert, GuardAlert::Suspicious | GuardAlert::Chasing) {
-                    audio.play_at(crate::audio::synth::bark(*alert == GuardAlert::Chasing), at(*position, 1.7), "guard bark");
+                    audio.play_at(
+                        crate::audio::synth::bark(*alert == GuardAlert::Chasing),
+                        at(*position, 1.7),
+                        "guard bark",
+                    );
                 }
             }
             _ => {}
@@ -533,7 +566,11 @@ fn contact_sound(mut state: ResMut<PhantomState>, haptics: NonSend<Haptics>, mut
 
 /// The contact sound's parameters from force samples (mean contact force and sliding speed of the
 /// stylus); `last` carries the previous sample between frames; `feel` sets hardness and roughness.
-pub fn contact_params(samples: &[haptic_rig::ForceSample], last: &mut Option<(u64, Vec3)>, feel: Option<MaterialClass>) -> ContactParams {
+pub fn contact_params(
+    samples: &[haptic_rig::ForceSample],
+    last: &mut Option<(u64, Vec3)>,
+    feel: Option<MaterialClass>,
+) -> ContactParams {
     let (mut force, mut speed, mut n) = (0.0, 0.0, 0u32);
     for s in samples {
         let f = s.contact_force.length();
@@ -568,7 +605,12 @@ fn speak(mut speaker: NonSendMut<Speaker>, mut audio: NonSendMut<AudioEngine>) {
 }
 
 /// Tells the server where the stylus is (20 times a second, during the heist) so Vive sees it move.
-fn send_tool_pose(mut state: ResMut<PhantomState>, haptics: NonSend<Haptics>, q: Query<&SessionView>, mut out: MessageWriter<ClientMsg>) {
+fn send_tool_pose(
+    mut state: ResMut<PhantomState>,
+    haptics: NonSend<Haptics>,
+    q: Query<&SessionView>,
+    mut out: MessageWriter<ClientMsg>,
+) {
     state.frame += 1;
     if session(&q).is_none_or(|s| s.phase != Phase::Heist) || !state.frame.is_multiple_of(3) {
         return;
@@ -598,8 +640,12 @@ mod tests {
 
     #[test]
     fn haptic_contact_drives_the_contact_sound_and_free_space_leaves_it_silent() {
-        let mut audio = AudioEngine::new(&AudioSettings { output: AudioOutput::Manual, spatial: SpatialMode::Hrtf, ..Default::default() })
-            .expect("audio starts");
+        let mut audio = AudioEngine::new(&AudioSettings {
+            output: AudioOutput::Manual,
+            spatial: SpatialMode::Hrtf,
+            ..Default::default()
+        })
+        .expect("audio starts");
         let capture = audio.capture().expect("memory output").clone();
         let energy = |frames: Vec<(f32, f32)>| frames.iter().map(|f| f.0 * f.0 + f.1 * f.1).sum::<f32>();
         let mut last = None;

@@ -201,7 +201,9 @@ impl Device for SteeredSim {
 pub fn preset(name: Option<&str>) -> Result<DeviceSpecs, ClientError> {
     match name {
         None => Ok(haptico::presets::phantom_desktop()),
-        Some(n) => haptico::presets::by_name(n).ok_or_else(|| ClientError::Device(format!("no device preset named {n:?}"))),
+        Some(n) => {
+            haptico::presets::by_name(n).ok_or_else(|| ClientError::Device(format!("no device preset named {n:?}")))
+        }
     }
 }
 

@@ -215,7 +215,14 @@ impl Exploration {
         let (next, goal, seconds) = match self.stage {
             Stage::Settle => {
                 self.taps_start_us = start;
-                let taps = HandGoal::Taps { centre: Vec3::new(0.0, y, 0.0), r_out, r_in, n: TAPS as u32, tap_s: TAP_S, start_us: start };
+                let taps = HandGoal::Taps {
+                    centre: Vec3::new(0.0, y, 0.0),
+                    r_out,
+                    r_in,
+                    n: TAPS as u32,
+                    tap_s: TAP_S,
+                    start_us: start,
+                };
                 (Stage::Taps, taps, TAPS as f32 * TAP_S + 0.05)
             }
             Stage::Taps => {
@@ -350,7 +357,11 @@ impl Exploration {
 /// Places `copy` on the bench of a running [`crate::haptics::Haptics`] (sim device) and explores it;
 /// gives up after a minute for the build and a minute for the exploration. Used by the tests and the
 /// `feel_copies` example; the client runs the same steps from its systems.
-pub fn feel(h: &mut crate::haptics::Haptics, copy: &heist_shared::protocol::WorkbenchCopy, kind: ArtifactKind) -> Result<Findings, String> {
+pub fn feel(
+    h: &mut crate::haptics::Haptics,
+    copy: &heist_shared::protocol::WorkbenchCopy,
+    kind: ArtifactKind,
+) -> Result<Findings, String> {
     use std::time::{Duration, Instant};
     h.place(copy);
     let deadline = Instant::now() + Duration::from_secs(60);
@@ -365,7 +376,9 @@ pub fn feel(h: &mut crate::haptics::Haptics, copy: &heist_shared::protocol::Work
     }
     let mut ex = Exploration::new(kind, h.now_us());
     let map = h.map;
-    let hand = |h: &mut crate::haptics::Haptics, goal| h.hand.as_mut().map(|c| c.set(to_device(&map, goal))).ok_or("the device has no steerable hand");
+    let hand = |h: &mut crate::haptics::Haptics, goal| {
+        h.hand.as_mut().map(|c| c.set(to_device(&map, goal))).ok_or("the device has no steerable hand")
+    };
     hand(h, ex.goal())?;
     let deadline = Instant::now() + Duration::from_secs(60);
     while !ex.done() {
@@ -404,7 +417,9 @@ pub fn to_device(map: &haptic_rig::WorkspaceMap, goal: HandGoal) -> HandGoal {
     let d = |p: Vec3| map.to_device(&Pose::from_translation(p)).translation;
     match goal {
         HandGoal::Hold(p) => HandGoal::Hold(map.to_device(&p)),
-        HandGoal::Line { from, to, duration_s, start_us } => HandGoal::Line { from: d(from), to: d(to), duration_s, start_us },
+        HandGoal::Line { from, to, duration_s, start_us } => {
+            HandGoal::Line { from: d(from), to: d(to), duration_s, start_us }
+        }
         HandGoal::Orbit { centre, radius, start_rad, period_s, turns, start_us } => {
             HandGoal::Orbit { centre: d(centre), radius: radius / map.scale, start_rad, period_s, turns, start_us }
         }

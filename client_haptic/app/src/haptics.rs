@@ -119,7 +119,8 @@ impl Haptics {
         let tool_reference_volume_m3 = immersed_volume(tree.spheres(), glam::Vec3::X, REFERENCE_DEPTH_M);
         // The gem is far stiffer than any copy, and its friction is 1 so the copy's own coefficient decides
         // (see `haptic_material`).
-        let tool = ToolSpec::new(Arc::new(tree), Material { stiffness_n_per_m3: 1e12, damping_ns_per_m: 1e6, friction: 1.0 });
+        let tool =
+            ToolSpec::new(Arc::new(tree), Material { stiffness_n_per_m3: 1e12, damping_ns_per_m: 1e6, friction: 1.0 });
         let scale = if specs.workspace_radius_m > 0.0 { (0.08 / specs.workspace_radius_m).max(1.0) } else { 1.0 };
         let map = WorkspaceMap { origin: Pose::IDENTITY, scale };
         let mut config = RigConfig { map, ..RigConfig::default() };
@@ -235,7 +236,11 @@ impl Haptics {
                 );
                 *w = (t.0 - t.0 % WINDOW_US, 0, 0, with_copy);
             }
-            if t.1 { w.1 += 1 } else { w.2 += 1 }
+            if t.1 {
+                w.1 += 1
+            } else {
+                w.2 += 1
+            }
             w.3 &= with_copy;
         }
     }
@@ -293,7 +298,11 @@ pub fn cache_key(mesh: &HapticMesh, spheres: usize) -> String {
 }
 
 /// Builds (or loads) the tree of `mesh`; the flag tells whether it came from `cache`.
-pub fn build_tree(mesh: &HapticMesh, spheres: usize, cache: Option<&std::path::Path>) -> Result<(InnerSphereTree, bool), String> {
+pub fn build_tree(
+    mesh: &HapticMesh,
+    spheres: usize,
+    cache: Option<&std::path::Path>,
+) -> Result<(InnerSphereTree, bool), String> {
     let file = cache.map(|dir| dir.join(format!("{}.ist", cache_key(mesh, spheres))));
     if let Some(file) = &file
         && file.exists()
@@ -304,7 +313,8 @@ pub fn build_tree(mesh: &HapticMesh, spheres: usize, cache: Option<&std::path::P
         }
     }
     let vertices = mesh.vertices.iter().map(|v| Vec3::from_array(*v)).collect();
-    let tri = TriMesh::new(vertices, mesh.triangles.clone()).map_err(|e| format!("its mesh is not a closed surface: {e}"))?;
+    let tri =
+        TriMesh::new(vertices, mesh.triangles.clone()).map_err(|e| format!("its mesh is not a closed surface: {e}"))?;
     let (tree, _) = collette::build(&tri, &BuildOptions::spheres(spheres), &mut |_| {}).map_err(|e| e.to_string())?;
     if let Some(file) = &file {
         let saved = file.parent().map_or(Ok(()), std::fs::create_dir_all).map_err(|e| e.to_string());
@@ -328,13 +338,20 @@ mod tests {
         let one = [collette::Sphere { center: Vec3::ZERO, radius: r }];
         let cap = std::f32::consts::PI * d * d * (3.0 * r - d) / 3.0;
         assert!((immersed_volume(&one, Vec3::X, d) / cap - 1.0).abs() < 1e-4);
-        assert!((immersed_volume(&one, Vec3::X, 3.0 * r) / (4.0 / 3.0 * std::f32::consts::PI * r * r * r) - 1.0).abs() < 1e-4);
+        assert!(
+            (immersed_volume(&one, Vec3::X, 3.0 * r) / (4.0 / 3.0 * std::f32::consts::PI * r * r * r) - 1.0).abs()
+                < 1e-4
+        );
         let m = haptic_material(&MaterialClass::HardRough.material(), cap);
         let force = m.stiffness_n_per_m3 * cap;
         assert!((force / (800.0 * d) - 1.0).abs() < 1e-4, "{force} N at {d} m");
         let soft = haptic_material(&MaterialClass::SoftRough.material(), cap);
         assert!((m.stiffness_n_per_m3 / soft.stiffness_n_per_m3 - 800.0 / 300.0).abs() < 1e-3);
-        assert!((m.combine(&Material { stiffness_n_per_m3: 1e12, damping_ns_per_m: 1e6, friction: 1.0 }).friction - 0.6).abs() < 1e-4);
+        assert!(
+            (m.combine(&Material { stiffness_n_per_m3: 1e12, damping_ns_per_m: 1e6, friction: 1.0 }).friction - 0.6)
+                .abs()
+                < 1e-4
+        );
     }
 
     #[test]
@@ -347,7 +364,8 @@ mod tests {
         let (loaded, cached) = build_tree(&mesh, 300, Some(&dir)).expect("loads");
         assert!(cached, "the second build comes from the cache");
         assert_eq!(built.spheres().len(), loaded.spheres().len());
-        let differs = copies.iter().find(|c| c.feature_count != copies[0].feature_count).expect("a fake with another count");
+        let differs =
+            copies.iter().find(|c| c.feature_count != copies[0].feature_count).expect("a fake with another count");
         let other = build_mesh(differs, 3);
         assert_ne!(cache_key(&mesh, 300), cache_key(&other, 300));
         assert_ne!(cache_key(&mesh, 300), cache_key(&mesh, 301));
@@ -356,7 +374,8 @@ mod tests {
 
     #[test]
     fn a_broken_mesh_is_refused_with_the_reason() {
-        let mesh = HapticMesh { vertices: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], triangles: vec![[0, 1, 2]] };
+        let mesh =
+            HapticMesh { vertices: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], triangles: vec![[0, 1, 2]] };
         let err = build_tree(&mesh, 100, None).err().expect("refused");
         assert!(err.contains("not a closed surface"), "{err}");
     }

@@ -20,7 +20,7 @@ pub mod speech;
 pub mod status;
 pub mod terminal;
 
-/// The sounds (the shared `heist_audio` crate).
-pub use heist_audio as audio;
 pub use client::{PhantomClientPlugin, PhantomSettings, PhantomState, start};
 pub use error::ClientError;
+/// The sounds (the shared `heist_audio` crate).
+pub use heist_audio as audio;

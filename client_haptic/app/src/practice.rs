@@ -8,7 +8,10 @@
 use bevy::prelude::*;
 use heist_client::Inbox;
 use heist_shared::artifact::{self, ArtifactKind, CopyTraits};
-use heist_shared::protocol::{ClientMsg, GameEvent, ItemId, ItemKind, ItemPlace, ItemView, Phase, PhantomMsg, Role, SessionView, VerdictOutcome, WorkbenchCopy};
+use heist_shared::protocol::{
+    ClientMsg, GameEvent, ItemId, ItemKind, ItemPlace, ItemView, PhantomMsg, Phase, Role, SessionView, VerdictOutcome,
+    WorkbenchCopy,
+};
 
 /// The copies to practise on.
 #[derive(Resource, Debug, Clone)]
@@ -47,7 +50,10 @@ pub struct PracticePlugin;
 
 impl Plugin for PracticePlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<Inbox>().add_message::<ClientMsg>().add_systems(Startup, set_up).add_systems(Update, answer);
+        app.init_resource::<Inbox>()
+            .add_message::<ClientMsg>()
+            .add_systems(Startup, set_up)
+            .add_systems(Update, answer);
     }
 }
 
@@ -60,7 +66,13 @@ fn place(p: &Practice, inbox: &mut Inbox) {
 fn set_up(mut commands: Commands, p: Res<Practice>, mut inbox: ResMut<Inbox>) {
     inbox.role = Some(Role::Phantom);
     inbox.briefings = vec![artifact::briefing(&p.copies[p.real])];
-    commands.spawn(SessionView { phase: Phase::Heist, time_left_s: 600.0, alarm: 0, targets: vec![(p.kind, false)], present: (true, true) });
+    commands.spawn(SessionView {
+        phase: Phase::Heist,
+        time_left_s: 600.0,
+        alarm: 0,
+        targets: vec![(p.kind, false)],
+        present: (true, true),
+    });
     for i in 0..p.copies.len() {
         let kind = ItemKind::Copy { artifact: p.kind, look: artifact::look(p.kind) };
         commands.spawn(ItemView { id: ItemId(i as u16), kind, place: ItemPlace::Workbench });
@@ -82,7 +94,11 @@ fn answer(mut verdicts: MessageReader<ClientMsg>, mut p: ResMut<Practice>, mut i
             (false, false) => VerdictOutcome::Discarded,
             _ => VerdictOutcome::Wrong,
         };
-        if outcome == VerdictOutcome::Wrong { p.wrong += 1 } else { p.right += 1 }
+        if outcome == VerdictOutcome::Wrong {
+            p.wrong += 1
+        } else {
+            p.right += 1
+        }
         inbox.events.push(GameEvent::Verdict { item: *item, declared_real: *real, outcome });
         // Practice moves on after every verdict, right or wrong.
         p.next += 1;

@@ -65,24 +65,40 @@ impl Plugin for SpectatorPlugin {
 }
 
 fn setup(mut commands: Commands, mut meshes: ResMut<Assets<Mesh>>, mut materials: ResMut<Assets<StandardMaterial>>) {
-    commands.spawn((Camera3d::default(), Transform::from_xyz(0.16, 0.14, 0.26).looking_at(Vec3::new(0.0, -0.01, 0.0), Vec3::Y)));
+    commands.spawn((
+        Camera3d::default(),
+        Transform::from_xyz(0.16, 0.14, 0.26).looking_at(Vec3::new(0.0, -0.01, 0.0), Vec3::Y),
+    ));
     // A key light from the upper left and a weak ambient, so the copy's features read as shading.
     commands.spawn((
         DirectionalLight { illuminance: 12_000.0, shadow_maps_enabled: false, ..default() },
         Transform::from_xyz(-0.4, 0.7, 0.5).looking_at(Vec3::ZERO, Vec3::Y),
     ));
     commands.insert_resource(GlobalAmbientLight { brightness: 120.0, ..default() });
-    commands.spawn((PointLight { intensity: 20_000.0, range: 3.0, shadow_maps_enabled: false, ..default() }, Transform::from_xyz(0.25, 0.25, 0.2)));
+    commands.spawn((
+        PointLight { intensity: 20_000.0, range: 3.0, shadow_maps_enabled: false, ..default() },
+        Transform::from_xyz(0.25, 0.25, 0.2),
+    ));
     // The workbench top, under the copies (they stand on y ≈ −0.06).
     commands.spawn((
         Mesh3d(meshes.add(Cuboid::new(0.5, 0.02, 0.35))),
-        MeshMaterial3d(materials.add(StandardMaterial { base_color: Color::srgb(0.42, 0.28, 0.16), perceptual_roughness: 0.8, ..default() })),
+        MeshMaterial3d(materials.add(StandardMaterial {
+            base_color: Color::srgb(0.42, 0.28, 0.16),
+            perceptual_roughness: 0.8,
+            ..default()
+        })),
         Transform::from_xyz(0.0, -0.071, 0.0),
     ));
     commands.spawn((
         Gem,
-        Mesh3d(meshes.add(Sphere::new(TOOL_DIAMETER_M / 2.0).mesh().ico(3).unwrap_or_else(|_| Sphere::new(0.003).mesh().uv(16, 8)))),
-        MeshMaterial3d(materials.add(StandardMaterial { base_color: Color::srgb(0.7, 0.9, 1.0), emissive: LinearRgba::rgb(0.3, 0.6, 0.9), ..default() })),
+        Mesh3d(meshes.add(
+            Sphere::new(TOOL_DIAMETER_M / 2.0).mesh().ico(3).unwrap_or_else(|_| Sphere::new(0.003).mesh().uv(16, 8)),
+        )),
+        MeshMaterial3d(materials.add(StandardMaterial {
+            base_color: Color::srgb(0.7, 0.9, 1.0),
+            emissive: LinearRgba::rgb(0.3, 0.6, 0.9),
+            ..default()
+        })),
         Transform::from_xyz(0.0, 0.06, 0.07),
     ));
 }

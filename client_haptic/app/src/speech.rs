@@ -49,10 +49,9 @@ pub fn decode_wav(bytes: &[u8]) -> Result<(u32, Vec<f32>), ClientError> {
 
 /// Runs espeak-ng on `text` and returns the speech.
 pub fn synthesize(text: &str) -> Result<StaticSoundData, ClientError> {
-    let out = Command::new("espeak-ng")
-        .args(["--stdout", "-s", "175", "--", text])
-        .output()
-        .map_err(|e| ClientError::Speech(format!("could not run espeak-ng ({e}); install it with `apt-get install espeak-ng`")))?;
+    let out = Command::new("espeak-ng").args(["--stdout", "-s", "175", "--", text]).output().map_err(|e| {
+        ClientError::Speech(format!("could not run espeak-ng ({e}); install it with `apt-get install espeak-ng`"))
+    })?;
     if !out.status.success() {
         return Err(ClientError::Speech(format!("espeak-ng failed: {}", String::from_utf8_lossy(&out.stderr).trim())));
     }
@@ -165,7 +164,8 @@ mod tests {
     #[test]
     fn a_menu_item_is_spoken_and_heard() {
         use crate::audio::{AudioEngine, AudioOutput, AudioSettings};
-        let mut audio = AudioEngine::new(&AudioSettings { output: AudioOutput::Manual, ..Default::default() }).expect("audio starts");
+        let mut audio = AudioEngine::new(&AudioSettings { output: AudioOutput::Manual, ..Default::default() })
+            .expect("audio starts");
         let capture = audio.capture().expect("memory output").clone();
         let mut speaker = Speaker::new();
         speaker.say(crate::status::MenuItem::Ready.label());

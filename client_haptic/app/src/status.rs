@@ -5,7 +5,9 @@
 
 use glam::Vec2;
 use heist_shared::artifact::{ArtifactKind, number_in_words};
-use heist_shared::protocol::{GameEvent, GuardAlert, GuardView, LossReason, Phase, SessionView, VerdictOutcome, WarningKind};
+use heist_shared::protocol::{
+    GameEvent, GuardAlert, GuardView, LossReason, Phase, SessionView, VerdictOutcome, WarningKind,
+};
 
 /// The lobby menu, read item by item (up/down moves, Enter chooses).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -90,7 +92,13 @@ pub fn status(session: &SessionView, guards: &[&GuardView], vive: Option<Vec2>) 
     if let Some(v) = vive {
         for g in guards {
             let d = g.position - v;
-            out += &format!(" {}, {} metres {} of Vive, {}.", g.name, number_in_words(d.length().round() as u32), compass(d), alert_words(g.alert));
+            out += &format!(
+                " {}, {} metres {} of Vive, {}.",
+                g.name,
+                number_in_words(d.length().round() as u32),
+                compass(d),
+                alert_words(g.alert)
+            );
         }
     }
     out
@@ -177,7 +185,13 @@ mod tests {
             targets: vec![(ArtifactKind::Crown, true), (ArtifactKind::Amphora, false), (ArtifactKind::Idol, false)],
             present: (true, true),
         };
-        let clara = GuardView { id: GuardId(0), name: "Clara".into(), position: Vec2::new(5.0, 8.0), facing: 0.0, alert: GuardAlert::Patrolling };
+        let clara = GuardView {
+            id: GuardId(0),
+            name: "Clara".into(),
+            position: Vec2::new(5.0, 8.0),
+            facing: 0.0,
+            alert: GuardAlert::Patrolling,
+        };
         let s = status(&session, &[&clara], Some(Vec2::new(5.0, 2.0)));
         assert_eq!(
             s,
@@ -189,7 +203,11 @@ Alarm level one. Clara, six metres north of Vive, patrolling."
 
     #[test]
     fn verdicts_and_the_end_are_announced() {
-        let e = GameEvent::Verdict { item: heist_shared::protocol::ItemId(3), declared_real: true, outcome: VerdictOutcome::Wrong };
+        let e = GameEvent::Verdict {
+            item: heist_shared::protocol::ItemId(3),
+            declared_real: true,
+            outcome: VerdictOutcome::Wrong,
+        };
         assert!(announce(&e, |_| None).expect("spoken").starts_with("Wrong"));
         let won = announce(&GameEvent::PhaseChanged(Phase::Won), |_| None).expect("spoken");
         assert!(won.contains("won"));

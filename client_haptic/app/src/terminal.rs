@@ -49,7 +49,9 @@ impl Plugin for TerminalKeysPlugin {
         if let Err(e) = spawned {
             log::error!("no terminal keys: {e}");
         }
-        app.init_resource::<ButtonInput<KeyCode>>().insert_resource(Lines(Mutex::new(rx))).add_systems(PreUpdate, press);
+        app.init_resource::<ButtonInput<KeyCode>>()
+            .insert_resource(Lines(Mutex::new(rx)))
+            .add_systems(PreUpdate, press);
     }
 }
 

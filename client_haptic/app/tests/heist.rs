@@ -34,8 +34,9 @@ fn the_server_a_vive_bot_and_the_touch_bot_win_a_heist_over_loopback_udp() {
         audio: AudioSettings { output: AudioOutput::Background(Some(wav.clone())), ..Default::default() },
         ..Default::default()
     };
-    let mut phantom = join(&server, Role::Phantom, |app| client_haptic::start(app, settings).expect("Phantom's client starts"))
-        .expect("Phantom joins");
+    let mut phantom =
+        join(&server, Role::Phantom, |app| client_haptic::start(app, settings).expect("Phantom's client starts"))
+            .expect("Phantom joins");
 
     let tick = Duration::from_secs_f64(1.0 / TICK_HZ);
     let mut paced_since: Option<(Instant, u64)> = None;
@@ -77,7 +78,12 @@ fn the_server_a_vive_bot_and_the_touch_bot_win_a_heist_over_loopback_udp() {
         game.phase
     );
     for v in &state.verdicts {
-        println!("verdict on copy {}: {} ({:?})", v.item.0, if v.real { "real" } else { "fake" }, v.findings.as_ref().map(|f| f.describe()));
+        println!(
+            "verdict on copy {}: {} ({:?})",
+            v.item.0,
+            if v.real { "real" } else { "fake" },
+            v.findings.as_ref().map(|f| f.describe())
+        );
     }
     let haptics = phantom.world().non_send::<Haptics>();
     let felt: Vec<_> = haptics.rates.iter().filter(|w| w.with_copy).collect();
@@ -88,7 +94,12 @@ fn the_server_a_vive_bot_and_the_touch_bot_win_a_heist_over_loopback_udp() {
         min(|w| w.haptic_hz),
         min(|w| w.collision_hz)
     );
-    assert_eq!(game.phase, Phase::Won, "the heist should be won; log: {:?}", &server.log()[server.log().len().saturating_sub(15)..]);
+    assert_eq!(
+        game.phase,
+        Phase::Won,
+        "the heist should be won; log: {:?}",
+        &server.log()[server.log().len().saturating_sub(15)..]
+    );
     assert!(state.verdicts.iter().any(|v| v.findings.is_some()), "verdicts come from touch");
     assert!(!felt.is_empty(), "the haptic loop ran while copies were felt");
     drop(phantom);

@@ -24,7 +24,19 @@ fn the_spectator_window_shows_the_copy_under_xvfb_on_lavapipe() {
     let mut child = Command::new("xvfb-run")
         .args(["-a", "-s", "-screen 0 640x480x24"])
         .arg(env!("CARGO_BIN_EXE_client_haptic"))
-        .args(["practice", "--kind", "idol", "--seed", "3", "--bot", "--audio", "memory", "--shot-after", "150", "--screenshot"])
+        .args([
+            "practice",
+            "--kind",
+            "idol",
+            "--seed",
+            "3",
+            "--bot",
+            "--audio",
+            "memory",
+            "--shot-after",
+            "150",
+            "--screenshot",
+        ])
         .arg(&shot)
         .env("WGPU_BACKEND", "vulkan")
         .stdout(Stdio::null())

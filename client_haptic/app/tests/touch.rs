@@ -19,7 +19,11 @@ fn the_touch_bot_tells_every_copy_of_each_kind_by_touch() {
         let (copies, _) = generate_copies(kind, seed, 3);
         for traits in &copies {
             item += 1;
-            let copy = WorkbenchCopy { item: ItemId(item), mesh: build_mesh(traits, seed), material: traits.material.material() };
+            let copy = WorkbenchCopy {
+                item: ItemId(item),
+                mesh: build_mesh(traits, seed),
+                material: traits.material.material(),
+            };
             let f = feel(&mut h, &copy, kind).expect("the copy is explored");
             println!("{kind:?} {} {:?}: felt {}", traits.feature_count, traits.material, f.describe());
             if f.feature_count != traits.feature_count || f.material != traits.material {

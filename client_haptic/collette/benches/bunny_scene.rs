@@ -7,8 +7,12 @@
 //! `COLLETTE_BENCH_SIZES` (default `1000,5000,10000,50000`), `COLLETTE_BENCH_BUDGET_US` (default 80),
 //! `COLLETTE_BENCH_STRIDE` (use every n-th pose, default 1), `COLLETTE_BENCH_TABLE_ONLY` (skip criterion).
 
-use collette::scene::{Phase, TrajectorySample, brilliant_cut, default_bunny_path, load_bunny, trajectory, write_trajectory_csv};
-use collette::{BuildOptions, Budget, ContactSet, InnerSphereTree, Pose, QueryWorkspace, TriMesh, build, overlap, overlap_budgeted};
+use collette::scene::{
+    Phase, TrajectorySample, brilliant_cut, default_bunny_path, load_bunny, trajectory, write_trajectory_csv,
+};
+use collette::{
+    Budget, BuildOptions, ContactSet, InnerSphereTree, Pose, QueryWorkspace, TriMesh, build, overlap, overlap_budgeted,
+};
 use criterion::Criterion;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -30,7 +34,10 @@ fn stats(mut us: Vec<f64>) -> [f64; 3] {
 
 fn to_parry_pose(p: &Pose) -> parry3d::math::Pose {
     let (t, q) = (p.translation, p.rotation);
-    parry3d::math::Pose::from_parts(parry3d::math::Vector::new(t.x, t.y, t.z), parry3d::math::Rotation::from_xyzw(q.x, q.y, q.z, q.w))
+    parry3d::math::Pose::from_parts(
+        parry3d::math::Vector::new(t.x, t.y, t.z),
+        parry3d::math::Rotation::from_xyzw(q.x, q.y, q.z, q.w),
+    )
 }
 
 struct Built {
@@ -54,7 +61,12 @@ struct QueryRun {
     contact_fraction: f64,
 }
 
-fn run_queries(bunny: &InnerSphereTree, tool: &InnerSphereTree, path: &[TrajectorySample], budget: Duration) -> QueryRun {
+fn run_queries(
+    bunny: &InnerSphereTree,
+    tool: &InnerSphereTree,
+    path: &[TrajectorySample],
+    budget: Duration,
+) -> QueryRun {
     let mut ws = QueryWorkspace::new();
     let mut set = ContactSet::new();
     let (mut exact, mut budgeted) = (Vec::with_capacity(path.len()), Vec::with_capacity(path.len()));
@@ -72,7 +84,8 @@ fn run_queries(bunny: &InnerSphereTree, tool: &InnerSphereTree, path: &[Trajecto
         overlap_budgeted(tool, &s.tool, bunny, &Pose::IDENTITY, Budget::Unlimited, &mut ws, &mut set);
         aggregated.push(t2.elapsed().as_secs_f64() * 1e6);
         let t1 = Instant::now();
-        let part = overlap_budgeted(tool, &s.tool, bunny, &Pose::IDENTITY, Budget::Deadline(t1 + budget), &mut ws, &mut set);
+        let part =
+            overlap_budgeted(tool, &s.tool, bunny, &Pose::IDENTITY, Budget::Deadline(t1 + budget), &mut ws, &mut set);
         budgeted.push(t1.elapsed().as_secs_f64() * 1e6);
         if full.total_volume > 0.0 {
             // Volume-weighted: summed absolute error over summed exact volume of the phase.
@@ -128,11 +141,26 @@ fn main() {
     let parry = stats(parry_us);
 
     let mut table = String::new();
-    let _ = writeln!(table, "bunny scene: {} poses (stride {stride}), budget {} us, parry3d trimesh contact p50/p99/max = {:.1}/{:.1}/{:.1} us (contact in {:.1} % of poses)\n", path.len(), budget.as_micros(), parry[0], parry[1], parry[2], 100.0 * parry_hits as f64 / path.len() as f64);
-    let _ = writeln!(table, "| spheres | bunny build s | bunny coverage | tool build s | tool coverage | every-pair p50 / p99 / max us | aggregated p50 / p99 / max us | budgeted p50 / p99 / max us | budget error grazing / deep (volume-weighted) | max pairs | parry/aggregated p50 | parry/aggregated p99 |");
+    let _ = writeln!(
+        table,
+        "bunny scene: {} poses (stride {stride}), budget {} us, parry3d trimesh contact p50/p99/max = {:.1}/{:.1}/{:.1} us (contact in {:.1} % of poses)\n",
+        path.len(),
+        budget.as_micros(),
+        parry[0],
+        parry[1],
+        parry[2],
+        100.0 * parry_hits as f64 / path.len() as f64
+    );
+    let _ = writeln!(
+        table,
+        "| spheres | bunny build s | bunny coverage | tool build s | tool coverage | every-pair p50 / p99 / max us | aggregated p50 / p99 / max us | budgeted p50 / p99 / max us | budget error grazing / deep (volume-weighted) | max pairs | parry/aggregated p50 | parry/aggregated p99 |"
+    );
     let _ = writeln!(table, "|---|---|---|---|---|---|---|---|---|---|---|---|");
     let mut phases = String::new();
-    let _ = writeln!(phases, "\n| spheres | phase | every-pair p50 / p99 / max us | aggregated p50 / p99 / max us |\n|---|---|---|---|");
+    let _ = writeln!(
+        phases,
+        "\n| spheres | phase | every-pair p50 / p99 / max us | aggregated p50 / p99 / max us |\n|---|---|---|---|"
+    );
     let mut json = Vec::new();
     for &n in &sizes {
         let b = build_tree(&bunny, n);
@@ -144,13 +172,40 @@ fn main() {
         let _ = writeln!(
             table,
             "| {n} | {:.2} | {:.1} % | {:.2} | {:.1} % | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} / {:.1} | {:.1} % / {:.1} % | {} | {:.2} | {:.2} |",
-            b.seconds, b.coverage * 100.0, t.seconds, t.coverage * 100.0, exact[0], exact[1], exact[2], aggregated[0], aggregated[1], aggregated[2], budgeted[0], budgeted[1], budgeted[2],
-            run.budget_error_grazing * 100.0, run.budget_error_deep * 100.0, run.max_pairs, parry[0] / aggregated[0], parry[1] / aggregated[1]
+            b.seconds,
+            b.coverage * 100.0,
+            t.seconds,
+            t.coverage * 100.0,
+            exact[0],
+            exact[1],
+            exact[2],
+            aggregated[0],
+            aggregated[1],
+            aggregated[2],
+            budgeted[0],
+            budgeted[1],
+            budgeted[2],
+            run.budget_error_grazing * 100.0,
+            run.budget_error_deep * 100.0,
+            run.max_pairs,
+            parry[0] / aggregated[0],
+            parry[1] / aggregated[1]
         );
         for phase in [Phase::Free, Phase::Grazing, Phase::Deep] {
             let p = stats(run.exact.iter().filter(|e| e.1 == phase).map(|e| e.0).collect());
-            let q = stats(run.exact.iter().zip(&run.aggregated).filter(|(e, _)| e.1 == phase).map(|(_, a)| *a).collect());
-            let _ = writeln!(phases, "| {n} | {} | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} / {:.1} |", phase.as_str(), p[0], p[1], p[2], q[0], q[1], q[2]);
+            let q =
+                stats(run.exact.iter().zip(&run.aggregated).filter(|(e, _)| e.1 == phase).map(|(_, a)| *a).collect());
+            let _ = writeln!(
+                phases,
+                "| {n} | {} | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} / {:.1} |",
+                phase.as_str(),
+                p[0],
+                p[1],
+                p[2],
+                q[0],
+                q[1],
+                q[2]
+            );
         }
         json.push(serde_json::json!({
             "spheres": n, "bunny_build_seconds": b.seconds, "bunny_coverage": b.coverage,
@@ -164,7 +219,8 @@ fn main() {
     table.push_str(&phases);
     println!("{table}");
     std::fs::write(out_dir.join("bench_table.md"), &table).expect("table written");
-    std::fs::write(out_dir.join("bench_results.json"), serde_json::to_string_pretty(&json).unwrap_or_default()).expect("json written");
+    std::fs::write(out_dir.join("bench_results.json"), serde_json::to_string_pretty(&json).unwrap_or_default())
+        .expect("json written");
 
     if std::env::var_os("COLLETTE_BENCH_TABLE_ONLY").is_some() {
         return;
@@ -180,6 +236,8 @@ fn main() {
             bench.iter(|| overlap(&t, &pose, &b, &Pose::IDENTITY, &mut ws, &mut set).total_volume)
         });
     }
-    c.bench_function("build_bunny_1k", |bench| bench.iter(|| build(&bunny, &BuildOptions::spheres(1000), &mut |_| {}).map(|r| r.1.spheres)));
+    c.bench_function("build_bunny_1k", |bench| {
+        bench.iter(|| build(&bunny, &BuildOptions::spheres(1000), &mut |_| {}).map(|r| r.1.spheres))
+    });
     c.final_summary();
 }

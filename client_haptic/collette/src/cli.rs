@@ -75,7 +75,13 @@ pub fn run() -> anyhow::Result<()> {
         Command::Build { mesh, output, spheres, coverage, resolution, min_radius, scale, json } => {
             let raw = TriMesh::from_obj(&mesh).with_context(|| format!("loading {}", mesh.display()))?;
             let mesh_data = if scale == 1.0 { raw } else { raw.map_vertices(|v| v * scale)? };
-            let options = BuildOptions { target_spheres: spheres, target_coverage: coverage, min_radius, grid_resolution: resolution, ..BuildOptions::default() };
+            let options = BuildOptions {
+                target_spheres: spheres,
+                target_coverage: coverage,
+                min_radius,
+                grid_resolution: resolution,
+                ..BuildOptions::default()
+            };
             let bar = if json { indicatif::ProgressBar::hidden() } else { indicatif::ProgressBar::new(1000) };
             bar.set_style(
                 indicatif::ProgressStyle::with_template("{spinner} [{elapsed_precise}] {wide_bar} {msg}")
@@ -106,8 +112,15 @@ pub fn run() -> anyhow::Result<()> {
             } else {
                 println!("{} -> {} ({bytes} bytes)", mesh.display(), output.display());
                 println!("  spheres        {}", report.spheres);
-                println!("  coverage       {:.2} % of the exact mesh volume {:.6e}", report.coverage * 100.0, report.mesh_volume);
-                println!("  build time     {:.3} s (grid {} voxels on the long side)", report.build_seconds, report.grid_resolution);
+                println!(
+                    "  coverage       {:.2} % of the exact mesh volume {:.6e}",
+                    report.coverage * 100.0,
+                    report.mesh_volume
+                );
+                println!(
+                    "  build time     {:.3} s (grid {} voxels on the long side)",
+                    report.build_seconds, report.grid_resolution
+                );
                 println!("  hierarchy      {} nodes, depth {}", tree.nodes().len(), tree.depth());
             }
         }
@@ -137,7 +150,8 @@ pub fn run() -> anyhow::Result<()> {
         }
         Command::Render { file, output, size, yaw, pitch } => {
             let tree = InnerSphereTree::load(&file)?;
-            let image = crate::render::render_packing(&tree, size.clamp(16, 4096), yaw.to_radians(), pitch.to_radians());
+            let image =
+                crate::render::render_packing(&tree, size.clamp(16, 4096), yaw.to_radians(), pitch.to_radians());
             image.write_png(&output).with_context(|| format!("writing {}", output.display()))?;
             println!("{} -> {} ({}x{})", file.display(), output.display(), image.width, image.height);
         }

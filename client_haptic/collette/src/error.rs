@@ -40,7 +40,9 @@ pub enum MeshError {
         c: u32,
     },
     /// An edge belongs to fewer or more than two triangles, so the mesh is not closed (or not manifold).
-    #[error("edge {a}-{b} (first seen in triangle {triangle}) is shared by {count} triangle(s), not 2: the mesh is not closed")]
+    #[error(
+        "edge {a}-{b} (first seen in triangle {triangle}) is shared by {count} triangle(s), not 2: the mesh is not closed"
+    )]
     OpenEdge {
         /// First vertex of the edge.
         a: u32,

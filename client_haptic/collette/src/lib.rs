@@ -30,7 +30,10 @@ pub use error::{BuildError, IstFileError, MeshError, TrajectoryError};
 pub use packing::{BuildOptions, BuildProgress, BuildReport, build};
 pub use partitioning::{InnerSphereTree, Node};
 pub use pipeline::{CollisionConfig, CollisionHandle, CollisionThread, ContactReader, ObjectId, PoseWriter, WatcherId};
-pub use query::{Budget, OverlapResult, ProbeHit, QueryWorkspace, Separation, overlap, overlap_budgeted, overlap_volume, probe, separation};
+pub use query::{
+    Budget, OverlapResult, ProbeHit, QueryWorkspace, Separation, overlap, overlap_budgeted, overlap_volume, probe,
+    separation,
+};
 pub use shape::{Sphere, TriMesh};
 
 /// Types shared with the other haptic crates, re-exported for convenience.

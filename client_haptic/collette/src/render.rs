@@ -69,7 +69,13 @@ pub fn render_packing(tree: &InnerSphereTree, panel: u32, yaw: f32, pitch: f32) 
 
 /// Nearest sphere hit: (sphere index, point, normal). With a cut, spheres whose centre lies on the
 /// camera's side of the plane (point, normal) are skipped.
-fn trace(tree: &InnerSphereTree, o: Vec3, d: Vec3, cut: Option<(Vec3, Vec3)>, stack: &mut Vec<u32>) -> Option<(usize, Vec3, Vec3)> {
+fn trace(
+    tree: &InnerSphereTree,
+    o: Vec3,
+    d: Vec3,
+    cut: Option<(Vec3, Vec3)>,
+    stack: &mut Vec<u32>,
+) -> Option<(usize, Vec3, Vec3)> {
     let hit = |c: Vec3, r: f32| -> Option<f32> {
         let oc = o - c;
         let b = oc.dot(d);
@@ -118,7 +124,11 @@ fn trace(tree: &InnerSphereTree, o: Vec3, d: Vec3, cut: Option<(Vec3, Vec3)>, st
 fn shade(index: usize, _p: Vec3, n: Vec3, light: Vec3, dir: Vec3) -> [f32; 3] {
     // A stable pseudo-random hue per sphere, so neighbours are told apart.
     let h = (index as u32).wrapping_mul(2_654_435_761) as f32 / u32::MAX as f32;
-    let base = Vec3::new(0.55 + 0.45 * (TAU * h).cos(), 0.55 + 0.45 * (TAU * (h + 0.33)).cos(), 0.55 + 0.45 * (TAU * (h + 0.67)).cos());
+    let base = Vec3::new(
+        0.55 + 0.45 * (TAU * h).cos(),
+        0.55 + 0.45 * (TAU * (h + 0.33)).cos(),
+        0.55 + 0.45 * (TAU * (h + 0.67)).cos(),
+    );
     let diffuse = n.dot(light).max(0.0);
     let spec = (2.0 * n.dot(light) * n - light).dot(-dir).max(0.0).powf(24.0);
     let c = base * (0.25 + 0.75 * diffuse) + Vec3::splat(0.35 * spec);

@@ -21,7 +21,14 @@ fn build_info_and_render_work_end_to_end() {
     let dir = temp_dir();
     let (obj, ist, png) = (dir.join("cube.obj"), dir.join("cube.ist"), dir.join("cube.png"));
     std::fs::write(&obj, CUBE_OBJ).expect("write obj");
-    let out = bin().args(["build"]).arg(&obj).arg("-o").arg(&ist).args(["--spheres", "200", "--json"]).output().expect("runs");
+    let out = bin()
+        .args(["build"])
+        .arg(&obj)
+        .arg("-o")
+        .arg(&ist)
+        .args(["--spheres", "200", "--json"])
+        .output()
+        .expect("runs");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let summary: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json summary");
     assert_eq!(summary["spheres"], 200);

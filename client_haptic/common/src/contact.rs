@@ -52,10 +52,10 @@ impl Default for ContactSet {
 impl ContactSet {
     /// An empty set with its full capacity allocated (call this once, off the hot path).
     pub fn new() -> Self {
-        let contacts: Box<[Contact; MAX_CONTACTS]> =
-            vec![Contact::default(); MAX_CONTACTS].into_boxed_slice().try_into().unwrap_or_else(|_| {
-                unreachable!("vector has exactly MAX_CONTACTS elements")
-            });
+        let contacts: Box<[Contact; MAX_CONTACTS]> = vec![Contact::default(); MAX_CONTACTS]
+            .into_boxed_slice()
+            .try_into()
+            .unwrap_or_else(|_| unreachable!("vector has exactly MAX_CONTACTS elements"));
         Self {
             object_a: 0,
             object_b: 0,

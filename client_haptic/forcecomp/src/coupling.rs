@@ -52,14 +52,15 @@ impl Default for CouplingConfig {
 impl CouplingConfig {
     /// A coupling for a device: stiffness at 75 % of its max stiffness, damping within the passivity
     /// bound `hand_damping − K·T/2` (halved for margin) and within the device's max damping.
-    pub fn for_device(max_stiffness_n_per_m: f32, max_damping_ns_per_m: f32, hand_damping_ns_per_m: f32, period_s: f32) -> Self {
+    pub fn for_device(
+        max_stiffness_n_per_m: f32,
+        max_damping_ns_per_m: f32,
+        hand_damping_ns_per_m: f32,
+        period_s: f32,
+    ) -> Self {
         let k = 0.75 * max_stiffness_n_per_m;
         let bound = (hand_damping_ns_per_m - k * period_s / 2.0).max(0.0);
-        Self {
-            stiffness_n_per_m: k,
-            damping_ns_per_m: (0.5 * bound).min(max_damping_ns_per_m),
-            ..Self::default()
-        }
+        Self { stiffness_n_per_m: k, damping_ns_per_m: (0.5 * bound).min(max_damping_ns_per_m), ..Self::default() }
     }
 
     /// Checks every value.
@@ -148,12 +149,15 @@ impl VirtualCoupling {
             + h * (c.rot_damping_nms_per_rad + c.tool_rot_drag_nms_per_rad)
             + h * h * c.rot_stiffness_nm_per_rad;
         self.w = (c.tool_inertia_kg_m2 * self.w
-            + h * (c.rot_stiffness_nm_per_rad * err + c.rot_damping_nms_per_rad * device.angular_velocity + env.torque))
+            + h * (c.rot_stiffness_nm_per_rad * err
+                + c.rot_damping_nms_per_rad * device.angular_velocity
+                + env.torque))
             / denom_r;
         self.pose.rotation = (Quat::from_scaled_axis(self.w * h) * self.pose.rotation).normalize();
 
         // The device feels the spring pulling it towards the tool.
-        let force = c.stiffness_n_per_m * (self.pose.translation - xd) + c.damping_ns_per_m * (self.v - device.linear_velocity);
+        let force =
+            c.stiffness_n_per_m * (self.pose.translation - xd) + c.damping_ns_per_m * (self.v - device.linear_velocity);
         let err = rotation_error(self.pose.rotation, device.pose.rotation);
         let torque = c.rot_stiffness_nm_per_rad * err + c.rot_damping_nms_per_rad * (self.w - device.angular_velocity);
         let out = ForceTorque { force, torque };
@@ -200,7 +204,11 @@ mod tests {
         let mut c = VirtualCoupling::new(CouplingConfig::default());
         let mut out = ForceTorque::ZERO;
         for _ in 0..5000 {
-            out = c.step(&device_at(Vec3::ZERO), ForceTorque { force: Vec3::new(0.0, 0.0, 2.0), torque: Vec3::ZERO }, 0.001);
+            out = c.step(
+                &device_at(Vec3::ZERO),
+                ForceTorque { force: Vec3::new(0.0, 0.0, 2.0), torque: Vec3::ZERO },
+                0.001,
+            );
         }
         // At rest: k (x_tool - x_dev) = F_contact, the device feels +2 N.
         assert!((out.force.z - 2.0).abs() < 1e-3, "{:?}", out.force);
@@ -213,7 +221,11 @@ mod tests {
         c.step(&device_at(Vec3::ZERO), ForceTorque::ZERO, 0.001);
         let target = Quat::from_rotation_z(0.5);
         for _ in 0..5000 {
-            c.step(&DeviceState { pose: Pose::new(Vec3::ZERO, target), ..Default::default() }, ForceTorque::ZERO, 0.001);
+            c.step(
+                &DeviceState { pose: Pose::new(Vec3::ZERO, target), ..Default::default() },
+                ForceTorque::ZERO,
+                0.001,
+            );
         }
         assert!(c.tool_pose().rotation.angle_between(target) < 1e-3);
     }
@@ -228,7 +240,8 @@ mod tests {
     #[test]
     fn non_finite_contact_forces_are_ignored() {
         let mut c = VirtualCoupling::new(CouplingConfig::default());
-        let out = c.step(&device_at(Vec3::ZERO), ForceTorque { force: Vec3::splat(f32::NAN), torque: Vec3::ZERO }, 0.001);
+        let out =
+            c.step(&device_at(Vec3::ZERO), ForceTorque { force: Vec3::splat(f32::NAN), torque: Vec3::ZERO }, 0.001);
         assert!(out.is_finite());
         assert!(c.tool_pose().is_finite());
     }

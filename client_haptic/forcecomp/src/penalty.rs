@@ -27,7 +27,12 @@ pub const FRICTION_REGULARIZATION_M_PER_S: f32 = 1e-3;
 ///
 /// Contacts with a non-finite field or a non-positive volume are skipped, and non-finite motion counts
 /// as rest, so the result is always finite. Allocation-free.
-pub fn volumetric_penalty(contacts: &ContactSet, tool: &BodyMotion, object: &BodyMotion, material: &Material) -> ForceTorque {
+pub fn volumetric_penalty(
+    contacts: &ContactSet,
+    tool: &BodyMotion,
+    object: &BodyMotion,
+    material: &Material,
+) -> ForceTorque {
     let valid = |c: &&haptic_common::Contact| {
         c.point.is_finite() && c.normal.is_finite() && c.volume.is_finite() && c.volume > 0.0 && c.normal != Vec3::ZERO
     };

@@ -313,11 +313,8 @@ mod tests {
     #[test]
     fn nan_and_infinite_requests_never_reach_the_output() {
         let mut s = engaged(SafetyConfig::for_limits(3.3, 0.2));
-        let out = s.apply(
-            ForceTorque { force: Vec3::new(f32::NAN, 1.0, 0.0), torque: Vec3::splat(f32::INFINITY) },
-            DT,
-            0.0,
-        );
+        let out =
+            s.apply(ForceTorque { force: Vec3::new(f32::NAN, 1.0, 0.0), torque: Vec3::splat(f32::INFINITY) }, DT, 0.0);
         assert!(out.is_finite());
         assert!(s.apply(ft(1.0), f32::NAN, f32::NAN).is_finite());
         assert_eq!(s.stats().non_finite, 2);

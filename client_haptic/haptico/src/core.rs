@@ -26,7 +26,10 @@ impl Default for HapticEvents {
 impl HapticEvents {
     /// Events with room for `capacity` delegates each (delegates bound later through the handle do not allocate).
     pub fn with_capacity(capacity: usize) -> Self {
-        Self { on_transform: Delegator::with_capacity(capacity), force_on_haptic_tick: Delegator::with_capacity(capacity) }
+        Self {
+            on_transform: Delegator::with_capacity(capacity),
+            force_on_haptic_tick: Delegator::with_capacity(capacity),
+        }
     }
 }
 
@@ -133,9 +136,9 @@ mod tests {
         let mut events = HapticEvents::default();
         let seen = std::sync::Arc::new(std::sync::atomic::AtomicU64::new(0));
         let s = seen.clone();
-        events.on_transform.add_delegate(move |st: &OnTransform| {
-            s.store(st.timestamp_us, std::sync::atomic::Ordering::Relaxed)
-        });
+        events
+            .on_transform
+            .add_delegate(move |st: &OnTransform| s.store(st.timestamp_us, std::sync::atomic::Ordering::Relaxed));
         events.force_on_haptic_tick.add_delegate(|t: &ForceOnHapticTick| {
             t.add(ForceTorque { force: Vec3::new(2.0, 0.0, 0.0), torque: Vec3::ZERO })
         });
@@ -169,9 +172,9 @@ mod tests {
     fn disabled_forces_command_zero() {
         let (dev, log) = MockDevice::touch();
         let mut events = HapticEvents::default();
-        events.force_on_haptic_tick.add_delegate(|t: &ForceOnHapticTick| {
-            t.add(ForceTorque { force: Vec3::ONE, torque: Vec3::ZERO })
-        });
+        events
+            .force_on_haptic_tick
+            .add_delegate(|t: &ForceOnHapticTick| t.add(ForceTorque { force: Vec3::ONE, torque: Vec3::ZERO }));
         let mut core = HapticCore::new(dev, events, 1000.0);
         core.set_forces_enabled(false);
         assert_eq!(core.tick(0), ForceTorque::ZERO);

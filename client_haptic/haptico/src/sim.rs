@@ -343,7 +343,8 @@ mod tests {
 
     #[test]
     fn reported_velocity_follows_the_true_velocity_on_a_slow_motion() {
-        let mut dev = SimDevice::new(SimConfig::new(presets::touch()), TargetPath::line(Vec3::ZERO, Vec3::X * 0.1, 2.0));
+        let mut dev =
+            SimDevice::new(SimConfig::new(presets::touch()), TargetPath::line(Vec3::ZERO, Vec3::X * 0.1, 2.0));
         let mut last = DeviceState::default();
         run(&mut dev, 1.0, |_, s| last = *s);
         assert!((last.linear_velocity.x - 0.05).abs() < 0.01, "{:?}", last.linear_velocity);

@@ -423,9 +423,8 @@ mod tests {
     #[test]
     fn the_thread_ticks_near_its_rate_and_stops_on_request() {
         let (device, log) = MockDevice::touch();
-        let handle =
-            HapticHandle::spawn(device, HapticEvents::default(), HapticConfig::default(), HapticClock::new())
-                .expect("spawn");
+        let handle = HapticHandle::spawn(device, HapticEvents::default(), HapticConfig::default(), HapticClock::new())
+            .expect("spawn");
         std::thread::sleep(Duration::from_millis(200));
         // Loose bounds: timing is measured by haptic-bench in release mode, not here.
         assert!(eventually(|| handle.telemetry().ticks > 20));
@@ -441,9 +440,8 @@ mod tests {
     #[test]
     fn delegates_bound_through_the_handle_run_and_come_back_to_be_freed_once_unbound() {
         let (device, log) = MockDevice::touch();
-        let handle =
-            HapticHandle::spawn(device, HapticEvents::default(), HapticConfig::default(), HapticClock::new())
-                .expect("spawn");
+        let handle = HapticHandle::spawn(device, HapticEvents::default(), HapticConfig::default(), HapticClock::new())
+            .expect("spawn");
         let d = handle
             .bind_force(|t: &ForceOnHapticTick| t.add(ForceTorque { force: Vec3::X, torque: Vec3::ZERO }))
             .expect("bind");

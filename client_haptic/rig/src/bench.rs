@@ -42,7 +42,12 @@ pub struct Window {
 }
 
 /// Counts, per window of `window_us`, the starts in `starts_us` (sorted), from `origin_us` on.
-pub fn count_per_window(starts_us: impl Iterator<Item = u64>, origin_us: u64, window_us: u64, windows: usize) -> Vec<u32> {
+pub fn count_per_window(
+    starts_us: impl Iterator<Item = u64>,
+    origin_us: u64,
+    window_us: u64,
+    windows: usize,
+) -> Vec<u32> {
     let mut counts = vec![0u32; windows];
     for s in starts_us {
         if s < origin_us {
@@ -133,7 +138,13 @@ pub fn steps_from_sequences(forces: &[ForceSample]) -> Vec<StepTiming> {
             let n = if last_seq == 0 { 1 } else { s.collision_sequence - last_seq };
             for _ in 0..n {
                 let period_us = last_start.map_or(0, |l| s.t_us.saturating_sub(l)) as u32;
-                out.push(StepTiming { sequence: s.collision_sequence, start_us: s.t_us, period_us, contacts: s.contacts, ..Default::default() });
+                out.push(StepTiming {
+                    sequence: s.collision_sequence,
+                    start_us: s.t_us,
+                    period_us,
+                    contacts: s.contacts,
+                    ..Default::default()
+                });
                 last_start = Some(s.t_us);
             }
             last_seq = s.collision_sequence;
@@ -144,7 +155,13 @@ pub fn steps_from_sequences(forces: &[ForceSample]) -> Vec<StepTiming> {
 
 /// Attributes hypervisor steal to windows: `samples` are (haptic-clock µs, cumulative steal ms) taken
 /// every few tens of ms; a window gets the steal between the last sample before it and the first after it.
-pub fn add_steal(windows: &mut [Window], haptic: &[TickTiming], samples: &[(u64, u64)], window_us: u64, nominal_period_us: u64) {
+pub fn add_steal(
+    windows: &mut [Window],
+    haptic: &[TickTiming],
+    samples: &[(u64, u64)],
+    window_us: u64,
+    nominal_period_us: u64,
+) {
     let Some(first) = haptic.first() else { return };
     let origin = first.start_us.saturating_sub(nominal_period_us / 2);
     for (i, w) in windows.iter_mut().enumerate() {
@@ -181,7 +198,13 @@ pub struct Summary {
 }
 
 /// Summarizes a run.
-pub fn summary(windows: &[Window], haptic: &[TickTiming], collision: &[StepTiming], forces: &[ForceSample], nominal_period_us: u32) -> Summary {
+pub fn summary(
+    windows: &[Window],
+    haptic: &[TickTiming],
+    collision: &[StepTiming],
+    forces: &[ForceSample],
+    nominal_period_us: u32,
+) -> Summary {
     let as_ticks: Vec<TickTiming> = collision
         .iter()
         .map(|s| TickTiming { tick: s.sequence, start_us: s.start_us, period_us: s.period_us, work_us: s.work_us })
@@ -251,7 +274,12 @@ pub fn plot(path: &Path, windows: &[Window], title: &str) -> Result<(), Box<dyn 
         .label("collision detection")
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
     chart.draw_series(LineSeries::new([(0.0, 1000.0), (t_max, 1000.0)], BLACK.mix(0.3)))?;
-    chart.configure_series_labels().position(SeriesLabelPosition::LowerRight).background_style(WHITE.mix(0.8)).border_style(BLACK).draw()?;
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerRight)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
 
     let f_max = windows.iter().map(|w| w.force_max_n).fold(0.1, f32::max) as f64 * 1.1;
     let tau_max = windows.iter().map(|w| w.torque_max_nm).fold(0.001, f32::max) as f64 * 1.1;
@@ -275,7 +303,12 @@ pub fn plot(path: &Path, windows: &[Window], title: &str) -> Result<(), Box<dyn 
         ))?
         .label("|torque| (window mean)")
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], MAGENTA.stroke_width(2)));
-    chart.configure_series_labels().position(SeriesLabelPosition::UpperLeft).background_style(WHITE.mix(0.8)).border_style(BLACK).draw()?;
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
     root.present()?;
     Ok(())
 }
@@ -288,7 +321,12 @@ mod tests {
 
     fn ticks(period_us: u64, n: u64, start: u64) -> Vec<TickTiming> {
         (0..n)
-            .map(|i| TickTiming { tick: i, start_us: start + i * period_us, period_us: if i == 0 { 0 } else { period_us as u32 }, work_us: 10 })
+            .map(|i| TickTiming {
+                tick: i,
+                start_us: start + i * period_us,
+                period_us: if i == 0 { 0 } else { period_us as u32 },
+                work_us: 10,
+            })
             .collect()
     }
 
@@ -314,7 +352,11 @@ mod tests {
     fn forces_are_averaged_per_window_and_the_largest_step_is_found() {
         let h = ticks(1000, 300, 0);
         let f: Vec<ForceSample> = (0..300u64)
-            .map(|i| ForceSample { t_us: i * 1000, force: Vec3::X * if i < 150 { 1.0 } else { 2.0 }, ..Default::default() })
+            .map(|i| ForceSample {
+                t_us: i * 1000,
+                force: Vec3::X * if i < 150 { 1.0 } else { 2.0 },
+                ..Default::default()
+            })
             .collect();
         let w = windows(&h, &[], &f, 100_000, 1000);
         assert!((w[0].force_mean_n - 1.0).abs() < 1e-6 && w[1].force_max_n == 2.0);

@@ -35,7 +35,14 @@ pub struct CollisionConfig {
 
 impl Default for CollisionConfig {
     fn default() -> Self {
-        Self { rate_hz: 1000.0, budget_us: 500, spin_margin_us: 300, timing_capacity: 1 << 16, catch_up_periods: 5, realtime_priority: None }
+        Self {
+            rate_hz: 1000.0,
+            budget_us: 500,
+            spin_margin_us: 300,
+            timing_capacity: 1 << 16,
+            catch_up_periods: 5,
+            realtime_priority: None,
+        }
     }
 }
 
@@ -163,8 +170,15 @@ impl CollisionWorld {
             let slot = &mut frame.objects[count];
             let budget = deadline.map_or(Budget::Unlimited, Budget::Deadline);
             let spec = &object.spec;
-            let result =
-                overlap_budgeted(&self.tool.tree, &pose.pose, &spec.tree, &spec.pose, budget, &mut self.workspace, &mut slot.contacts);
+            let result = overlap_budgeted(
+                &self.tool.tree,
+                &pose.pose,
+                &spec.tree,
+                &spec.pose,
+                budget,
+                &mut self.workspace,
+                &mut slot.contacts,
+            );
             budget_hit |= !result.complete;
             if slot.contacts.is_empty() {
                 continue;

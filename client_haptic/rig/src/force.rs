@@ -84,10 +84,7 @@ pub enum Rendering {
 /// Where the force stage gets contacts from and sends the tool pose to.
 pub(crate) enum Source {
     /// The rig's own collision thread ([`crate::collision`]).
-    Rig {
-        frames: triple_buffer::Output<CollisionFrame>,
-        poses: triple_buffer::Input<ToolPoseMsg>,
-    },
+    Rig { frames: triple_buffer::Output<CollisionFrame>, poses: triple_buffer::Input<ToolPoseMsg> },
     /// collette's collision pipeline thread.
     Collette(Box<ColletteSource>),
 }

@@ -30,12 +30,26 @@ impl<D: Device> Lockstep<D> {
     /// A lockstep rig; the collision step runs before every `collision_every`-th haptic tick, using the
     /// tool pose of the tick before (as the threaded rig does at best). `budget` limits each step's
     /// queries in wall-clock time (None: exact queries, fully deterministic).
-    pub fn new(device: D, tool: ToolSpec, config: &RigConfig, collision_every: u64, budget: Option<Duration>) -> Result<Self> {
+    pub fn new(
+        device: D,
+        tool: ToolSpec,
+        config: &RigConfig,
+        collision_every: u64,
+        budget: Option<Duration>,
+    ) -> Result<Self> {
         let Parts { mut stage, world, inner } = Parts::new(device.specs(), tool, config, Delegator::new())?;
         let mut events = HapticEvents::default();
         events.force_on_haptic_tick.add_delegate(move |tick| stage.on_tick(tick));
         let core = HapticCore::new(device, events, config.haptic.rate_hz);
-        Ok(Self { core, world, inner, clock: HapticClock::new(), collision_every: collision_every.max(1), budget, paused: false })
+        Ok(Self {
+            core,
+            world,
+            inner,
+            clock: HapticClock::new(),
+            collision_every: collision_every.max(1),
+            budget,
+            paused: false,
+        })
     }
 
     /// Watches an object.

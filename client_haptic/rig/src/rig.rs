@@ -208,7 +208,12 @@ impl<D: Device + 'static> HapticRig<D> {
         }));
         events.force_on_haptic_tick.add_delegate(move |tick| stage.on_tick(tick));
         let haptic = HapticHandle::spawn(device, events, config.haptic.clone(), clock)?;
-        Ok(Self { haptic: Some(haptic), inner: Mutex::new(inner), collette: Some(Mutex::new(pipeline)), _static_poses: Mutex::new(writers) })
+        Ok(Self {
+            haptic: Some(haptic),
+            inner: Mutex::new(inner),
+            collette: Some(Mutex::new(pipeline)),
+            _static_poses: Mutex::new(writers),
+        })
     }
 
     fn refuse_in_collette_mode(&self) -> Result<()> {

@@ -16,9 +16,14 @@ use haptico::sim::{Keyframe, SimConfig, SimDevice, TargetPath};
 #[test]
 fn clamps_and_force_rate_hold_along_the_whole_benchmark_trace() {
     let bunny_mesh = scene::load_bunny(scene::default_bunny_path()).expect("bunny");
-    let (bunny, _) = collette::build(&bunny_mesh, &collette::BuildOptions::spheres(1500), &mut |_| {}).expect("bunny tree");
-    let (gem, _) = collette::build(&scene::brilliant_cut(scene::TOOL_DIAMETER), &collette::BuildOptions::spheres(150), &mut |_| {})
-        .expect("gem tree");
+    let (bunny, _) =
+        collette::build(&bunny_mesh, &collette::BuildOptions::spheres(1500), &mut |_| {}).expect("bunny tree");
+    let (gem, _) = collette::build(
+        &scene::brilliant_cut(scene::TOOL_DIAMETER),
+        &collette::BuildOptions::spheres(150),
+        &mut |_| {},
+    )
+    .expect("gem tree");
     let path = scene::trajectory(&bunny_mesh);
     let keyframes = path.iter().map(|s| Keyframe { t_s: s.time_s, pose: s.tool }).collect();
     let specs = presets::phantom_premium_6dof();
@@ -31,8 +36,9 @@ fn clamps_and_force_rate_hold_along_the_whole_benchmark_trace() {
     let config = RigConfig { safety: Some(safety), ..RigConfig::default() };
     // Very stiff materials, so that the deep stretch asks for more than the device's peak force.
     let stiff = Material { stiffness_n_per_m3: 1e10, damping_ns_per_m: 4.0, friction: 0.3 };
-    let mut rig = Lockstep::new(device, ToolSpec::new(Arc::new(gem), stiff), &config, 2, Some(Duration::from_micros(400)))
-        .expect("rig");
+    let mut rig =
+        Lockstep::new(device, ToolSpec::new(Arc::new(gem), stiff), &config, 2, Some(Duration::from_micros(400)))
+            .expect("rig");
     rig.add_object(ObjectSpec { id: 1, tree: Arc::new(bunny), pose: Pose::IDENTITY, material: stiff }).expect("bunny");
 
     let mut previous = haptic_common::ForceTorque::ZERO;
@@ -46,7 +52,9 @@ fn clamps_and_force_rate_hold_along_the_whole_benchmark_trace() {
         touched += (rig.telemetry().contacts > 0) as u32;
         previous = out;
     }
-    eprintln!("max |F| {max_f:.3} N, max |tau| {max_tau:.4} N.m, max |dF| {max_step:.3} N/tick, {touched} ticks in contact");
+    eprintln!(
+        "max |F| {max_f:.3} N, max |tau| {max_tau:.4} N.m, max |dF| {max_step:.3} N/tick, {touched} ticks in contact"
+    );
     assert!(touched > 10_000, "the path does touch the bunny");
     assert!(max_f <= specs.peak_force_n + 1e-4);
     assert!(max_tau <= specs.max_torque_nm + 1e-5);

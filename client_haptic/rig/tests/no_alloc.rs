@@ -23,7 +23,12 @@ fn a_steady_state_rig_tick_neither_allocates_nor_frees() {
     );
     let tool = ToolSpec::new(utils::ball_tool(), Material::default());
     let mut rig = Lockstep::new(device, tool, &RigConfig::default(), 1, None).expect("rig");
-    let slab = ObjectSpec { id: 1, tree: utils::slab(), pose: Pose::from_translation(Vec3::new(0.0, -0.01, 0.0)), material: Material::default() };
+    let slab = ObjectSpec {
+        id: 1,
+        tree: utils::slab(),
+        pose: Pose::from_translation(Vec3::new(0.0, -0.01, 0.0)),
+        material: Material::default(),
+    };
     rig.add_object(slab).expect("object");
     let mut t = 0;
     for _ in 0..500 {

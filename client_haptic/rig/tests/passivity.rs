@@ -25,8 +25,13 @@ fn push_into_wall(rendering: Rendering, seconds: f64) -> Vec<(f32, f32, f32)> {
     };
     let tool = ToolSpec::new(utils::ball_tool(), Material { stiffness_n_per_m3: 1e9, ..Material::default() });
     let mut rig = Lockstep::new(device, tool, &config, 1, None).expect("rig");
-    rig.add_object(ObjectSpec { id: 1, tree: utils::slab(), pose: Pose::from_translation(Vec3::new(0.0, -0.01, 0.0)), material: stiff })
-        .expect("object");
+    rig.add_object(ObjectSpec {
+        id: 1,
+        tree: utils::slab(),
+        pose: Pose::from_translation(Vec3::new(0.0, -0.01, 0.0)),
+        material: stiff,
+    })
+    .expect("object");
     let ticks = (seconds * 1000.0) as u64;
     let mut out = Vec::with_capacity(ticks as usize);
     for i in 0..ticks {
@@ -48,7 +53,10 @@ fn with_the_coupling_a_stiff_wall_gains_no_energy_and_settles() {
     let ke_last = max_in(last, |s| s.1);
     let y_min = last.iter().map(|s| s.0).fold(f32::INFINITY, f32::min);
     let y_max = last.iter().map(|s| s.0).fold(f32::NEG_INFINITY, f32::max);
-    eprintln!("coupled: KE {ke_before:.2e} -> {ke_last:.2e} J, y in [{y_min:.5}, {y_max:.5}], |F| {:.3} N", last[999].2);
+    eprintln!(
+        "coupled: KE {ke_before:.2e} -> {ke_last:.2e} J, y in [{y_min:.5}, {y_max:.5}], |F| {:.3} N",
+        last[999].2
+    );
     assert!(ke_last <= ke_before + 1e-7, "energy grew: {ke_before} -> {ke_last}");
     assert!(ke_last < 1e-6, "no sustained oscillation: {ke_last} J");
     assert!(y_max - y_min < 2e-4, "settled: {y_min}..{y_max}");

@@ -40,18 +40,26 @@ fn the_rig_runs_both_threads_and_broadcasts_collisions() {
     });
     let tool = ToolSpec::new(utils::ball_tool(), Material::default());
     let rig = HapticRig::start(device, tool, RigConfig::default(), HapticEvents::default(), on_collision).expect("rig");
-    rig.add_object(ObjectSpec { id: 3, tree: utils::slab(), pose: Pose::from_translation(Vec3::new(0.0, -0.01, 0.0)), material: Material::default() })
-        .expect("object");
+    rig.add_object(ObjectSpec {
+        id: 3,
+        tree: utils::slab(),
+        pose: Pose::from_translation(Vec3::new(0.0, -0.01, 0.0)),
+        material: Material::default(),
+    })
+    .expect("object");
     assert!(eventually(|| rig.haptic_telemetry().ticks > 50 && rig.telemetry().collision_sequence > 50));
     assert!(eventually(|| hits.load(std::sync::atomic::Ordering::Relaxed) > 0), "OnCollision fired with contacts");
     let mut samples = Vec::new();
     assert!(rig.drain_force_samples(&mut samples) > 50);
     rig.remove_object(3).expect("remove");
     let mut freed = 0;
-    assert!(eventually(|| {
-        freed += rig.collect_garbage();
-        freed >= 1
-    }), "the removed object came back to be freed here");
+    assert!(
+        eventually(|| {
+            freed += rig.collect_garbage();
+            freed >= 1
+        }),
+        "the removed object came back to be freed here"
+    );
     assert!(rig.stop().is_some());
 }
 
@@ -62,9 +70,19 @@ fn the_rig_also_runs_on_collettes_pipeline_thread() {
         TargetPath::line(Vec3::new(0.0, 0.01, 0.0), Vec3::new(0.0, -0.002, 0.0), 0.1),
     );
     let tool = ToolSpec::new(utils::ball_tool(), Material::default());
-    let slab = ObjectSpec { id: 3, tree: utils::slab(), pose: Pose::from_translation(Vec3::new(0.0, -0.01, 0.0)), material: Material::default() };
-    let rig = HapticRig::start_with_collette(device, tool, vec![slab], RigConfig::default(), HapticEvents::default()).expect("rig");
-    assert!(eventually(|| rig.telemetry().collision_sequence > 50 && rig.telemetry().contacts > 0), "{:?}", rig.telemetry());
+    let slab = ObjectSpec {
+        id: 3,
+        tree: utils::slab(),
+        pose: Pose::from_translation(Vec3::new(0.0, -0.01, 0.0)),
+        material: Material::default(),
+    };
+    let rig = HapticRig::start_with_collette(device, tool, vec![slab], RigConfig::default(), HapticEvents::default())
+        .expect("rig");
+    assert!(
+        eventually(|| rig.telemetry().collision_sequence > 50 && rig.telemetry().contacts > 0),
+        "{:?}",
+        rig.telemetry()
+    );
     let tel = rig.telemetry();
     assert!(tel.data_age_us < 1_000_000, "{tel:?}");
     assert!(matches!(rig.pause_collision(true), Err(haptic_rig::RigError::Unsupported(_))));

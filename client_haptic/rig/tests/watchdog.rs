@@ -21,8 +21,13 @@ fn pausing_the_collision_thread_ramps_the_force_to_zero() {
     let tool = ToolSpec::new(utils::ball_tool(), Material::default());
     let mut rig = Lockstep::new(device, tool, &config, 1, None).expect("rig");
     let slab = Material { stiffness_n_per_m3: 1e9, damping_ns_per_m: 1.0, friction: 0.0 };
-    rig.add_object(ObjectSpec { id: 7, tree: utils::slab(), pose: Pose::from_translation(Vec3::new(0.0, -0.01, 0.0)), material: slab })
-        .expect("object");
+    rig.add_object(ObjectSpec {
+        id: 7,
+        tree: utils::slab(),
+        pose: Pose::from_translation(Vec3::new(0.0, -0.01, 0.0)),
+        material: slab,
+    })
+    .expect("object");
     let mut t = 0u64;
     for _ in 0..1500 {
         rig.tick(t);

@@ -162,11 +162,16 @@ impl Plugin for XrInputPlugin {
             .add_systems(XrSessionCreated, (attach_set, spawn_tracked))
             .add_systems(XrPreDestroySession, despawn_tracked)
             .add_systems(PreUpdate, sync_set.before(OxrActionSetSyncSet).run_if(openxr_session_running))
-            .add_systems(RunFixedMainLoop, (read_hands, comfort).chain().in_set(IntentSystems::Gather).run_if(openxr_session_running))
+            .add_systems(
+                RunFixedMainLoop,
+                (read_hands, comfort).chain().in_set(IntentSystems::Gather).run_if(openxr_session_running),
+            )
             .add_systems(Startup, spawn_mirror)
             .add_systems(
                 Update,
-                (pulse, strap_wrist_panel, follow_head).in_set(crate::client::ViveSystems::Present).run_if(openxr_session_running),
+                (pulse, strap_wrist_panel, follow_head)
+                    .in_set(crate::client::ViveSystems::Present)
+                    .run_if(openxr_session_running),
             );
     }
 }
@@ -203,9 +208,24 @@ fn suggest_bindings(actions: Option<Res<XrActions>>, mut out: MessageWriter<OxrS
     let Some(a) = actions else { return };
     // (profile, squeeze, stick, stick click) — every path exists on both hands of its profile.
     for (profile, squeeze, stick, click) in [
-        ("/interaction_profiles/htc/vive_controller", "/input/squeeze/click", "/input/trackpad", "/input/trackpad/click"),
-        ("/interaction_profiles/oculus/touch_controller", "/input/squeeze/value", "/input/thumbstick", "/input/thumbstick/click"),
-        ("/interaction_profiles/valve/index_controller", "/input/squeeze/value", "/input/thumbstick", "/input/thumbstick/click"),
+        (
+            "/interaction_profiles/htc/vive_controller",
+            "/input/squeeze/click",
+            "/input/trackpad",
+            "/input/trackpad/click",
+        ),
+        (
+            "/interaction_profiles/oculus/touch_controller",
+            "/input/squeeze/value",
+            "/input/thumbstick",
+            "/input/thumbstick/click",
+        ),
+        (
+            "/interaction_profiles/valve/index_controller",
+            "/input/squeeze/value",
+            "/input/thumbstick",
+            "/input/thumbstick/click",
+        ),
     ] {
         let mut bind = |action: openxr::sys::Action, path: &str| {
             out.write(OxrSuggestActionBinding { action, interaction_profile: profile.into(), bindings: both(path) });
@@ -266,7 +286,8 @@ fn spawn_tracked(
                     Vignette,
                     Mesh3d(ring),
                     MeshMaterial3d(black),
-                    Transform::from_xyz(0.0, 0.0, -VIGNETTE_DISTANCE_M).with_scale(Vec3::splat(VIGNETTE_OPEN_M.0 / 0.5)),
+                    Transform::from_xyz(0.0, 0.0, -VIGNETTE_DISTANCE_M)
+                        .with_scale(Vec3::splat(VIGNETTE_OPEN_M.0 / 0.5)),
                     Visibility::Hidden,
                 ));
             });
@@ -290,7 +311,12 @@ fn spawn_tracked(
 }
 
 fn spawn_mirror(mut commands: Commands) {
-    commands.spawn((Mirror, Camera3d::default(), IsDefaultUiCamera, Transform::from_xyz(0.0, space::EYE_HEIGHT_M, 0.0)));
+    commands.spawn((
+        Mirror,
+        Camera3d::default(),
+        IsDefaultUiCamera,
+        Transform::from_xyz(0.0, space::EYE_HEIGHT_M, 0.0),
+    ));
 }
 
 fn follow_head(head: Query<&GlobalTransform, With<Head>>, mut mirror: Query<&mut Transform, With<Mirror>>) {
@@ -375,7 +401,8 @@ fn read_hands(
     cases: Query<&CaseView>,
     items: Query<&ItemView>,
 ) {
-    let (Some(a), Ok(mut root), Some(view), Some(body)) = (actions, root.single_mut(), views.first(), state.body()) else {
+    let (Some(a), Ok(mut root), Some(view), Some(body)) = (actions, root.single_mut(), views.first(), state.body())
+    else {
         return;
     };
     let dt = time.delta_secs().max(1e-4);
@@ -431,25 +458,36 @@ fn read_hands(
         history[5] = hand_pos[hand];
         let velocity = (history[5] - history[0]) / (5.0 * dt);
         let aim = Aim { from: space::floor(hand_pos[hand]), towards: pointing[hand] };
-        if squeeze && !hs.squeezed[hand] && hs.holding[hand].is_none()
-            && let Some(item) = aim.item(items.iter(), &case_refs) {
-                intent.actions.push(Do::PickUp(item));
-                hs.holding[hand] = Some(item);
-            }
-        if !squeeze && hs.squeezed[hand] && !hs.triggered[hand]
-            && let Some(item) = hs.holding[hand].take() {
-                let bench = state.level.as_ref().map(|l| l.workbench);
-                let at_bench = bench.is_some_and(|b| b.distance(space::floor(hand_pos[hand])) < rules::REACH);
-                intent.actions.push(if at_bench { Do::Place(item) } else { Do::Drop(item) });
-            }
-        if trigger && !hs.triggered[hand] && hs.holding[hand].is_none()
-            && let Some(case) = aim.case(cases) {
-                intent.actions.push(Do::Break(case));
-            }
-        if !trigger && hs.triggered[hand]
-            && let Some(item) = hs.holding[hand].take() {
-                intent.actions.push(Do::Throw { item, target: throw_landing(hand_pos[hand], velocity) });
-            }
+        if squeeze
+            && !hs.squeezed[hand]
+            && hs.holding[hand].is_none()
+            && let Some(item) = aim.item(items.iter(), &case_refs)
+        {
+            intent.actions.push(Do::PickUp(item));
+            hs.holding[hand] = Some(item);
+        }
+        if !squeeze
+            && hs.squeezed[hand]
+            && !hs.triggered[hand]
+            && let Some(item) = hs.holding[hand].take()
+        {
+            let bench = state.level.as_ref().map(|l| l.workbench);
+            let at_bench = bench.is_some_and(|b| b.distance(space::floor(hand_pos[hand])) < rules::REACH);
+            intent.actions.push(if at_bench { Do::Place(item) } else { Do::Drop(item) });
+        }
+        if trigger
+            && !hs.triggered[hand]
+            && hs.holding[hand].is_none()
+            && let Some(case) = aim.case(cases)
+        {
+            intent.actions.push(Do::Break(case));
+        }
+        if !trigger
+            && hs.triggered[hand]
+            && let Some(item) = hs.holding[hand].take()
+        {
+            intent.actions.push(Do::Throw { item, target: throw_landing(hand_pos[hand], velocity) });
+        }
         hs.squeezed[hand] = squeeze;
         hs.triggered[hand] = trigger;
         if click && hand == off {
@@ -506,7 +544,8 @@ fn read_hands(
         Locomotion::Teleport => {
             if stick.y > 0.6 {
                 // Aiming: the target is along the off hand's pointer, up to the range.
-                let target = space::floor(hand_pos[off]) + pointing[off].normalize_or_zero() * TELEPORT_RANGE_M * stick.y;
+                let target =
+                    space::floor(hand_pos[off]) + pointing[off].normalize_or_zero() * TELEPORT_RANGE_M * stick.y;
                 hs.travel = Some(target);
                 hs.fade = 0.0;
             } else if let Some(target) = hs.travel {
@@ -569,7 +608,12 @@ fn comfort(
     }
 }
 
-fn pulse(actions: Option<Res<XrActions>>, session: Res<OxrSession>, options: Res<XrOptions>, mut pulses: MessageReader<Pulse>) {
+fn pulse(
+    actions: Option<Res<XrActions>>,
+    session: Res<OxrSession>,
+    options: Res<XrOptions>,
+    mut pulses: MessageReader<Pulse>,
+) {
     let Some(a) = actions else { return };
     let main = match options.hand {
         Handedness::Right => a.hands[1],

@@ -116,6 +116,8 @@ mod tests {
         let p = XrProbe::NoRuntime { reason: "XR_ERROR_RUNTIME_UNAVAILABLE".into() };
         assert!(p.line().contains("no OpenXR runtime") && p.line().contains("XR_ERROR_RUNTIME_UNAVAILABLE"));
         assert!(XrProbe::Ready { runtime: "Monado 25.0.0".into() }.line().starts_with("XR mode"));
-        assert!(XrProbe::NoHeadset { runtime: "SteamVR".into(), reason: "x".into() }.line().starts_with("desktop mode"));
+        assert!(
+            XrProbe::NoHeadset { runtime: "SteamVR".into(), reason: "x".into() }.line().starts_with("desktop mode")
+        );
     }
 }

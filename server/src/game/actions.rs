@@ -2,7 +2,7 @@
 
 use glam::Vec2;
 use heist_shared::protocol::{
-    CaseId, GameEvent, Gait, ItemId, ItemKind, ItemPlace, NoiseKind, Phase, PhantomMsg, Refusal, Role, ServerMsg,
+    CaseId, Gait, GameEvent, ItemId, ItemKind, ItemPlace, NoiseKind, PhantomMsg, Phase, Refusal, Role, ServerMsg,
     Stance, VerdictOutcome, ViveMsg, WorkbenchCopy,
 };
 use heist_shared::rules;

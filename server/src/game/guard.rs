@@ -172,9 +172,17 @@ impl Guard {
 }
 
 /// Sight and hearing for one guard.
-pub fn perceive(guard: &Guard, vive: &Vive, walls: &WallSet, nav: &NavGraph, noises: &[(Vec2, f32)], alarm: f32) -> Perception {
+pub fn perceive(
+    guard: &Guard,
+    vive: &Vive,
+    walls: &WallSet,
+    nav: &NavGraph,
+    noises: &[(Vec2, f32)],
+    alarm: f32,
+) -> Perception {
     let crouching = vive.stance == Stance::Crouching;
-    let sees_vive = guard.in_cone(vive.position, crouching, alarm) && walls.line_of_sight(guard.position, vive.position);
+    let sees_vive =
+        guard.in_cone(vive.position, crouching, alarm) && walls.line_of_sight(guard.position, vive.position);
     let hearing = 1.0 + 0.25 * alarm;
     let heard = noises
         .iter()
@@ -192,7 +200,8 @@ fn catch_if_within_reach(_g: &Guard, p: &Perception) -> Option<Decision> {
 
 /// Chase when sure someone is there and still seeing him.
 fn chase_if_sure(g: &Guard, p: &Perception) -> Option<Decision> {
-    (p.sees_vive && (g.suspicion >= 1.0 || matches!(g.state, GuardState::Chase { .. }))).then_some(Decision::Chase(p.vive_at))
+    (p.sees_vive && (g.suspicion >= 1.0 || matches!(g.state, GuardState::Chase { .. })))
+        .then_some(Decision::Chase(p.vive_at))
 }
 
 /// Keep running to the last known position after losing sight.
@@ -236,7 +245,11 @@ fn investigate_if_glimpse_lost(g: &Guard, _p: &Perception) -> Option<Decision> {
 fn continue_investigation_if_started(g: &Guard, _p: &Perception) -> Option<Decision> {
     match g.state {
         GuardState::Investigate { at, looked } if looked < LOOK_AROUND_S => {
-            if g.position.distance(at) < 0.8 { Some(Decision::LookAround) } else { Some(Decision::Investigate(at)) }
+            if g.position.distance(at) < 0.8 {
+                Some(Decision::LookAround)
+            } else {
+                Some(Decision::Investigate(at))
+            }
         }
         GuardState::Investigate { .. } => Some(Decision::Return),
         _ => None,
@@ -340,7 +353,9 @@ pub fn think_and_act(g: &mut Guard, p: &Perception, walls: &WallSet, nav: &NavGr
 }
 
 fn nearest_waypoint(g: &Guard) -> usize {
-    (0..g.route.len()).min_by(|&a, &b| g.position.distance(g.route[a]).total_cmp(&g.position.distance(g.route[b]))).unwrap_or(0)
+    (0..g.route.len())
+        .min_by(|&a, &b| g.position.distance(g.route[a]).total_cmp(&g.position.distance(g.route[b])))
+        .unwrap_or(0)
 }
 
 fn turn_towards(g: &mut Guard, yaw: f32, dt: f32) {

@@ -15,8 +15,8 @@ use glam::Vec2;
 use heist_shared::artifact::{ArtifactKind, Briefing};
 use heist_shared::level::{Level, NavGraph, WallSet};
 use heist_shared::protocol::{
-    CaseId, ClientMsg, GameEvent, ItemId, ItemKind, ItemPlace, LobbyMsg, LossReason, NoiseKind, Phase, Refusal,
-    Role, ServerMsg, Stance, verify,
+    CaseId, ClientMsg, GameEvent, ItemId, ItemKind, ItemPlace, LobbyMsg, LossReason, NoiseKind, Phase, Refusal, Role,
+    ServerMsg, Stance, verify,
 };
 use heist_shared::rules;
 use rand_chacha::ChaCha8Rng;
@@ -325,14 +325,7 @@ impl Game {
         for i in 0..self.guards.len() {
             let perception = guard::perceive(&self.guards[i], &self.vive, &self.walls, &self.nav, &self.noises, alarm);
             let before = self.guards[i].alert;
-            let caught = guard::think_and_act(
-                &mut self.guards[i],
-                &perception,
-                &self.walls,
-                &self.nav,
-                alarm,
-                dt,
-            );
+            let caught = guard::think_and_act(&mut self.guards[i], &perception, &self.walls, &self.nav, alarm, dt);
             let g = &self.guards[i];
             if g.alert != before {
                 let event = GameEvent::GuardAlert { guard: g.id, alert: g.alert, position: g.position };

@@ -37,11 +37,7 @@ pub(super) fn new_game(level: Level, options: &GameOptions) -> Game {
     for (t, spec) in level.targets.iter().enumerate() {
         let target_seed = options.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15).wrapping_add(t as u64);
         let (traits, real_index) = artifact::generate_copies(spec.kind, target_seed, spec.copies);
-        targets.push(Target {
-            kind: spec.kind,
-            briefing: artifact::briefing(&traits[real_index]),
-            secured: false,
-        });
+        targets.push(Target { kind: spec.kind, briefing: artifact::briefing(&traits[real_index]), secured: false });
         for (c, tr) in traits.into_iter().enumerate() {
             let mesh = artifact::build_mesh(&tr, target_seed.wrapping_add(c as u64 * 7919));
             let material = tr.material.material();
@@ -56,11 +52,7 @@ pub(super) fn new_game(level: Level, options: &GameOptions) -> Game {
     let mut items: Vec<Item> = copies
         .into_iter()
         .zip(&case_order)
-        .map(|((kind, truth), &case)| Item {
-            kind,
-            place: ItemPlace::InCase(CaseId(case as u16)),
-            truth: Some(truth),
-        })
+        .map(|((kind, truth), &case)| Item { kind, place: ItemPlace::InCase(CaseId(case as u16)), truth: Some(truth) })
         .collect();
     items.extend(level.props.iter().map(|&p| Item { kind: ItemKind::Prop, place: ItemPlace::Floor(p), truth: None }));
 

@@ -3,7 +3,7 @@
 use glam::Vec2;
 use heist_shared::level::Level;
 use heist_shared::protocol::{
-    CaseId, ClientMsg, GameEvent, ItemPlace, LobbyMsg, LossReason, Phase, PhantomMsg, Refusal, Role, ServerMsg,
+    CaseId, ClientMsg, GameEvent, ItemPlace, LobbyMsg, LossReason, PhantomMsg, Phase, Refusal, Role, ServerMsg,
     VerdictOutcome, ViveMsg,
 };
 
@@ -182,7 +182,6 @@ fn the_same_seed_gives_the_same_session() {
     assert_ne!(reals(&a), reals(&started(10)), "another seed shuffles the copies");
 }
 
-
 fn walk(seq: u32, direction: Vec2) -> ViveMsg {
     ViveMsg::Move { seq, direction, gait: Default::default(), facing: 0.0 }
 }
@@ -257,6 +256,10 @@ fn an_action_applies_the_inputs_sent_before_it_first() {
     for seq in 1..=10 {
         vive(&mut g, walk(seq, dir)).unwrap();
     }
-    assert_eq!(vive(&mut g, ViveMsg::Break(heist_shared::protocol::CaseId(0))), Ok(()), "in reach after the queued steps");
+    assert_eq!(
+        vive(&mut g, ViveMsg::Break(heist_shared::protocol::CaseId(0))),
+        Ok(()),
+        "in reach after the queued steps"
+    );
     assert_eq!(g.vive.last_input_seq, 10);
 }

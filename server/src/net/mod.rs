@@ -4,10 +4,10 @@
 //! Systems run in `PreUpdate` (receive, after replicon's receive) and `PostUpdate` (send, before
 //! replicon's send).
 
+mod admission;
 pub mod receive;
 pub mod send;
 pub mod tokens;
-mod admission;
 
 use std::net::{SocketAddr, UdpSocket};
 use std::time::{SystemTime, UNIX_EPOCH};

@@ -4,8 +4,8 @@ use bevy::prelude::*;
 use bevy_replicon::prelude::*;
 use heist_shared::protocol::{ClientMsg, DisconnectReason, PhantomMsg, PhantomTool, ServerMsg};
 
-use super::admission::{Player, refuse_and_disconnect};
 use super::NetSettings;
+use super::admission::{Player, refuse_and_disconnect};
 use crate::session::{GameState, SessionLog};
 
 /// Applies every message received this frame, in order.

@@ -10,9 +10,9 @@ use std::collections::VecDeque;
 use std::sync::Arc;
 
 use glam::Vec3;
+use kira::Frame;
 use kira::effect::{Effect, EffectBuilder};
 use kira::info::Info;
-use kira::Frame;
 
 use super::hrir::{HEAD_RADIUS_M, SPEED_OF_SOUND_M_PER_S, ear_delay_s};
 

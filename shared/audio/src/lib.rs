@@ -33,7 +33,6 @@ use self::backend::{Capture, CaptureBackend, CaptureSettings};
 use self::binaural::{BinauralBuilder, BinauralHandle, Placement, Spatializer};
 use self::synth::{ContactHandle, ContactParams, ContactSoundData, Earcon};
 
-
 /// Where the sound goes.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum AudioOutput {
@@ -148,7 +147,9 @@ impl Pump {
                 }
                 if let Some(path) = wav {
                     match backend::write_wav(&path, rate, &kept) {
-                        Ok(()) => log::info!("audio written to {} ({:.1} s)", path.display(), kept.len() as f64 / rate as f64),
+                        Ok(()) => {
+                            log::info!("audio written to {} ({:.1} s)", path.display(), kept.len() as f64 / rate as f64)
+                        }
                         Err(e) => log::error!("could not write {}: {e}", path.display()),
                     }
                 }
@@ -211,7 +212,8 @@ impl AudioEngine {
             let place = builder.add_effect(BinauralBuilder::new(spatializer.clone(), Placement { offset: at }));
             Ok(Voice { track: manager.add_sub_track(builder)?, place })
         };
-        let voices = (0..settings.voices.max(1)).map(|_| voice(&mut manager, Vec3::NEG_Z)).collect::<Result<Vec<_>, _>>()?;
+        let voices =
+            (0..settings.voices.max(1)).map(|_| voice(&mut manager, Vec3::NEG_Z)).collect::<Result<Vec<_>, _>>()?;
         let speech = voice(&mut manager, SPEECH_OFFSET)?;
         let mut contact_voice = voice(&mut manager, CONTACT_OFFSET)?;
         let contact = contact_voice.track.play(ContactSoundData).ok();

@@ -9,10 +9,10 @@ use std::f32::consts::TAU;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU32, Ordering};
 
+use kira::Frame;
 use kira::info::Info;
 use kira::sound::static_sound::{StaticSoundData, StaticSoundSettings};
 use kira::sound::{Sound, SoundData};
-use kira::Frame;
 
 /// Sample rate of the synthesized sounds, Hz.
 pub const RATE: u32 = 48_000;
@@ -62,10 +62,14 @@ pub fn glass() -> StaticSoundData {
     let partials = [2900.0, 3700.0, 4410.0, 5230.0, 6170.0, 7040.0];
     mono(&samples(0.9, |t| {
         let crack = noise.next_sample() * (-t / 0.03).exp();
-        let tinkle: f32 = partials.iter().enumerate().map(|(i, f)| {
-            let onset = 0.02 + 0.07 * i as f32;
-            if t < onset { 0.0 } else { (TAU * f * t).sin() * (-(t - onset) / 0.12).exp() * 0.07 }
-        }).sum();
+        let tinkle: f32 = partials
+            .iter()
+            .enumerate()
+            .map(|(i, f)| {
+                let onset = 0.02 + 0.07 * i as f32;
+                if t < onset { 0.0 } else { (TAU * f * t).sin() * (-(t - onset) / 0.12).exp() * 0.07 }
+            })
+            .sum();
         0.5 * crack + tinkle
     }))
 }
@@ -176,7 +180,16 @@ impl SoundData for ContactSoundData {
     fn into_sound(self) -> Result<(Box<dyn Sound>, Self::Handle), Self::Error> {
         let (input, output) = triple_buffer::triple_buffer(&ContactParams::default());
         let taps = Arc::new(AtomicU32::new(0));
-        let sound = ContactSound { params: output, taps: taps.clone(), noise: Noise::new(3), band: [0.0; 2], level: 0.0, tap_amp: 0.0, tap_phase: 0.0, current: ContactParams::default() };
+        let sound = ContactSound {
+            params: output,
+            taps: taps.clone(),
+            noise: Noise::new(3),
+            band: [0.0; 2],
+            level: 0.0,
+            tap_amp: 0.0,
+            tap_phase: 0.0,
+            current: ContactParams::default(),
+        };
         Ok((Box::new(sound), ContactHandle { params: input, taps }))
     }
 }
@@ -205,7 +218,11 @@ impl Sound for ContactSound {
     fn process(&mut self, out: &mut [Frame], dt: f64, _info: &Info) {
         let p = self.current;
         let dt = dt as f32;
-        let target = if p.force_n > 0.0 { (p.force_n * p.slip_m_per_s * 4.0).min(1.0) * (0.35 + 0.65 * p.roughness) } else { 0.0 };
+        let target = if p.force_n > 0.0 {
+            (p.force_n * p.slip_m_per_s * 4.0).min(1.0) * (0.35 + 0.65 * p.roughness)
+        } else {
+            0.0
+        };
         let centre = 500.0 + 2500.0 * p.hardness + 4000.0 * p.slip_m_per_s.min(0.5);
         // State-variable band-pass: centre frequency and a fixed Q of about 2.
         let f = (2.0 * (std::f32::consts::PI * centre * dt).sin()).min(1.0);
@@ -240,9 +257,18 @@ mod tests {
 
     #[test]
     fn every_one_shot_is_short_audible_and_bounded() {
-        let all = [footstep(1), glass(), thud(), alarm(), bark(true), bark(false)]
-            .into_iter()
-            .chain([Earcon::CopyArrived, Earcon::ReadyToFeel, Earcon::Right, Earcon::Wrong, Earcon::AlarmUp, Earcon::Won, Earcon::Lost].map(earcon));
+        let all = [footstep(1), glass(), thud(), alarm(), bark(true), bark(false)].into_iter().chain(
+            [
+                Earcon::CopyArrived,
+                Earcon::ReadyToFeel,
+                Earcon::Right,
+                Earcon::Wrong,
+                Earcon::AlarmUp,
+                Earcon::Won,
+                Earcon::Lost,
+            ]
+            .map(earcon),
+        );
         for s in all {
             let peak = s.frames.iter().map(|f| f.left.abs()).fold(0.0, f32::max);
             assert!(peak > 0.05 && peak <= 1.0, "peak {peak}");

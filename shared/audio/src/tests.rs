@@ -3,7 +3,8 @@
 use super::*;
 
 fn engine(spatial: SpatialMode) -> AudioEngine {
-    AudioEngine::new(&AudioSettings { output: AudioOutput::Manual, spatial, ..Default::default() }).expect("engine starts")
+    AudioEngine::new(&AudioSettings { output: AudioOutput::Manual, spatial, ..Default::default() })
+        .expect("engine starts")
 }
 
 /// A 20 ms noise burst.

@@ -115,7 +115,15 @@ impl Forecast {
     }
 
     /// True when walking the polyline from `from` through `path` at `speed` stays unseen for `horizon` s.
-    pub fn path_hidden(&self, from: Vec2, path: &[Vec2], speed: f32, horizon: f32, crouching: bool, walls: &WallSet) -> bool {
+    pub fn path_hidden(
+        &self,
+        from: Vec2,
+        path: &[Vec2],
+        speed: f32,
+        horizon: f32,
+        crouching: bool,
+        walls: &WallSet,
+    ) -> bool {
         let mut at = from;
         let mut t = 0.0;
         let step = 0.25;

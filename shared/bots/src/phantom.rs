@@ -4,7 +4,7 @@ use bevy::prelude::*;
 use heist_client::Inbox;
 use heist_shared::artifact::{self, ArtifactKind};
 use heist_shared::protocol::{
-    ClientMsg, GameEvent, ItemId, ItemKind, ItemView, LobbyMsg, Phase, PhantomMsg, SessionView, VerdictOutcome,
+    ClientMsg, GameEvent, ItemId, ItemKind, ItemView, LobbyMsg, PhantomMsg, Phase, SessionView, VerdictOutcome,
     WorkbenchCopy,
 };
 

@@ -435,7 +435,8 @@ fn hide(
         .filter_map(|c| {
             let route = nav.route(me, c)?;
             let length = nav.route_length(me, c);
-            let ok = forecast.path_hidden(me, &route, rules::WALK_SPEED, length / rules::WALK_SPEED + 3.0, false, walls);
+            let ok =
+                forecast.path_hidden(me, &route, rules::WALK_SPEED, length / rules::WALK_SPEED + 3.0, false, walls);
             ok.then_some((length, route))
         })
         .min_by(|a, b| a.0.total_cmp(&b.0));

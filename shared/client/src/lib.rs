@@ -131,8 +131,7 @@ fn insert_transport(app: &mut App, server: std::net::SocketAddr, auth: ClientAut
     let bind = if server.ip().is_loopback() { "127.0.0.1:0" } else { "0.0.0.0:0" };
     let socket = UdpSocket::bind(bind).map_err(JoinError::Socket)?;
     let now = SystemTime::now().duration_since(UNIX_EPOCH).unwrap_or_default();
-    let transport =
-        NetcodeClientTransport::new(now, auth, socket).map_err(|e| JoinError::Transport(e.to_string()))?;
+    let transport = NetcodeClientTransport::new(now, auth, socket).map_err(|e| JoinError::Transport(e.to_string()))?;
     let channels = app.world().resource::<RepliconChannels>();
     let connection = ConnectionConfig {
         server_channels_config: channels.server_configs(),

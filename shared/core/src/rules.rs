@@ -38,6 +38,12 @@ pub fn gait_speed(gait: crate::protocol::Gait) -> f32 {
 /// Where Vive's body ends up after `dt` seconds of moving along `direction` (|d| ≤ 1) at `speed` m/s from
 /// `from`, sliding along walls. The server moves Vive with this and the Vive client predicts with it, so
 /// both agree to the bit when they see the same inputs.
-pub fn move_body(walls: &crate::level::WallSet, from: glam::Vec2, direction: glam::Vec2, speed: f32, dt: f32) -> glam::Vec2 {
+pub fn move_body(
+    walls: &crate::level::WallSet,
+    from: glam::Vec2,
+    direction: glam::Vec2,
+    speed: f32,
+    dt: f32,
+) -> glam::Vec2 {
     walls.slide(from, direction * speed * dt, BODY_RADIUS)
 }

@@ -27,9 +27,9 @@ pub fn enclosing_sphere(spheres: &[Sphere]) -> Sphere {
         // A few Ritter-style steps towards the farthest sphere shrink the bound further.
         let mut c = c;
         for _ in 0..8 {
-            let far = spheres.iter().max_by(|a, b| {
-                (c.distance(a.center) + a.radius).total_cmp(&(c.distance(b.center) + b.radius))
-            });
+            let far = spheres
+                .iter()
+                .max_by(|a, b| (c.distance(a.center) + a.radius).total_cmp(&(c.distance(b.center) + b.radius)));
             let Some(far) = far else { break };
             let dir = far.center - c;
             let len = dir.length();

@@ -34,7 +34,8 @@ const LEAF_BIT: u32 = 1 << 31;
 impl InnerSphereTree {
     /// Serializes the tree in the `.ist` format.
     pub fn to_bytes(&self) -> Vec<u8> {
-        let mut b = Vec::with_capacity(HEADER_SIZE + SPHERE_SIZE * self.spheres.len() + NODE_SIZE * self.nodes.len() + 4);
+        let mut b =
+            Vec::with_capacity(HEADER_SIZE + SPHERE_SIZE * self.spheres.len() + NODE_SIZE * self.nodes.len() + 4);
         b.extend_from_slice(&MAGIC);
         for v in [FORMAT_VERSION, HEADER_SIZE as u32, self.spheres.len() as u32, self.nodes.len() as u32] {
             b.extend_from_slice(&v.to_le_bytes());
@@ -98,7 +99,13 @@ impl InnerSphereTree {
                 .map(|i| {
                     let at = HEADER_SIZE + SPHERE_SIZE * spheres + NODE_SIZE * i;
                     let count = u(at + 24);
-                    Node { bound: sphere_at(at), volume: f(at + 16), first: u(at + 20), count: count & !LEAF_BIT, leaf: count & LEAF_BIT != 0 }
+                    Node {
+                        bound: sphere_at(at),
+                        volume: f(at + 16),
+                        first: u(at + 20),
+                        count: count & !LEAF_BIT,
+                        leaf: count & LEAF_BIT != 0,
+                    }
                 })
                 .collect(),
             mesh_volume: f(24),

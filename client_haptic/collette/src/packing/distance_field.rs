@@ -42,7 +42,12 @@ impl DistanceField {
                 let (y0, z0) = row_of(a.y.min(b.y).min(c.y), a.z.min(b.z).min(c.z));
                 let (y1, z1) = row_of(a.y.max(b.y).max(c.y), a.z.max(b.z).max(c.z));
                 let clampi = |v: f32, n: usize| (v.max(0.0) as usize).min(n);
-                (clampi(y0.ceil() - 1.0, ny), clampi(y1.floor() + 2.0, ny), clampi(z0.ceil() - 1.0, nz), clampi(z1.floor() + 2.0, nz))
+                (
+                    clampi(y0.ceil() - 1.0, ny),
+                    clampi(y1.floor() + 2.0, ny),
+                    clampi(z0.ceil() - 1.0, nz),
+                    clampi(z1.floor() + 2.0, nz),
+                )
             })
             .collect();
         for &(j0, j1, k0, k1) in &ranges {
@@ -70,35 +75,38 @@ impl DistanceField {
         let parry_mesh = to_parry(mesh);
         let tris = mesh.triangles();
         let mut distance = vec![-1.0f32; nx * ny * nz];
-        distance.par_chunks_mut(nx).enumerate().for_each_init(Vec::new, |crossings: &mut Vec<(f32, i32)>, (row, out)| {
-            let (j, k) = (row % ny, row / ny);
-            // A tiny irrational offset keeps rows off shared edges and vertices.
-            let y = origin.y + j as f32 * h + h * 1.3e-4;
-            let z = origin.z + k as f32 * h + h * 0.7e-4;
-            crossings.clear();
-            for &ti in &bins[counts[row] as usize..counts[row + 1] as usize] {
-                let [a, b, c] = tris[ti as usize].map(|i| verts[i as usize]);
-                if let Some(hit) = row_crossing(a, b, c, y, z) {
-                    crossings.push(hit);
+        distance.par_chunks_mut(nx).enumerate().for_each_init(
+            Vec::new,
+            |crossings: &mut Vec<(f32, i32)>, (row, out)| {
+                let (j, k) = (row % ny, row / ny);
+                // A tiny irrational offset keeps rows off shared edges and vertices.
+                let y = origin.y + j as f32 * h + h * 1.3e-4;
+                let z = origin.z + k as f32 * h + h * 0.7e-4;
+                crossings.clear();
+                for &ti in &bins[counts[row] as usize..counts[row + 1] as usize] {
+                    let [a, b, c] = tris[ti as usize].map(|i| verts[i as usize]);
+                    if let Some(hit) = row_crossing(a, b, c, y, z) {
+                        crossings.push(hit);
+                    }
                 }
-            }
-            if crossings.is_empty() {
-                return;
-            }
-            crossings.sort_by(|p, q| p.0.total_cmp(&q.0));
-            let (mut next, mut winding) = (0usize, 0i32);
-            for (i, d) in out.iter_mut().enumerate() {
-                let x = origin.x + i as f32 * h;
-                while next < crossings.len() && crossings[next].0 < x {
-                    winding += crossings[next].1;
-                    next += 1;
+                if crossings.is_empty() {
+                    return;
                 }
-                if winding != 0 {
-                    let p = Vec3::new(x, origin.y + j as f32 * h, origin.z + k as f32 * h);
-                    *d = surface_distance(&parry_mesh, p);
+                crossings.sort_by(|p, q| p.0.total_cmp(&q.0));
+                let (mut next, mut winding) = (0usize, 0i32);
+                for (i, d) in out.iter_mut().enumerate() {
+                    let x = origin.x + i as f32 * h;
+                    while next < crossings.len() && crossings[next].0 < x {
+                        winding += crossings[next].1;
+                        next += 1;
+                    }
+                    if winding != 0 {
+                        let p = Vec3::new(x, origin.y + j as f32 * h, origin.z + k as f32 * h);
+                        *d = surface_distance(&parry_mesh, p);
+                    }
                 }
-            }
-        });
+            },
+        );
         Self { origin, voxel_size: h, dims, distance }
     }
 
@@ -138,7 +146,8 @@ fn row_crossing(a: Vec3, b: Vec3, c: Vec3, y: f32, z: f32) -> Option<(f32, i32)>
 /// The mesh as a parry triangle mesh (for exact point distances and the parry comparison benchmark).
 pub fn to_parry(mesh: &TriMesh) -> parry3d::shape::TriMesh {
     let v = mesh.vertices().iter().map(|p| parry3d::math::Vector::new(p.x, p.y, p.z)).collect();
-    parry3d::shape::TriMesh::new(v, mesh.triangles().to_vec()).unwrap_or_else(|_| unreachable!("validated mesh is non-empty"))
+    parry3d::shape::TriMesh::new(v, mesh.triangles().to_vec())
+        .unwrap_or_else(|_| unreachable!("validated mesh is non-empty"))
 }
 
 #[inline]

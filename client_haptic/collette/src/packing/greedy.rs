@@ -32,12 +32,8 @@ pub(crate) fn pack(
     progress: &mut dyn FnMut(usize, f64),
 ) -> Vec<Sphere> {
     let mut free = field.distance.clone();
-    let mut heap: BinaryHeap<u64> = free
-        .iter()
-        .enumerate()
-        .filter(|(_, d)| **d >= stop.min_radius && **d > 0.0)
-        .map(|(i, &d)| key(d, i))
-        .collect();
+    let mut heap: BinaryHeap<u64> =
+        free.iter().enumerate().filter(|(_, d)| **d >= stop.min_radius && **d > 0.0).map(|(i, &d)| key(d, i)).collect();
     let mut spheres = Vec::with_capacity(stop.max_spheres.min(1 << 20));
     let mut packed = 0.0f64;
     let report_every = (stop.max_spheres / 100).max(1);

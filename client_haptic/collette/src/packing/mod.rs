@@ -36,7 +36,13 @@ pub struct BuildOptions {
 
 impl Default for BuildOptions {
     fn default() -> Self {
-        Self { target_spheres: None, target_coverage: None, min_radius: None, grid_resolution: None, refine_centers: true }
+        Self {
+            target_spheres: None,
+            target_coverage: None,
+            min_radius: None,
+            grid_resolution: None,
+            refine_centers: true,
+        }
     }
 }
 
@@ -134,7 +140,9 @@ pub fn build(
     let ext = mesh.aabb().extents();
     let voxels: f64 = (0..3).map(|a| (ext[a] / ext.max_element() * resolution as f32).ceil().max(1.0) as f64).product();
     if voxels > MAX_VOXELS as f64 {
-        return Err(BuildError::InvalidOption(format!("grid resolution {resolution} needs {voxels:.3e} voxels (at most {MAX_VOXELS})")));
+        return Err(BuildError::InvalidOption(format!(
+            "grid resolution {resolution} needs {voxels:.3e} voxels (at most {MAX_VOXELS})"
+        )));
     }
     let mesh_volume = mesh.volume() as f64;
     progress(BuildProgress::DistanceField);
@@ -190,7 +198,10 @@ mod tests {
         let sp = tree.spheres();
         for i in 0..sp.len() {
             for j in i + 1..sp.len() {
-                assert!(sp[i].center.distance(sp[j].center) >= (sp[i].radius + sp[j].radius) * (1.0 - 1e-4), "{i} and {j} overlap");
+                assert!(
+                    sp[i].center.distance(sp[j].center) >= (sp[i].radius + sp[j].radius) * (1.0 - 1e-4),
+                    "{i} and {j} overlap"
+                );
             }
         }
         assert!((report.coverage - tree.coverage() as f64).abs() < 1e-3);

@@ -54,7 +54,13 @@ fn split(spheres: &mut [Sphere]) -> usize {
     let total: f64 = spheres.iter().map(weight).sum();
     let mean = spheres.iter().map(|s| s.center.as_dvec3() * weight(s)).sum::<glam::DVec3>() / total;
     let var = spheres.iter().map(|s| (s.center.as_dvec3() - mean).powf(2.0) * weight(s)).sum::<glam::DVec3>();
-    let axis = if var.x >= var.y && var.x >= var.z { 0 } else if var.y >= var.z { 1 } else { 2 };
+    let axis = if var.x >= var.y && var.x >= var.z {
+        0
+    } else if var.y >= var.z {
+        1
+    } else {
+        2
+    };
     // Stable sort on the coordinate keeps the result deterministic for equal coordinates.
     spheres.sort_by(|a, b| a.center[axis].total_cmp(&b.center[axis]));
     let mut acc = 0.0;
@@ -75,7 +81,9 @@ mod tests {
     use glam::Vec3;
 
     fn line_of_spheres(n: usize) -> Vec<Sphere> {
-        (0..n).map(|i| Sphere::new(Vec3::new(i as f32, (i % 3) as f32 * 0.1, 0.0), 0.1 + (i % 5) as f32 * 0.05)).collect()
+        (0..n)
+            .map(|i| Sphere::new(Vec3::new(i as f32, (i % 3) as f32 * 0.1, 0.0), 0.1 + (i % 5) as f32 * 0.05))
+            .collect()
     }
 
     #[test]

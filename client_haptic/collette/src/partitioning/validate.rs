@@ -11,7 +11,11 @@ impl InnerSphereTree {
         if !self.mesh_volume.is_finite() || self.mesh_volume < 0.0 {
             return Err(format!("mesh volume {} is not a finite positive number", self.mesh_volume));
         }
-        if let Some(i) = self.spheres.iter().position(|s| !s.center.is_finite() || s.radius.is_nan() || s.radius < 0.0 || !s.radius.is_finite()) {
+        if let Some(i) = self
+            .spheres
+            .iter()
+            .position(|s| !s.center.is_finite() || s.radius.is_nan() || s.radius < 0.0 || !s.radius.is_finite())
+        {
             return Err(format!("sphere {i} has a non-finite centre or a bad radius"));
         }
         let mut seen = vec![false; self.spheres.len()];

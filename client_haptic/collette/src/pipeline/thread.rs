@@ -63,7 +63,8 @@ impl CollisionThread {
     /// Spawns the thread, which steps every `config.period` with `config.step_budget` per step.
     pub fn spawn(config: CollisionConfig) -> std::io::Result<CollisionHandle> {
         let (commands, mut incoming) = rtrb::RingBuffer::new(config.command_capacity);
-        let (mut retire_tx, retired) = rtrb::RingBuffer::new(config.command_capacity + config.max_objects + config.max_watchers);
+        let (mut retire_tx, retired) =
+            rtrb::RingBuffer::new(config.command_capacity + config.max_objects + config.max_watchers);
         let stop = Arc::new(AtomicBool::new(false));
         let steps = Arc::new(AtomicU64::new(0));
         let mut world = CollisionWorld::new(&config);
@@ -202,7 +203,9 @@ mod tests {
     #[test]
     fn the_thread_publishes_contacts_and_follows_poses_objects_and_regions() {
         let (v, t) = box_buffers(Vec3::splat(0.5));
-        let tree = Arc::new(build(&TriMesh::new(v, t).expect("valid"), &BuildOptions::spheres(200), &mut |_| {}).expect("builds").0);
+        let tree = Arc::new(
+            build(&TriMesh::new(v, t).expect("valid"), &BuildOptions::spheres(200), &mut |_| {}).expect("builds").0,
+        );
         let mut handle = CollisionThread::spawn(CollisionConfig::default()).expect("spawns");
         let mut tool = handle.add_object(tree.clone(), Pose::from_translation(Vec3::X * 5.0)).expect("slot");
         let target = handle.add_object(tree.clone(), Pose::IDENTITY).expect("slot");

@@ -162,14 +162,17 @@ impl CollisionWorld {
             set.object_a = w.a.0;
             set.object_b = w.b.0;
             set.sequence = self.sequence;
-            let (Some(Some(a)), Some(Some(b))) = (self.objects.get(w.a.0 as usize), self.objects.get(w.b.0 as usize)) else {
+            let (Some(Some(a)), Some(Some(b))) = (self.objects.get(w.a.0 as usize), self.objects.get(w.b.0 as usize))
+            else {
                 w.out.publish();
                 continue;
             };
             let (pa, pb) = (*a.pose.output_buffer(), *b.pose.output_buffer());
             set.timestamp_us = pa.timestamp_us.min(pb.timestamp_us);
             let in_region = |tree: &InnerSphereTree, pose: &Pose| {
-                self.region.is_none_or(|r| r.intersects_sphere(pose.transform_point(tree.root().bound.center), tree.root().bound.radius))
+                self.region.is_none_or(|r| {
+                    r.intersects_sphere(pose.transform_point(tree.root().bound.center), tree.root().bound.radius)
+                })
             };
             if in_region(&a.tree, &pa.pose) && in_region(&b.tree, &pb.pose) {
                 let budget = share.map_or(Budget::Unlimited, Budget::Deadline);

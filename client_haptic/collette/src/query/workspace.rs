@@ -26,6 +26,11 @@ impl QueryWorkspace {
 
     /// A workspace with room for deep trees (allocates; call it once, off the hot path).
     pub fn new() -> Self {
-        Self { stack: Vec::with_capacity(8192), ring: vec![(0, 0); Self::RING_CAPACITY], nodes: Vec::with_capacity(1024), estimate_ns: 60.0 }
+        Self {
+            stack: Vec::with_capacity(8192),
+            ring: vec![(0, 0); Self::RING_CAPACITY],
+            nodes: Vec::with_capacity(1024),
+            estimate_ns: 60.0,
+        }
     }
 }

@@ -14,10 +14,12 @@ pub fn brilliant_cut(diameter: f32) -> TriMesh {
     let (table_r, crown, girdle, pavilion) = (0.53 * r, 0.162 * diameter, 0.02 * diameter, 0.431 * diameter);
     let (zt, zg) = (girdle * 0.5 + crown, girdle * 0.5);
     let ring = |n: usize, radius: f32, z: f32| -> Vec<Vec3> {
-        (0..n).map(|k| {
-            let a = TAU * k as f32 / n as f32;
-            Vec3::new(radius * a.cos(), radius * a.sin(), z)
-        }).collect()
+        (0..n)
+            .map(|k| {
+                let a = TAU * k as f32 / n as f32;
+                Vec3::new(radius * a.cos(), radius * a.sin(), z)
+            })
+            .collect()
     };
     let mut v = vec![Vec3::new(0.0, 0.0, zt)];
     let t0 = v.len() as u32;

@@ -99,7 +99,10 @@ pub fn trajectory(bunny: &TriMesh) -> Vec<TrajectorySample> {
             let (az, el) = (TAU * t / 20.0 + 0.3, 0.5 * (TAU * t / 13.0).sin());
             let dir = Vec3::new(el.cos() * az.cos(), el.sin(), el.cos() * az.sin());
             let origin = center + dir * far;
-            let ray = Ray::new(parry3d::math::Vector::new(origin.x, origin.y, origin.z), parry3d::math::Vector::new(-dir.x, -dir.y, -dir.z));
+            let ray = Ray::new(
+                parry3d::math::Vector::new(origin.x, origin.y, origin.z),
+                parry3d::math::Vector::new(-dir.x, -dir.y, -dir.z),
+            );
             if let Some(toi) = mesh.cast_local_ray(&ray, far, true) {
                 last_surface = far - toi;
             }
@@ -108,7 +111,11 @@ pub fn trajectory(bunny: &TriMesh) -> Vec<TrajectorySample> {
             let (off, phase) = offset(t);
             let position = center + dir * (s + off).max(0.0);
             let rotation = Quat::from_euler(EulerRot::YXZ, 0.7 * t, 0.4 * (0.5 * t).sin(), 0.2 * t);
-            TrajectorySample { time_s: i as f64 / TRAJECTORY_RATE_HZ as f64, tool: Pose::new(position, rotation), phase }
+            TrajectorySample {
+                time_s: i as f64 / TRAJECTORY_RATE_HZ as f64,
+                tool: Pose::new(position, rotation),
+                phase,
+            }
         })
         .collect()
 }
@@ -126,7 +133,8 @@ mod tests {
         assert_eq!(path.len(), 35_000);
         assert_eq!(path[0].phase, Phase::Free);
         assert!(path.iter().any(|s| s.phase == Phase::Deep));
-        let max_step = path.windows(2).map(|w| w[0].tool.translation.distance(w[1].tool.translation)).fold(0.0, f32::max);
+        let max_step =
+            path.windows(2).map(|w| w[0].tool.translation.distance(w[1].tool.translation)).fold(0.0, f32::max);
         assert!(max_step < 0.001, "no jump above 1 mm per millisecond: {max_step}");
         assert_eq!(path, trajectory(&ball), "deterministic");
     }

@@ -5,12 +5,27 @@ use glam::Vec3;
 /// The 8 corners and 12 triangles of an axis-aligned box (outward-facing); used by tests and examples.
 pub fn box_buffers(half: Vec3) -> (Vec<Vec3>, Vec<[u32; 3]>) {
     let v = (0..8)
-        .map(|i| Vec3::new(if i & 1 == 0 { -half.x } else { half.x }, if i & 2 == 0 { -half.y } else { half.y }, if i & 4 == 0 { -half.z } else { half.z }))
+        .map(|i| {
+            Vec3::new(
+                if i & 1 == 0 { -half.x } else { half.x },
+                if i & 2 == 0 { -half.y } else { half.y },
+                if i & 4 == 0 { -half.z } else { half.z },
+            )
+        })
         .collect();
     let t = vec![
-        [0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], // -z, +z
-        [0, 1, 4], [1, 5, 4], [2, 6, 3], [3, 6, 7], // -y, +y
-        [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5], // -x, +x
+        [0, 2, 1],
+        [1, 2, 3],
+        [4, 5, 6],
+        [5, 7, 6], // -z, +z
+        [0, 1, 4],
+        [1, 5, 4],
+        [2, 6, 3],
+        [3, 6, 7], // -y, +y
+        [0, 4, 2],
+        [2, 4, 6],
+        [1, 3, 5],
+        [3, 7, 5], // -x, +x
     ];
     (v, t)
 }

@@ -22,7 +22,9 @@
 mod pid;
 mod spacemouse;
 
-pub use pid::{PidForceDevice, PidReportIds, encode_constant_force, encode_effect_operation, encode_set_effect, pid_force};
+pub use pid::{
+    PidForceDevice, PidReportIds, encode_constant_force, encode_effect_operation, encode_set_effect, pid_force,
+};
 pub use spacemouse::{SpaceMouse, SpaceMouseAxes, SpaceMouseMode, spacemouse_pose, spacemouse_specs};
 
 use crate::{HapticoError, Result};
@@ -105,7 +107,11 @@ pub fn list_devices() -> Result<Vec<HidDeviceInfo>> {
         .collect())
 }
 
-pub(crate) fn open_first(kind: HidKind, wanted: &str, path: Option<&str>) -> Result<(hidapi::HidDevice, HidDeviceInfo)> {
+pub(crate) fn open_first(
+    kind: HidKind,
+    wanted: &str,
+    path: Option<&str>,
+) -> Result<(hidapi::HidDevice, HidDeviceInfo)> {
     let api = hidapi::HidApi::new().map_err(hid_err)?;
     let found = api.device_list().find(|d| {
         classify(d.vendor_id(), d.usage_page(), d.usage()) == kind
@@ -148,7 +154,9 @@ mod tests {
             Ok(list) => assert!(list.iter().all(|d| !d.path.is_empty())),
             Err(e) => assert!(!e.to_string().is_empty()),
         }
-        if let Err(e) = SpaceMouse::open_first(SpaceMouseMode::Rate { metres_per_s_per_count: 1e-4, radians_per_s_per_count: 1e-3 }) {
+        if let Err(e) =
+            SpaceMouse::open_first(SpaceMouseMode::Rate { metres_per_s_per_count: 1e-4, radians_per_s_per_count: 1e-3 })
+        {
             assert!(matches!(e, HapticoError::NoDevice { .. } | HapticoError::Hid(_)), "{e}");
         }
     }

@@ -40,13 +40,20 @@ pub fn encode_set_effect(ids: &PidReportIds, block: u8, direction_cdeg: u16) -> 
     let dur = 0xFFFFu16.to_le_bytes(); // infinite
     let dir = direction_cdeg.to_le_bytes();
     [
-        ids.set_effect, block, EFFECT_TYPE_CONSTANT, dur[0], dur[1], // duration
-        0, 0, // trigger repeat interval
-        0, 0, // sample period (default)
-        255, // gain
+        ids.set_effect,
+        block,
+        EFFECT_TYPE_CONSTANT,
+        dur[0],
+        dur[1], // duration
+        0,
+        0, // trigger repeat interval
+        0,
+        0,    // sample period (default)
+        255,  // gain
         0xFF, // trigger button: none
         0b11, // axes enable X, Y
-        dir[0], dir[1],
+        dir[0],
+        dir[1],
     ]
 }
 

@@ -188,7 +188,13 @@ impl Device for SpaceMouse {
         self.last_t_us = Some(t_us);
         let (pose, v, w) = spacemouse_pose(self.mode, &self.axes, self.pose, dt);
         self.pose = pose;
-        DeviceState { pose, linear_velocity: v, angular_velocity: w, buttons: Buttons(self.axes.buttons), timestamp_us: t_us }
+        DeviceState {
+            pose,
+            linear_velocity: v,
+            angular_velocity: w,
+            buttons: Buttons(self.axes.buttons),
+            timestamp_us: t_us,
+        }
     }
 
     fn command(&mut self, _ft: ForceTorque) {}

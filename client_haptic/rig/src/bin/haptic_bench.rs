@@ -16,7 +16,9 @@ use haptico::sim::{Keyframe, SimConfig, SimDevice, TargetPath};
 use haptico::{HapticConfig, HapticEvents, presets};
 
 #[derive(Parser, Debug)]
-#[command(about = "Runs the gemstone-over-bunny trajectory through the full haptic loop and measures it (paper Fig. 9).")]
+#[command(
+    about = "Runs the gemstone-over-bunny trajectory through the full haptic loop and measures it (paper Fig. 9)."
+)]
 struct Args {
     /// Seconds to run (the trajectory lasts 35 s).
     #[arg(long, default_value_t = 35.0)]
@@ -63,7 +65,8 @@ struct Args {
 
 fn main() -> anyhow::Result<()> {
     let args = Args::parse();
-    let specs = presets::by_name(&args.device).with_context(|| format!("no device preset matches {:?}", args.device))?;
+    let specs =
+        presets::by_name(&args.device).with_context(|| format!("no device preset matches {:?}", args.device))?;
 
     let locked = args.realtime.is_some() && haptico::timing::lock_memory();
     let started = Instant::now();

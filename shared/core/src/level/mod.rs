@@ -171,8 +171,7 @@ impl Level {
     /// Reads and validates a level file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self, LevelError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path)
-            .map_err(|source| LevelError::Io { path: path.to_owned(), source })?;
+        let text = std::fs::read_to_string(path).map_err(|source| LevelError::Io { path: path.to_owned(), source })?;
         Self::parse(&text, path)
     }
 
@@ -185,11 +184,7 @@ impl Level {
             column: e.span.start.col,
             message: e.code.to_string(),
         })?;
-        level.validate().map_err(|(place, problem)| LevelError::Invalid {
-            path: path.to_owned(),
-            place,
-            problem,
-        })?;
+        level.validate().map_err(|(place, problem)| LevelError::Invalid { path: path.to_owned(), place, problem })?;
         Ok(level)
     }
 
@@ -220,7 +215,10 @@ impl Level {
             return err("time_limit_s".into(), format!("must be a positive number, got {}", self.time_limit_s));
         }
         if self.rooms.len() < MIN_ROOMS {
-            return err("rooms".into(), format!("a museum needs at least {MIN_ROOMS} rooms, found {}", self.rooms.len()));
+            return err(
+                "rooms".into(),
+                format!("a museum needs at least {MIN_ROOMS} rooms, found {}", self.rooms.len()),
+            );
         }
         for (i, room) in self.rooms.iter().enumerate() {
             let place = format!("rooms[{i}] ({})", room.id);
@@ -228,7 +226,10 @@ impl Level {
                 return err(place, "corners must be finite numbers".into());
             }
             if room.max.x - room.min.x < 2.0 || room.max.y - room.min.y < 2.0 {
-                return err(place, format!("must be at least 2 m on each side (min {:?}, max {:?})", room.min, room.max));
+                return err(
+                    place,
+                    format!("must be at least 2 m on each side (min {:?}, max {:?})", room.min, room.max),
+                );
             }
             if self.rooms[..i].iter().any(|r| r.id == room.id) {
                 return err(place, format!("duplicate room id `{}`", room.id));
@@ -260,10 +261,7 @@ impl Level {
                 return err(place, format!("attenuation must be within 0..=1, got {}", door.attenuation));
             }
             if geometry::shared_wall_axis(&self.rooms[ra], &self.rooms[rb], door.at).is_none() {
-                return err(
-                    place,
-                    format!("{:?} is not on a wall shared by `{a}` and `{b}`", door.at),
-                );
+                return err(place, format!("{:?} is not on a wall shared by `{a}` and `{b}`", door.at));
             }
         }
         let nav = NavGraph::new(self);
@@ -283,11 +281,17 @@ impl Level {
             }
         }
         if self.targets.len() < MIN_TARGETS {
-            return err("targets".into(), format!("a heist needs at least {MIN_TARGETS} targets, found {}", self.targets.len()));
+            return err(
+                "targets".into(),
+                format!("a heist needs at least {MIN_TARGETS} targets, found {}", self.targets.len()),
+            );
         }
         for (i, t) in self.targets.iter().enumerate() {
             if t.copies < 3 {
-                return err(format!("targets[{i}]"), format!("needs at least 3 copies (1 real + 2 fakes), got {}", t.copies));
+                return err(
+                    format!("targets[{i}]"),
+                    format!("needs at least 3 copies (1 real + 2 fakes), got {}", t.copies),
+                );
             }
             if self.targets[..i].iter().any(|o| o.kind == t.kind) {
                 return err(format!("targets[{i}]"), format!("artifact {:?} is listed twice", t.kind));
@@ -300,7 +304,10 @@ impl Level {
             );
         }
         if self.guards.len() < MIN_GUARDS {
-            return err("guards".into(), format!("a museum needs at least {MIN_GUARDS} guards, found {}", self.guards.len()));
+            return err(
+                "guards".into(),
+                format!("a museum needs at least {MIN_GUARDS} guards, found {}", self.guards.len()),
+            );
         }
         for (g, guard) in self.guards.iter().enumerate() {
             if guard.route.is_empty() {
@@ -345,8 +352,11 @@ mod tests {
 
     #[test]
     fn a_door_between_unknown_rooms_is_named() {
-        let text = include_str!("../../../../assets/levels/museum.ron")
-            .replacen("between: (\"lobby\"", "between: (\"attic\"", 1);
+        let text = include_str!("../../../../assets/levels/museum.ron").replacen(
+            "between: (\"lobby\"",
+            "between: (\"attic\"",
+            1,
+        );
         let e = Level::parse(&text, "m.ron").unwrap_err().to_string();
         assert!(e.contains("doors[") && e.contains("unknown room `attic`"), "{e}");
     }

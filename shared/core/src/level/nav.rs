@@ -43,8 +43,7 @@ impl NavGraph {
         let mut door_gain = Vec::with_capacity(level.doors.len());
         for (i, door) in level.doors.iter().enumerate() {
             door_gain.push(if door.open { 1.0 } else { door.attenuation });
-            let (Some(a), Some(b)) = (level.room_index(&door.between.0), level.room_index(&door.between.1))
-            else {
+            let (Some(a), Some(b)) = (level.room_index(&door.between.0), level.room_index(&door.between.1)) else {
                 continue;
             };
             let into = |r: usize| {

@@ -1,7 +1,11 @@
 //! Messages from a client to the server, grouped by phase and role.
 
 use bevy::prelude::*;
-use bevy_replicon::{bytes::Bytes, postcard, shared::message::ctx::{ClientSendCtx, ServerReceiveCtx}};
+use bevy_replicon::{
+    bytes::Bytes,
+    postcard,
+    shared::message::ctx::{ClientSendCtx, ServerReceiveCtx},
+};
 use glam::{Quat, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 

@@ -13,12 +13,10 @@ mod verify;
 pub use client_msg::{ClientMsg, Gait, LobbyMsg, PhantomMsg, ViveMsg, WarningKind};
 pub use ids::{CaseId, GuardId, ItemId, Role};
 pub use replicated::{
-    Audience, CaseView, ClientRole, GuardAlert, GuardView, ItemKind, ItemPlace, ItemView, LossReason, Phase, PhantomTool,
-    SessionView, Stance, ViveAvatar, REPLICATED,
+    Audience, CaseView, ClientRole, GuardAlert, GuardView, ItemKind, ItemPlace, ItemView, LossReason, PhantomTool,
+    Phase, REPLICATED, SessionView, Stance, ViveAvatar,
 };
-pub use server_msg::{
-    DisconnectReason, GameEvent, NoiseKind, Refusal, ServerMsg, VerdictOutcome, WorkbenchCopy,
-};
+pub use server_msg::{DisconnectReason, GameEvent, NoiseKind, Refusal, ServerMsg, VerdictOutcome, WorkbenchCopy};
 pub use token::{JoinRequest, JoinResponse, TokenUserData, USER_DATA_MAGIC};
 pub use verify::verify;
 

@@ -4,9 +4,9 @@ use bevy::prelude::*;
 use glam::Vec2;
 use serde::{Deserialize, Serialize};
 
+use super::client_msg::WarningKind;
 use super::ids::{CaseId, GuardId, ItemId, Role};
 use super::replicated::{GuardAlert, Phase};
-use super::client_msg::WarningKind;
 use crate::artifact::{Briefing, HapticMesh, Material};
 
 /// Everything the server can say to one client.

@@ -23,7 +23,13 @@ pub enum Separation {
 }
 
 /// Separation of `a` at `pose_a` and `b` at `pose_b`.
-pub fn separation(a: &InnerSphereTree, pose_a: &Pose, b: &InnerSphereTree, pose_b: &Pose, ws: &mut QueryWorkspace) -> Separation {
+pub fn separation(
+    a: &InnerSphereTree,
+    pose_a: &Pose,
+    b: &InnerSphereTree,
+    pose_b: &Pose,
+    ws: &mut QueryWorkspace,
+) -> Separation {
     let pos12 = pose_a.relative_to(pose_b);
     let gap = |ca: Vec3, ra: f32, cb: Vec3, rb: f32| ca.distance(cb) - ra - rb;
     let mut best = f32::INFINITY;
@@ -59,7 +65,11 @@ pub fn separation(a: &InnerSphereTree, pose_a: &Pose, b: &InnerSphereTree, pose_
         for (k, kid) in kids.iter_mut().enumerate().take(n) {
             let (ca, cb_) = if descend_a { (na.first + k as u32, ib) } else { (ia, nb.first + k as u32) };
             let (ma, mb) = (&a.nodes[ca as usize], &b.nodes[cb_ as usize]);
-            *kid = (ca, cb_, gap(ma.bound.center, ma.bound.radius, pos12.transform_point(mb.bound.center), mb.bound.radius));
+            *kid = (
+                ca,
+                cb_,
+                gap(ma.bound.center, ma.bound.radius, pos12.transform_point(mb.bound.center), mb.bound.radius),
+            );
         }
         kids[..n].sort_unstable_by(|x, y| y.2.total_cmp(&x.2));
         ws.stack.extend(kids[..n].iter().filter(|k| k.2 < best).map(|k| (k.0, k.1)));

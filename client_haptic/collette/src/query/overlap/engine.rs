@@ -26,9 +26,26 @@ pub(super) struct Engine<'a, S> {
 impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
     /// `aggregate`: a node lying wholly inside one leaf sphere of the other tree contributes its summed
     /// volume as one contact (exact volume, far fewer pairs) instead of one contact per leaf pair.
-    pub(super) fn new(a: &'a InnerSphereTree, b: &'a InnerSphereTree, pos12: Pose, budget: Budget, aggregate: bool, sink: S) -> Self {
+    pub(super) fn new(
+        a: &'a InnerSphereTree,
+        b: &'a InnerSphereTree,
+        pos12: Pose,
+        budget: Budget,
+        aggregate: bool,
+        sink: S,
+    ) -> Self {
         let result = OverlapResult { complete: true, ..OverlapResult::default() };
-        Self { a, b, pos12: Affine3A::from_rotation_translation(pos12.rotation, pos12.translation), budget, aggregate, sink, until_clock: 0, exhausted: false, result }
+        Self {
+            a,
+            b,
+            pos12: Affine3A::from_rotation_translation(pos12.rotation, pos12.translation),
+            budget,
+            aggregate,
+            sink,
+            until_clock: 0,
+            exhausted: false,
+            result,
+        }
     }
 
     /// Maps a point of B's frame into A's frame.
@@ -79,7 +96,8 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
             if len >= 32 {
                 // Keep the reserve calibrated to this machine (slow to shrink, quick to grow).
                 let per = start.elapsed().as_nanos() as f32 / len as f32;
-                ws.estimate_ns = if per > ws.estimate_ns { per } else { 0.9 * ws.estimate_ns + 0.1 * per }.clamp(5.0, 1000.0);
+                ws.estimate_ns =
+                    if per > ws.estimate_ns { per } else { 0.9 * ws.estimate_ns + 0.1 * per }.clamp(5.0, 1000.0);
             }
         }
     }
@@ -192,7 +210,8 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
                 let c = self.tp(sb.center);
                 let d = na.bound.center.distance(c);
                 if d + na.bound.radius <= sb.radius {
-                    let l = Lens { volume: na.volume, centroid: na.bound.center, depth: sb.radius + na.bound.radius - d };
+                    let l =
+                        Lens { volume: na.volume, centroid: na.bound.center, depth: sb.radius + na.bound.radius - d };
                     self.emit_aggregate(&l, na.bound.center, c);
                     return true;
                 }

@@ -44,8 +44,15 @@ pub struct OverlapResult {
 }
 
 /// Total overlap volume of `a` at `pose_a` and `b` at `pose_b` (exact, no contacts reported).
-pub fn overlap_volume(a: &InnerSphereTree, pose_a: &Pose, b: &InnerSphereTree, pose_b: &Pose, ws: &mut QueryWorkspace) -> OverlapResult {
-    let mut engine = Engine::new(a, b, pose_a.relative_to(pose_b), Budget::Unlimited, true, |_: &Lens, _: Vec3, _: Vec3| {});
+pub fn overlap_volume(
+    a: &InnerSphereTree,
+    pose_a: &Pose,
+    b: &InnerSphereTree,
+    pose_b: &Pose,
+    ws: &mut QueryWorkspace,
+) -> OverlapResult {
+    let mut engine =
+        Engine::new(a, b, pose_a.relative_to(pose_b), Budget::Unlimited, true, |_: &Lens, _: Vec3, _: Vec3| {});
     engine.run_depth_first(ws);
     engine.result
 }
@@ -102,7 +109,12 @@ fn run(
         let delta = ca - cb;
         let len = delta.length();
         let normal = if len > 1e-12 { rot * (delta / len) } else { fallback };
-        out.push(Contact { point: pose_a.transform_point(lens.centroid), normal, volume: lens.volume, depth: lens.depth });
+        out.push(Contact {
+            point: pose_a.transform_point(lens.centroid),
+            normal,
+            volume: lens.volume,
+            depth: lens.depth,
+        });
     };
     let mut engine = Engine::new(a, b, pose_a.relative_to(pose_b), budget, aggregate, sink);
     match budget {

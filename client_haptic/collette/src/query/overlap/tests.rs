@@ -164,9 +164,9 @@ mod properties {
     use proptest::prelude::*;
 
     fn pose() -> impl Strategy<Value = Pose> {
-        (-1.5f32..1.5, -1.5f32..1.5, -1.5f32..1.5, -3.2f32..3.2, -3.2f32..3.2, -3.2f32..3.2).prop_map(|(x, y, z, a, b, c)| {
-            Pose::new(Vec3::new(x, y, z), Quat::from_euler(glam::EulerRot::XYZ, a, b, c))
-        })
+        (-1.5f32..1.5, -1.5f32..1.5, -1.5f32..1.5, -3.2f32..3.2, -3.2f32..3.2, -3.2f32..3.2).prop_map(
+            |(x, y, z, a, b, c)| Pose::new(Vec3::new(x, y, z), Quat::from_euler(glam::EulerRot::XYZ, a, b, c)),
+        )
     }
 
     proptest! {

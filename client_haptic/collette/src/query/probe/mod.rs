@@ -68,7 +68,8 @@ mod tests {
 
     #[test]
     fn a_point_inside_a_sphere_reports_depth_and_outward_normal() {
-        let t = InnerSphereTree::from_spheres(vec![Sphere::new(Vec3::ZERO, 1.0), Sphere::new(Vec3::X * 3.0, 1.0)], 10.0);
+        let t =
+            InnerSphereTree::from_spheres(vec![Sphere::new(Vec3::ZERO, 1.0), Sphere::new(Vec3::X * 3.0, 1.0)], 10.0);
         let pose = Pose::from_translation(Vec3::Z * 5.0);
         let mut ws = QueryWorkspace::new();
         let hit = probe(&t, &pose, Vec3::new(0.0, 0.0, 5.75), 0.0, &mut ws, None).expect("inside");
