@@ -1,0 +1,26 @@
+//! You need this crate to move the game's datagrams between a UDP socket and renet without trusting a
+//! single byte of them: it runs netcode (renetcode) and renet as bevy_renet's netcode transport does, but
+//! checks every datagram's header before netcode parses it ([`datagram`]), every decrypted renet packet
+//! before renet parses it ([`payload`]), and limits the rate of both ([`limit`]). renetcode 2.0.0 and
+//! renet 2.0.1 panic on packets these checks refuse (docs/decisions.md has the reports).
+//!
+//! No Bevy and no socket: [`ServerIntake`] and [`ClientIntake`] take datagrams and a send function, so the
+//! game, the tests and the fuzz target drive the same code.
+#![warn(missing_docs)]
+
+pub mod client;
+pub mod datagram;
+mod error;
+pub mod limit;
+#[cfg(feature = "test-support")]
+pub mod memory;
+pub mod payload;
+pub mod server;
+pub mod throttle;
+
+pub use client::ClientIntake;
+pub use error::{DatagramRefusal, PayloadRefusal, TransportError};
+pub use server::{IntakeLimits, IntakeStats, Refused, ServerIntake};
+
+pub use renet;
+pub use renetcode;
