@@ -3,9 +3,9 @@
 use bevy::prelude::*;
 use bevy_replicon::prelude::*;
 use bevy_replicon::shared::backend::connected_client::NetworkId;
-use bevy_replicon_renet::netcode::NetcodeServerTransport;
 use heist_shared::protocol::{ClientRole, DisconnectReason, Role, ServerMsg, TokenUserData};
 
+use super::transport::GameTransport;
 use super::{Auth, NetSettings};
 use crate::session::{GameState, SessionLog};
 
@@ -65,7 +65,7 @@ pub(super) fn admit(
     add: On<Add, ConnectedClient>,
     mut commands: Commands,
     ids: Query<&NetworkId>,
-    transport: Option<Res<NetcodeServerTransport>>,
+    transport: Option<Res<GameTransport>>,
     settings: Res<NetSettings>,
     mut roles: ResMut<Roles>,
     mut game: ResMut<GameState>,

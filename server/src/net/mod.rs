@@ -8,16 +8,18 @@ mod admission;
 pub mod receive;
 pub mod send;
 pub mod tokens;
+pub mod transport;
 
 use std::net::{SocketAddr, UdpSocket};
 use std::time::{SystemTime, UNIX_EPOCH};
 
 use bevy::prelude::*;
 use bevy_replicon::prelude::*;
-use bevy_replicon_renet::netcode::{NetcodeServerTransport, ServerAuthentication, ServerConfig};
 use bevy_replicon_renet::renet::ConnectionConfig;
 use bevy_replicon_renet::{RenetChannelsExt, RenetServer};
 use heist_shared::protocol::{PROTOCOL_ID, Role};
+use heist_transport::IntakeLimits;
+use heist_transport::renetcode::{ServerAuthentication, ServerConfig};
 
 pub use admission::{Player, Roles};
 use tokens::RoleTable;
@@ -90,6 +92,7 @@ impl Plugin for ServerNetPlugin {
             .configure_sets(PostUpdate, NetSystems::Send.before(ServerSystems::Send))
             .add_systems(PreUpdate, receive::apply_client_messages.in_set(NetSystems::Receive))
             .add_systems(PostUpdate, send::send_outgoing.in_set(NetSystems::Send));
+        transport::add_systems(app);
     }
 }
 
@@ -119,7 +122,7 @@ fn start_transport(
         public_addresses: vec![settings.advertise.unwrap_or(addr)],
         authentication,
     };
-    match NetcodeServerTransport::new(config, socket) {
+    match transport::GameTransport::new(socket, config, IntakeLimits::default()) {
         Ok(transport) => {
             let connection = ConnectionConfig {
                 server_channels_config: channels.server_configs(),

@@ -9,7 +9,7 @@ use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
-use bevy_replicon_renet::netcode::ConnectToken;
+use heist_transport::renetcode::ConnectToken;
 use heist_shared::protocol::{JoinRequest, JoinResponse, PROTOCOL_ID, Role, TokenUserData};
 
 /// Longest request line accepted, bytes.

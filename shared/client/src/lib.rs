@@ -8,6 +8,7 @@
 
 mod error;
 mod token;
+pub mod transport;
 
 pub use error::JoinError;
 pub use token::request_token;
@@ -17,12 +18,13 @@ use std::time::{SystemTime, UNIX_EPOCH};
 
 use bevy::prelude::*;
 use bevy_replicon::prelude::*;
-use bevy_replicon_renet::netcode::{ClientAuthentication, ConnectToken, NetcodeClientTransport};
 use bevy_replicon_renet::renet::ConnectionConfig;
 use bevy_replicon_renet::{RenetChannelsExt, RenetClient};
 use heist_shared::artifact::Briefing;
 use heist_shared::level::Level;
 use heist_shared::protocol::{DisconnectReason, GameEvent, Refusal, Role, ServerMsg, WorkbenchCopy};
+use heist_transport::ClientIntake;
+use heist_transport::renetcode::{ClientAuthentication, ConnectToken};
 
 /// What the server has told this client, kept for the app's systems to read.
 #[derive(Resource, Default, Debug)]
@@ -78,6 +80,7 @@ impl Plugin for ClientNetPlugin {
             .init_resource::<Inbox>()
             .configure_sets(PreUpdate, ClientNetSystems::Receive.after(ClientSystems::Receive))
             .add_systems(PreUpdate, fill_inbox.in_set(ClientNetSystems::Receive));
+        transport::add_systems(app);
     }
 }
 
@@ -131,7 +134,8 @@ fn insert_transport(app: &mut App, server: std::net::SocketAddr, auth: ClientAut
     let bind = if server.ip().is_loopback() { "127.0.0.1:0" } else { "0.0.0.0:0" };
     let socket = UdpSocket::bind(bind).map_err(JoinError::Socket)?;
     let now = SystemTime::now().duration_since(UNIX_EPOCH).unwrap_or_default();
-    let transport = NetcodeClientTransport::new(now, auth, socket).map_err(|e| JoinError::Transport(e.to_string()))?;
+    let intake = ClientIntake::new(now, auth).map_err(|e| JoinError::Transport(e.to_string()))?;
+    let transport = transport::ClientTransport::new(socket, intake).map_err(JoinError::Socket)?;
     let channels = app.world().resource::<RepliconChannels>();
     let connection = ConnectionConfig {
         server_channels_config: channels.server_configs(),

@@ -4,7 +4,7 @@ use std::io::{BufRead, BufReader, Read, Write};
 use std::net::{SocketAddr, TcpStream};
 use std::time::Duration;
 
-use bevy_replicon_renet::netcode::ConnectToken;
+use heist_transport::renetcode::ConnectToken;
 use heist_shared::protocol::{JoinRequest, JoinResponse, Role};
 
 use crate::JoinError;

@@ -1,0 +1,113 @@
+//! The game socket: every datagram through heist_transport's checks into netcode and renet, and renet's
+//! packets back out. Stands where bevy_renet's `NetcodeServerTransport` would (same schedule slots), so a
+//! datagram that would panic renetcode or renet never reaches them.
+
+use std::io::ErrorKind;
+use std::net::{SocketAddr, UdpSocket};
+
+use bevy::prelude::*;
+use bevy_replicon_renet::{RenetReceive, RenetSend, RenetServer, RenetServerPlugin};
+use heist_transport::renetcode::{NETCODE_USER_DATA_BYTES, ServerConfig};
+use heist_transport::{IntakeLimits, IntakeStats, ServerIntake};
+
+/// Datagrams read per frame at most: a flood waits in the kernel's buffer (and is dropped there) instead
+/// of stalling the tick.
+pub const MAX_DATAGRAMS_PER_FRAME: usize = 4096;
+
+/// The bound game socket and the intake that checks what arrives on it.
+#[derive(Resource)]
+pub struct GameTransport {
+    socket: UdpSocket,
+    intake: ServerIntake,
+    /// Larger than netcode's 1400 so an oversized datagram is seen as such, not silently cut.
+    buffer: Box<[u8; 1500]>,
+}
+
+impl GameTransport {
+    /// Serves `socket` (made non-blocking) with a netcode server made from `config`.
+    pub fn new(socket: UdpSocket, config: ServerConfig, limits: IntakeLimits) -> std::io::Result<Self> {
+        socket.set_nonblocking(true)?;
+        Ok(Self { socket, intake: ServerIntake::new(config, limits), buffer: Box::new([0; 1500]) })
+    }
+
+    /// The user data in a connected client's token.
+    pub fn user_data(&self, client_id: u64) -> Option<[u8; NETCODE_USER_DATA_BYTES]> {
+        self.intake.user_data(client_id)
+    }
+
+    /// A connected client's address.
+    pub fn client_addr(&self, client_id: u64) -> Option<SocketAddr> {
+        self.intake.client_addr(client_id)
+    }
+
+    /// What the intake passed and refused so far.
+    pub fn stats(&self) -> IntakeStats {
+        self.intake.stats()
+    }
+}
+
+/// Adds the transport's systems; the resource is inserted at start-up by the network plugin.
+pub(super) fn add_systems(app: &mut App) {
+    app.add_systems(
+        PreUpdate,
+        receive
+            .in_set(RenetReceive)
+            .after(RenetServerPlugin::update_system)
+            .before(RenetServerPlugin::emit_server_events_system)
+            .run_if(resource_exists::<GameTransport>)
+            .run_if(resource_exists::<RenetServer>),
+    )
+    .add_systems(
+        PostUpdate,
+        send.in_set(RenetSend).run_if(resource_exists::<GameTransport>).run_if(resource_exists::<RenetServer>),
+    )
+    .add_systems(
+        Last,
+        disconnect_on_exit.run_if(resource_exists::<GameTransport>).run_if(resource_exists::<RenetServer>),
+    );
+}
+
+fn send_to(socket: &UdpSocket) -> impl FnMut(SocketAddr, &[u8]) + '_ {
+    move |to, bytes| {
+        if let Err(e) = socket.send_to(bytes, to) {
+            debug!("cannot send {} bytes to {to}: {e}", bytes.len());
+        }
+    }
+}
+
+fn receive(mut transport: ResMut<GameTransport>, mut renet: ResMut<RenetServer>, time: Res<Time<Real>>) {
+    let GameTransport { socket, intake, buffer } = &mut *transport;
+    intake.advance(time.delta());
+    let mut send = send_to(socket);
+    for _ in 0..MAX_DATAGRAMS_PER_FRAME {
+        match socket.recv_from(&mut buffer[..]) {
+            Ok((len, from)) => {
+                // Refusals are counted and logged (throttled) by the intake.
+                let _ = intake.receive(from, &mut buffer[..len], &mut renet, &mut send);
+            }
+            Err(e) if e.kind() == ErrorKind::WouldBlock => break,
+            Err(e) if matches!(e.kind(), ErrorKind::Interrupted | ErrorKind::ConnectionReset) => continue,
+            Err(e) => {
+                error!("the game socket failed: {e}");
+                break;
+            }
+        }
+    }
+    intake.update(&mut renet, &mut send);
+}
+
+fn send(mut transport: ResMut<GameTransport>, mut renet: ResMut<RenetServer>) {
+    let GameTransport { socket, intake, .. } = &mut *transport;
+    intake.send_packets(&mut renet, &mut send_to(socket));
+}
+
+fn disconnect_on_exit(
+    exit: MessageReader<AppExit>,
+    mut transport: ResMut<GameTransport>,
+    mut renet: ResMut<RenetServer>,
+) {
+    if !exit.is_empty() {
+        let GameTransport { socket, intake, .. } = &mut *transport;
+        intake.disconnect_all(&mut renet, &mut send_to(socket));
+    }
+}

@@ -1,0 +1,125 @@
+//! The client's socket: datagrams from the server through heist_transport's checks into netcode and
+//! renet, renet's packets back out. Stands where bevy_renet's `NetcodeClientTransport` would (same
+//! schedule slots), so a datagram spoofed from the server's address cannot panic the client.
+
+use std::io::ErrorKind;
+use std::net::{SocketAddr, UdpSocket};
+
+use bevy::prelude::*;
+use bevy_replicon_renet::{RenetClient, RenetClientPlugin, RenetReceive, RenetSend};
+use heist_transport::renetcode::{DisconnectReason, NetcodeError};
+use heist_transport::{ClientIntake, TransportError};
+
+/// Datagrams read per frame at most, so a flood cannot stall a frame.
+pub const MAX_DATAGRAMS_PER_FRAME: usize = 1024;
+
+/// The client's socket and the intake that checks what arrives on it.
+#[derive(Resource)]
+pub struct ClientTransport {
+    socket: UdpSocket,
+    intake: ClientIntake,
+    buffer: Box<[u8; 1500]>,
+    /// Why the transport stopped, once it has.
+    pub stopped: Option<String>,
+}
+
+impl ClientTransport {
+    /// Serves `socket` (made non-blocking) for `intake`.
+    pub fn new(socket: UdpSocket, intake: ClientIntake) -> std::io::Result<Self> {
+        socket.set_nonblocking(true)?;
+        Ok(Self { socket, intake, buffer: Box::new([0; 1500]), stopped: None })
+    }
+
+    /// Why netcode gave up, if it did.
+    pub fn disconnect_reason(&self) -> Option<DisconnectReason> {
+        self.intake.disconnect_reason()
+    }
+
+    /// The server's address.
+    pub fn server_addr(&self) -> SocketAddr {
+        self.intake.server_addr()
+    }
+
+    /// Datagrams and payloads refused so far.
+    pub fn refused(&self) -> u64 {
+        self.intake.refused()
+    }
+}
+
+/// Adds the transport's systems (the resource is inserted by `connect`).
+pub(crate) fn add_systems(app: &mut App) {
+    app.add_systems(
+        PreUpdate,
+        receive
+            .in_set(RenetReceive)
+            .after(RenetClientPlugin::update_system)
+            .run_if(resource_exists::<ClientTransport>)
+            .run_if(resource_exists::<RenetClient>),
+    )
+    .add_systems(
+        PostUpdate,
+        send.in_set(RenetSend).run_if(resource_exists::<ClientTransport>).run_if(resource_exists::<RenetClient>),
+    )
+    .add_systems(
+        Last,
+        disconnect_on_exit.run_if(resource_exists::<ClientTransport>).run_if(resource_exists::<RenetClient>),
+    );
+}
+
+fn send_to(socket: &UdpSocket) -> impl FnMut(SocketAddr, &[u8]) + '_ {
+    move |to, bytes| {
+        if let Err(e) = socket.send_to(bytes, to) {
+            debug!("cannot send {} bytes to {to}: {e}", bytes.len());
+        }
+    }
+}
+
+fn stop(stopped: &mut Option<String>, error: TransportError) {
+    if stopped.is_none() {
+        // Said once: the transport keeps reporting the same reason every frame.
+        match &error {
+            TransportError::Netcode(NetcodeError::Disconnected(reason)) => info!("disconnected: {reason}"),
+            e => warn!("connection lost: {e}"),
+        }
+        *stopped = Some(error.to_string());
+    }
+}
+
+fn receive(mut transport: ResMut<ClientTransport>, mut renet: ResMut<RenetClient>, time: Res<Time<Real>>) {
+    let ClientTransport { socket, intake, buffer, stopped } = &mut *transport;
+    let mut send = send_to(socket);
+    if let Err(e) = intake.begin_update(&mut renet, &mut send) {
+        stop(stopped, e);
+        return;
+    }
+    for _ in 0..MAX_DATAGRAMS_PER_FRAME {
+        match socket.recv_from(&mut buffer[..]) {
+            Ok((len, from)) => {
+                if let Err(r) = intake.receive(from, &mut buffer[..len], &mut renet) {
+                    debug!("refused a datagram from {from}: {r}");
+                }
+            }
+            Err(e) if e.kind() == ErrorKind::WouldBlock => break,
+            Err(e) if matches!(e.kind(), ErrorKind::Interrupted | ErrorKind::ConnectionReset) => continue,
+            Err(e) => {
+                stop(stopped, TransportError::Io(e));
+                break;
+            }
+        }
+    }
+    intake.finish_update(time.delta(), &mut send);
+}
+
+fn send(mut transport: ResMut<ClientTransport>, mut renet: ResMut<RenetClient>) {
+    let ClientTransport { socket, intake, stopped, .. } = &mut *transport;
+    if let Err(e) = intake.send_packets(&mut renet, &mut send_to(socket)) {
+        stop(stopped, e);
+    }
+}
+
+fn disconnect_on_exit(exit: MessageReader<AppExit>, mut transport: ResMut<ClientTransport>) {
+    if !exit.is_empty() {
+        let ClientTransport { socket, intake, .. } = &mut *transport;
+        intake.disconnect(&mut send_to(socket));
+    }
+}
