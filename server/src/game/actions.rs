@@ -2,7 +2,7 @@
 
 use glam::Vec2;
 use heist_shared::protocol::{
-    CaseId, Gait, GameEvent, ItemId, ItemKind, ItemPlace, NoiseKind, PhantomMsg, Phase, Refusal, Role, ServerMsg,
+    CaseId, Gait, GameEvent, ItemId, ItemKind, ItemPlace, NoiseKind, PhantomMsg, PhantomTool, Phase, Refusal, Role, ServerMsg,
     Stance, VerdictOutcome, ViveMsg, WorkbenchCopy,
 };
 use heist_shared::rules;
@@ -55,7 +55,10 @@ impl Game {
     pub(super) fn apply_phantom(&mut self, msg: &PhantomMsg) -> Result<(), Refusal> {
         match *msg {
             PhantomMsg::Verdict { item, real } => self.verdict(item, real),
-            PhantomMsg::ToolPose { .. } => Ok(()),
+            PhantomMsg::ToolPose { position, rotation } => {
+                self.tool = PhantomTool { position, rotation };
+                Ok(())
+            }
             PhantomMsg::Warn(kind) => {
                 self.outgoing.push(Outgoing::To(Role::Vive, ServerMsg::Event(GameEvent::Warning(kind))));
                 Ok(())

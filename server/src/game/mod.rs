@@ -15,8 +15,8 @@ use glam::Vec2;
 use heist_shared::artifact::{ArtifactKind, Briefing};
 use heist_shared::level::{Level, NavGraph, WallSet};
 use heist_shared::protocol::{
-    CaseId, ClientMsg, GameEvent, ItemId, ItemKind, ItemPlace, LobbyMsg, LossReason, NoiseKind, Phase, Refusal, Role,
-    ServerMsg, Stance, verify,
+    CaseId, ClientMsg, GameEvent, ItemId, ItemKind, ItemPlace, LobbyMsg, LossReason, NoiseKind, Phase, PhantomTool, Refusal,
+    Role, ServerMsg, Stance, verify,
 };
 use heist_shared::rules;
 use rand_chacha::ChaCha8Rng;
@@ -91,6 +91,9 @@ pub const MAX_QUEUED_INPUTS: usize = 60;
 pub const MAX_MOVE_CREDIT: i32 = 30;
 /// Inputs applied in one tick at most (catching up).
 pub const MAX_INPUTS_PER_TICK: usize = 4;
+/// Ticks of movement an action may fast-forward beyond the banked credit (the inputs that arrived in the
+/// same frame as it); later ticks repay them.
+pub const MAX_MOVE_DEBT: i32 = MAX_INPUTS_PER_TICK as i32;
 
 /// A display case.
 #[derive(Clone, Debug)]
@@ -154,6 +157,10 @@ pub struct Game {
     pub workbench: Option<ItemId>,
     /// Connected roles (Vive, Phantom).
     pub present: (bool, bool),
+    /// Where Phantom's tool was last reported (workbench frame), for Vive's client to draw.
+    pub tool: PhantomTool,
+    /// The seed the session was made from (secret while it runs: it decides which copy is real).
+    pub seed: u64,
     ready: (bool, bool),
     absent_s: f32,
     noises: Vec<(Vec2, f32)>,
@@ -293,7 +300,19 @@ impl Game {
             applied += 1;
         }
         self.vive.velocity = (self.vive.position - before) / dt.max(1e-6);
-        if self.vive.stance == Stance::Running && self.vive.velocity.length() > 0.5 {
+    }
+
+    /// Moves the body by the oldest queued input, spending a tick of credit; false when none waits.
+    /// Every running input counts towards footsteps, however it was applied.
+    fn apply_next_input(&mut self, dt: f32) -> bool {
+        let Some(input) = self.vive.inputs.pop_front() else { return false };
+        let from = self.vive.position;
+        self.vive.position = rules::move_body(&self.walls, from, input.direction, input.speed, dt);
+        self.vive.stance = input.stance;
+        self.vive.facing = input.facing;
+        self.vive.last_input_seq = input.seq;
+        self.vive.move_credit -= 1;
+        if input.stance == Stance::Running && self.vive.position.distance(from) > 0.5 * dt {
             self.vive.footstep_timer -= dt;
             if self.vive.footstep_timer <= 0.0 {
                 self.vive.footstep_timer = 0.5;
@@ -301,23 +320,15 @@ impl Game {
                 self.noise(NoiseKind::Footsteps, at, rules::RUN_LOUDNESS);
             }
         }
-    }
-
-    /// Moves the body by the oldest queued input; false when none waits.
-    fn apply_next_input(&mut self, dt: f32) -> bool {
-        let Some(input) = self.vive.inputs.pop_front() else { return false };
-        self.vive.position = rules::move_body(&self.walls, self.vive.position, input.direction, input.speed, dt);
-        self.vive.stance = input.stance;
-        self.vive.facing = input.facing;
-        self.vive.last_input_seq = input.seq;
-        self.vive.move_credit -= 1;
         true
     }
 
-    /// Applies every queued input now: an action arrived after them, so the player meant it from where
-    /// they lead.
+    /// Applies the queued inputs now, as far as the move credit allows (it may run
+    /// [`MAX_MOVE_DEBT`] ticks into debt, repaid by later ticks): an action arrived after them, so the
+    /// player meant it from where they lead. However often actions come, the body never moves more
+    /// ticks than have passed plus the banked credit.
     pub(super) fn fast_forward_inputs(&mut self, dt: f32) {
-        while self.apply_next_input(dt) {}
+        while self.vive.move_credit > -MAX_MOVE_DEBT && self.apply_next_input(dt) {}
     }
 
     fn step_guards(&mut self, dt: f32) {

@@ -86,6 +86,8 @@ pub(super) fn new_game(level: Level, options: &GameOptions) -> Game {
         outgoing: Vec::new(),
         rng,
         level,
+        seed: options.seed,
+        tool: Default::default(),
     }
 }
 

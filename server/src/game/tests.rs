@@ -250,16 +250,78 @@ fn sending_faster_than_the_tick_rate_gains_no_speed() {
 fn an_action_applies_the_inputs_sent_before_it_first() {
     let mut g = started(3);
     let case = g.cases[0].position;
-    // Put the body 2 m from the case; two queued inputs bring it within reach.
+    // Put the body 2 m from the case; the queued inputs bring it within reach. Their ticks passed while
+    // they were late (banked credit), as when the network bunches them.
     let dir = Vec2::X;
     g.vive.position = case - dir * (heist_shared::rules::REACH + 0.05);
+    for _ in 0..10 {
+        g.step(TICK_S);
+    }
+    let start = g.vive.position;
     for seq in 1..=10 {
         vive(&mut g, walk(seq, dir)).unwrap();
     }
-    assert_eq!(
-        vive(&mut g, ViveMsg::Break(heist_shared::protocol::CaseId(0))),
-        Ok(()),
-        "in reach after the queued steps"
-    );
+    assert_eq!(vive(&mut g, ViveMsg::Break(heist_shared::protocol::CaseId(0))), Ok(()), "in reach after the queued steps");
     assert_eq!(g.vive.last_input_seq, 10);
+    assert!(g.vive.position.distance(east_of(start, 10)) < 1e-4);
+}
+
+#[test]
+fn actions_cannot_fast_forward_vive_past_his_move_credit() {
+    // The speed hack: every tick, a second's worth of moves and an action (even a refused one) to
+    // fast-forward them. In the widest room, walking east, with room for far more than allowed.
+    let mut g = started(3);
+    let room = g.level.rooms.iter().max_by(|a, b| (a.max.x - a.min.x).total_cmp(&(b.max.x - b.min.x))).unwrap().clone();
+    let start = Vec2::new(room.min.x + 0.6, room.centre().y);
+    assert!(room.max.x - 0.6 - start.x > 5.0, "the room leaves 5 m to walk");
+    g.vive.position = start;
+    let mut seq = 0;
+    for _ in 0..60 {
+        for _ in 0..60 {
+            seq += 1;
+            vive(&mut g, walk(seq, Vec2::X)).unwrap();
+        }
+        let _ = vive(&mut g, ViveMsg::Break(heist_shared::protocol::CaseId(999)));
+        g.step(TICK_S);
+    }
+    assert_eq!(g.phase, Phase::Heist);
+    let walked = g.vive.position.x - start.x;
+    let most = (60 + MAX_MOVE_CREDIT + MAX_MOVE_DEBT) as f32 * heist_shared::rules::WALK_SPEED * TICK_S;
+    assert!(walked <= most + 1e-3, "walked {walked:.2} m in a second (at most {most:.2})");
+}
+
+#[test]
+fn fast_forwarded_running_is_heard() {
+    let mut g = started(3);
+    // Half a second banked, then half a second of running applied at once by an action.
+    for _ in 0..30 {
+        g.step(TICK_S);
+    }
+    g.drain_outgoing().for_each(drop);
+    for seq in 1..=30 {
+        let run = ViveMsg::Move { seq, direction: Vec2::X, gait: heist_shared::protocol::Gait::Run, facing: 0.0 };
+        vive(&mut g, run).unwrap();
+    }
+    let _ = vive(&mut g, ViveMsg::Break(heist_shared::protocol::CaseId(999)));
+    assert_eq!(g.vive.last_input_seq, 30);
+    let footsteps = g
+        .drain_outgoing()
+        .filter(|o| {
+            matches!(
+                o,
+                Outgoing::All(ServerMsg::Event(GameEvent::Noise { kind: heist_shared::protocol::NoiseKind::Footsteps, .. }))
+            )
+        })
+        .count();
+    assert!(footsteps >= 1, "half a second of running makes footsteps");
+}
+
+#[test]
+fn only_phantom_moves_the_tool() {
+    let mut g = started(3);
+    let pose = PhantomMsg::ToolPose { position: glam::Vec3::new(0.1, 0.2, 0.3), rotation: glam::Quat::IDENTITY };
+    assert_eq!(g.apply(Role::Vive, &ClientMsg::Phantom(pose.clone())), Err(Refusal::WrongRole));
+    assert_eq!(g.tool, Default::default(), "Vive's pose moved nothing");
+    g.apply(Role::Phantom, &ClientMsg::Phantom(pose)).unwrap();
+    assert_eq!(g.tool.position, glam::Vec3::new(0.1, 0.2, 0.3));
 }

@@ -1,8 +1,8 @@
-//! Client messages into the game: decode (already done by the protocol), check, apply or refuse.
+//! Client messages into the game: decode (already done by the protocol), check the rate, apply or refuse.
 
 use bevy::prelude::*;
 use bevy_replicon::prelude::*;
-use heist_shared::protocol::{ClientMsg, DisconnectReason, PhantomMsg, PhantomTool, ServerMsg};
+use heist_shared::protocol::{ClientMsg, DisconnectReason, ServerMsg};
 
 use super::NetSettings;
 use super::admission::{Player, refuse_and_disconnect};
@@ -14,7 +14,6 @@ pub fn apply_client_messages(
     mut received: MessageReader<FromClient<ClientMsg>>,
     mut players: Query<&mut Player>,
     mut game: ResMut<GameState>,
-    mut tool: Query<&mut PhantomTool>,
     settings: Res<NetSettings>,
     time: Res<Time<Real>>,
     mut log: ResMut<SessionLog>,
@@ -34,14 +33,8 @@ pub fn apply_client_messages(
         if player.expelled {
             continue; // being disconnected: nothing more it says counts
         }
-        if let ClientMsg::Phantom(PhantomMsg::ToolPose { position, rotation }) = message
-            && position.is_finite()
-            && rotation.is_finite()
-            && let Ok(mut t) = tool.single_mut()
-        {
-            t.set_if_neq(PhantomTool { position: *position, rotation: *rotation });
-        }
-        if let Err(refusal) = game.0.apply(player.role, message) {
+        let now = time.elapsed_secs_f64();
+        if let Err(refusal) = player.limits.check(message, now).and_then(|()| game.0.apply(player.role, message)) {
             player.strikes += 1.0;
             log.debug(game.0.elapsed_s, format!("{} refused: {refusal:?}", player.role));
             messages.write(ToClients {

@@ -1,0 +1,111 @@
+//! How often a client may send each kind of message. Past its rate a message is refused with
+//! [`Refusal::RateLimited`] and counts against the sender like any refusal, so a flood ends in a
+//! disconnection; nothing it asked for happens.
+
+use heist_shared::protocol::{ClientMsg, LobbyMsg, PhantomMsg, Refusal, ViveMsg};
+use heist_transport::limit::{Bucket, Rate};
+
+/// The kinds of client message, each with its own rate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MsgKind {
+    /// `Ready`.
+    Ready,
+    /// Vive's `Move`: one per tick.
+    Move,
+    /// Vive's actions: break, pick up, drop, throw, place.
+    Action,
+    /// Phantom's verdicts.
+    Verdict,
+    /// Phantom's tool pose: 20 a second from the client.
+    ToolPose,
+    /// Phantom's warnings to Vive.
+    Warn,
+}
+
+impl MsgKind {
+    /// Every kind, in [`MessageLimits`]' order.
+    pub const ALL: [MsgKind; 6] =
+        [MsgKind::Ready, MsgKind::Move, MsgKind::Action, MsgKind::Verdict, MsgKind::ToolPose, MsgKind::Warn];
+
+    /// The kind of `msg`; `None` for a malformed one (refused anyway).
+    pub fn of(msg: &ClientMsg) -> Option<Self> {
+        Some(match msg {
+            ClientMsg::Lobby(LobbyMsg::Ready) => MsgKind::Ready,
+            ClientMsg::Vive(ViveMsg::Move { .. }) => MsgKind::Move,
+            ClientMsg::Vive(_) => MsgKind::Action,
+            ClientMsg::Phantom(PhantomMsg::Verdict { .. }) => MsgKind::Verdict,
+            ClientMsg::Phantom(PhantomMsg::ToolPose { .. }) => MsgKind::ToolPose,
+            ClientMsg::Phantom(PhantomMsg::Warn(_)) => MsgKind::Warn,
+            ClientMsg::Malformed(_) => return None,
+        })
+    }
+
+    /// The kind's rate: what an honest client sends, with room for a second or two of bunching.
+    pub const fn rate(self) -> Rate {
+        match self {
+            MsgKind::Ready => Rate::new(2.0, 4.0),
+            // 60 a second; a stalled reliable channel may deliver two seconds at once.
+            MsgKind::Move => Rate::new(75.0, 120.0),
+            MsgKind::Action => Rate::new(10.0, 10.0),
+            MsgKind::Verdict => Rate::new(2.0, 4.0),
+            MsgKind::ToolPose => Rate::new(120.0, 120.0),
+            // A warning is a key a person presses.
+            MsgKind::Warn => Rate::new(1.0, 3.0),
+        }
+    }
+}
+
+/// One client's buckets, one per kind.
+#[derive(Clone, Copy, Debug)]
+pub struct MessageLimits([Bucket; 6]);
+
+impl MessageLimits {
+    /// Full buckets at `now_s`.
+    pub fn new(now_s: f64) -> Self {
+        Self(MsgKind::ALL.map(|k| Bucket::full(k.rate(), now_s)))
+    }
+
+    /// `Ok` when `msg` is within its kind's rate (it takes a token), else the refusal.
+    pub fn check(&mut self, msg: &ClientMsg, now_s: f64) -> Result<(), Refusal> {
+        let Some(kind) = MsgKind::of(msg) else { return Ok(()) };
+        let i = MsgKind::ALL.iter().position(|&k| k == kind).unwrap_or_default();
+        if self.0[i].take(kind.rate(), now_s) { Ok(()) } else { Err(Refusal::RateLimited) }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use heist_shared::protocol::WarningKind;
+
+    #[test]
+    fn a_warning_a_second_passes_a_flood_does_not() {
+        let mut l = MessageLimits::new(0.0);
+        let warn = ClientMsg::Phantom(PhantomMsg::Warn(WarningKind::Hide));
+        let passed = (0..100).filter(|_| l.check(&warn, 0.0).is_ok()).count();
+        assert_eq!(passed, 3, "the burst");
+        assert_eq!(l.check(&warn, 0.5), Err(Refusal::RateLimited));
+        assert_eq!(l.check(&warn, 1.0), Ok(()), "one more a second");
+    }
+
+    #[test]
+    fn kinds_do_not_share_a_budget() {
+        let mut l = MessageLimits::new(0.0);
+        let warn = ClientMsg::Phantom(PhantomMsg::Warn(WarningKind::Go));
+        while l.check(&warn, 0.0).is_ok() {}
+        let verdict = ClientMsg::Phantom(PhantomMsg::Verdict { item: heist_shared::protocol::ItemId(0), real: true });
+        assert_eq!(l.check(&verdict, 0.0), Ok(()));
+    }
+
+    #[test]
+    fn an_honest_vive_client_is_never_limited() {
+        // One move per tick for a minute, with the whole of each second arriving at once.
+        let mut l = MessageLimits::new(0.0);
+        let mv = ClientMsg::Vive(ViveMsg::Move { seq: 1, direction: glam::Vec2::X, gait: Default::default(), facing: 0.0 });
+        for second in 0..60 {
+            for _ in 0..60 {
+                assert_eq!(l.check(&mv, f64::from(second)), Ok(()));
+            }
+        }
+    }
+}
