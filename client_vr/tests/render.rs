@@ -35,7 +35,7 @@ fn desktop_mode_joins_a_server_and_shows_the_museum() {
     let mut child = Command::new("xvfb-run")
         .args(["-a", "-s", "-screen 0 640x480x24"])
         .arg(env!("CARGO_BIN_EXE_client_vr"))
-        .args(["join", &endpoint.to_string(), "--code", &server.join_code])
+        .args(["join", &endpoint.to_string(), "--code", &server.join_code().expect("a secure server").code])
         .args(["--size", "640x480", "--audio", "off", "--shot-after", "150", "--screenshot"])
         .arg(&shot)
         .env_remove("XR_RUNTIME_JSON")

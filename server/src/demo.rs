@@ -28,8 +28,8 @@ pub fn stepped_client_app() -> App {
 
 /// Joins `server` as `role` through its token endpoint; `plugins` add the bot (or test probes).
 pub fn join(server: &HostedServer, role: Role, setup: impl FnOnce(&mut App)) -> anyhow::Result<App> {
-    let endpoint = server.tokens.as_ref().context("the server runs without a token endpoint")?.addr;
-    let token = request_token(endpoint, &server.join_code, role, TOKEN_TIMEOUT)?;
+    let tokens = server.tokens.as_ref().context("the server runs without a token endpoint")?;
+    let token = request_token(tokens.addr, &tokens.codes.current().code, role, TOKEN_TIMEOUT)?;
     let mut app = stepped_client_app();
     setup(&mut app);
     app.finish();
@@ -53,7 +53,11 @@ pub struct Heist {
 impl Heist {
     /// Starts a server with `options` and joins both bots.
     pub fn start(options: ServerOptions, style: ViveStyle) -> anyhow::Result<Self> {
-        let server = build_server(options)?;
+        Self::join(build_server(options)?, style)
+    }
+
+    /// Joins both bots to a running `server`.
+    pub fn join(server: HostedServer, style: ViveStyle) -> anyhow::Result<Self> {
         let vive = join(&server, Role::Vive, |app| {
             app.add_plugins(ViveBotPlugin { style });
         })?;

@@ -23,9 +23,9 @@ use heist_shared::level::Level;
 use heist_shared::protocol::{ProtocolPlugin, TICK_HZ};
 
 use game::{Game, GameOptions};
-use net::tokens::{RoleTable, TokenConfig, TokenService, new_join_code};
+use net::tokens::{CodeBook, JoinCode, RoleTable, TokenConfig, TokenLimits, TokenService};
 use net::{Auth, NetSettings, ServerNetPlugin};
-use session::{GameState, SessionLog, SessionPlugin};
+use session::{GameState, LogEcho, SessionLog, SessionPlugin};
 
 /// How the server's clock advances.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -51,14 +51,21 @@ pub struct ServerOptions {
     pub insecure: bool,
     /// How time advances.
     pub clock: Clock,
-    /// Print the session log as it is written.
-    pub echo_log: bool,
+    /// Where the session log goes as it is written.
+    pub echo_log: LogEcho,
     /// Refused messages tolerated per client before disconnecting it (default 50).
     pub abuse_limit: u32,
     /// The game address clients are told to use when it differs from the bound one (a relay, a NAT);
     /// `None` advertises the bound address.
     pub advertise: Option<SocketAddr>,
+    /// How long a join code works (default 30 min); the host can rotate it sooner.
+    pub code_ttl: Duration,
+    /// The token endpoint's limits.
+    pub token_limits: TokenLimits,
 }
+
+/// How long a join code works unless the host says otherwise.
+pub const DEFAULT_CODE_TTL: Duration = Duration::from_secs(30 * 60);
 
 impl ServerOptions {
     /// Loopback, secure, stepped clock, the shipped museum.
@@ -71,9 +78,11 @@ impl ServerOptions {
             token_bind: loopback,
             insecure: false,
             clock: Clock::Stepped,
-            echo_log: false,
+            echo_log: LogEcho::Off,
             abuse_limit: 50,
             advertise: None,
+            code_ttl: DEFAULT_CODE_TTL,
+            token_limits: TokenLimits::default(),
         }
     }
 }
@@ -82,18 +91,23 @@ impl ServerOptions {
 pub struct HostedServer {
     /// The Bevy app.
     pub app: App,
-    /// Its game address.
+    /// Its game address, as bound.
     pub addr: SocketAddr,
+    /// The game address players are given in their tokens (the bound one unless advertised otherwise).
+    pub advertised: SocketAddr,
     /// The token endpoint (secure mode).
     pub tokens: Option<TokenService>,
-    /// The join code players exchange for tokens.
-    pub join_code: String,
 }
 
 impl HostedServer {
     /// The session's game state.
     pub fn game(&self) -> &Game {
         &self.app.world().resource::<GameState>().0
+    }
+
+    /// The join code in force (secure mode).
+    pub fn join_code(&self) -> Option<JoinCode> {
+        self.tokens.as_ref().map(|t| t.codes.current())
     }
 
     /// The session log so far.
@@ -106,8 +120,12 @@ impl HostedServer {
 pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
     let socket = net::bind_game_socket(options.bind).with_context(|| format!("cannot bind UDP {}", options.bind))?;
     let addr = socket.local_addr()?;
+    let advertise = match options.advertise {
+        None if addr.ip().is_unspecified() => Some(net::advertise_for(addr)?),
+        a => a,
+    };
+    let advertised = advertise.unwrap_or(addr);
     let roles = RoleTable::default();
-    let join_code = new_join_code();
     let (auth, tokens) = if options.insecure {
         (Auth::Insecure, None)
     } else {
@@ -116,11 +134,12 @@ pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
         let service = TokenService::spawn(
             options.token_bind,
             TokenConfig {
-                code: join_code.clone(),
+                codes: CodeBook::new(options.code_ttl),
                 private_key,
-                server_addr: options.advertise.unwrap_or(addr),
+                server_addr: advertised,
                 session,
                 roles: roles.clone(),
+                limits: options.token_limits,
             },
         )
         .with_context(|| format!("cannot bind the token endpoint on TCP {}", options.token_bind))?;
@@ -144,11 +163,11 @@ pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
         .add_plugins(SessionPlugin)
         .add_plugins(ServerNetPlugin {
             socket: std::sync::Mutex::new(Some(socket)),
-            settings: NetSettings { auth, roles, abuse_limit: options.abuse_limit, advertise: options.advertise },
+            settings: NetSettings { auth, roles, abuse_limit: options.abuse_limit, advertise },
         });
     if options.clock == Clock::Stepped {
         app.finish();
         app.cleanup();
     }
-    Ok(HostedServer { app, addr, tokens, join_code })
+    Ok(HostedServer { app, addr, advertised, tokens })
 }

@@ -15,7 +15,7 @@ pub enum JoinError {
     },
     /// The endpoint refused (wrong code, role taken...).
     #[error("the host refused to let us join: {0}")]
-    Refused(String),
+    Refused(heist_shared::protocol::join::JoinRefusal),
     /// The endpoint's answer was not understood.
     #[error("the token endpoint sent something we do not understand: {0}")]
     BadResponse(String),

@@ -1,39 +1,69 @@
-//! Asking the host's token endpoint for a connect token.
+//! Asking the host's token endpoint for a connect token: the join exchange of
+//! [`heist_shared::protocol::join`], client side (blocking, with a timeout on every step).
 
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpStream};
 use std::time::Duration;
 
+use heist_shared::protocol::join::{self, JOIN_VERSION, JoinMsg, JoinReply, MAX_FRAME, Pake};
+use heist_shared::protocol::{PROTOCOL_ID, Role};
 use heist_transport::renetcode::ConnectToken;
-use heist_shared::protocol::{JoinRequest, JoinResponse, Role};
 
 use crate::JoinError;
 
-/// Longest answer accepted, bytes (a token is 2 KiB; JSON spells each byte as up to 4 characters).
-const MAX_RESPONSE: u64 = 16 * 1024;
-
 /// Exchanges `code` + `role` for a connect token at `endpoint` (the host's game address, TCP).
-pub fn request_token(
-    endpoint: SocketAddr,
-    code: &str,
-    role: Role,
-    timeout: Duration,
-) -> Result<ConnectToken, JoinError> {
+pub fn request_token(endpoint: SocketAddr, code: &str, role: Role, timeout: Duration) -> Result<ConnectToken, JoinError> {
     let unreachable = |source| JoinError::Unreachable { addr: endpoint, source };
-    let stream = TcpStream::connect_timeout(&endpoint, timeout).map_err(unreachable)?;
+    let mut stream = TcpStream::connect_timeout(&endpoint, timeout).map_err(unreachable)?;
     stream.set_read_timeout(Some(timeout)).map_err(unreachable)?;
     stream.set_write_timeout(Some(timeout)).map_err(unreachable)?;
-    let mut line = serde_json::to_vec(&JoinRequest { code: code.to_owned(), role })
-        .map_err(|e| JoinError::BadResponse(e.to_string()))?;
-    line.push(b'\n');
-    (&stream).write_all(&line).map_err(unreachable)?;
-    let mut answer = String::new();
-    BufReader::new((&stream).take(MAX_RESPONSE)).read_line(&mut answer).map_err(unreachable)?;
-    match serde_json::from_str::<JoinResponse>(answer.trim()) {
-        Ok(JoinResponse::Token(bytes)) => {
-            ConnectToken::read(&mut bytes.as_slice()).map_err(|e| JoinError::BadResponse(format!("bad token: {e}")))
-        }
-        Ok(JoinResponse::Refused(reason)) => Err(JoinError::Refused(reason)),
-        Err(e) => Err(JoinError::BadResponse(format!("{e} in {:?}", answer.chars().take(80).collect::<String>()))),
+
+    let (pake, ours) = Pake::client(code);
+    let hello = join::frame(&JoinMsg::Hello { version: JOIN_VERSION, role, pake: ours });
+    stream.write_all(&hello).map_err(unreachable)?;
+    let challenge = read_frame(&mut stream).map_err(unreachable)?;
+    let theirs = match decode(&challenge)? {
+        JoinReply::Challenge { pake } => pake,
+        JoinReply::Refused(r) => return Err(JoinError::Refused(r)),
+        JoinReply::Token { .. } => return Err(JoinError::BadResponse("a token before the key exchange".into())),
+    };
+    let keys = pake.finish(&theirs, &hello[2..], &challenge).map_err(JoinError::BadResponse)?;
+    stream.write_all(&join::frame(&JoinMsg::Confirm { mac: *keys.client_mac.as_bytes() })).map_err(unreachable)?;
+    let sealed = match decode(&read_frame(&mut stream).map_err(unreachable)?)? {
+        JoinReply::Token { sealed } => sealed,
+        JoinReply::Refused(r) => return Err(JoinError::Refused(r)),
+        JoinReply::Challenge { .. } => return Err(JoinError::BadResponse("a second challenge".into())),
+    };
+    let bytes = keys.open(&sealed).ok_or_else(|| JoinError::BadResponse("the token was not sealed for us".into()))?;
+    let token =
+        ConnectToken::read(&mut bytes.as_slice()).map_err(|e| JoinError::BadResponse(format!("bad token: {e}")))?;
+    check(&token)?;
+    Ok(token)
+}
+
+fn read_frame(stream: &mut TcpStream) -> std::io::Result<Vec<u8>> {
+    let mut header = [0u8; 2];
+    stream.read_exact(&mut header)?;
+    let len = join::frame_len(header, MAX_FRAME).map_err(std::io::Error::other)?;
+    let mut body = vec![0u8; len];
+    stream.read_exact(&mut body)?;
+    Ok(body)
+}
+
+fn decode(body: &[u8]) -> Result<JoinReply, JoinError> {
+    join::decode(body).map_err(JoinError::BadResponse)
+}
+
+/// What netcode's client would otherwise panic on or silently fail with.
+fn check(token: &ConnectToken) -> Result<(), JoinError> {
+    if token.protocol_id != PROTOCOL_ID {
+        return Err(JoinError::BadResponse("the token is for another game version".into()));
     }
+    if token.expire_timestamp < token.create_timestamp {
+        return Err(JoinError::BadResponse("the token expires before it was made".into()));
+    }
+    if token.server_addresses[0].is_none() {
+        return Err(JoinError::NoServerAddress);
+    }
+    Ok(())
 }

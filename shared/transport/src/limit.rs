@@ -55,6 +55,11 @@ impl Bucket {
         }
     }
 
+    /// Gives back a token taken for something that did not happen.
+    pub fn refund(&mut self, rate: Rate) {
+        self.tokens = (self.tokens + 1.0).min(rate.burst);
+    }
+
     /// True when the bucket has refilled completely (it can be forgotten).
     pub fn is_full(&self, rate: Rate, now_s: f64) -> bool {
         self.tokens + (now_s - self.at_s).max(0.0) * rate.per_s >= rate.burst

@@ -4,19 +4,20 @@
 //! (SPAKE2 keyed by the code: neither the code nor the token crosses the wire in clear) as its own task
 //! on a small async runtime in its own thread, so no connection waits for another and the game loop
 //! waits for none. Every connection has a deadline; connections are capped per address and in total (the
-//! oldest gives way); wrong codes are limited per address and for the whole server ([`guesses`]).
+//! oldest gives way, so opening connections never locks anyone out); wrong codes are limited per address
+//! and for the whole server ([`guesses`]).
 
 mod connections;
 mod exchange;
 pub mod guesses;
 
-use std::net::{IpAddr, SocketAddr};
+use std::net::SocketAddr;
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant, SystemTime};
 
 use heist_shared::protocol::Role;
-use heist_transport::limit::{KeyedLimiter, Rate, address_key};
+use heist_transport::limit::address_key;
 use heist_transport::throttle::RefusalLog;
 
 use connections::Connections;
@@ -117,8 +118,6 @@ pub struct TokenLimits {
     pub per_address: usize,
     /// Open connections in all; default 256, the oldest gives way.
     pub total: usize,
-    /// New connections per address; default 5 a second, 20 at once.
-    pub connect_rate: Rate,
     /// Wrong codes.
     pub guesses: GuessLimits,
 }
@@ -129,7 +128,6 @@ impl Default for TokenLimits {
             deadline: Duration::from_secs(2),
             per_address: 32,
             total: 256,
-            connect_rate: Rate::new(5.0, 20.0),
             guesses: GuessLimits::default(),
         }
     }
@@ -157,7 +155,6 @@ struct Shared {
     config: TokenConfig,
     started: Instant,
     guesses: Mutex<Guesses>,
-    connects: Mutex<KeyedLimiter<IpAddr>>,
     log: Mutex<RefusalLog>,
 }
 
@@ -196,7 +193,6 @@ impl TokenService {
         let shared = Arc::new(Shared {
             started: Instant::now(),
             guesses: Mutex::new(Guesses::new(limits.guesses)),
-            connects: Mutex::new(KeyedLimiter::new(limits.connect_rate, Rate::new(1e6, 1e6), 16_384)),
             log: Mutex::new(RefusalLog::new("token endpoint")),
             config,
         });
@@ -244,10 +240,6 @@ async fn accept(listener: tokio::net::TcpListener, shared: Arc<Shared>, mut stop
             }
         };
         let key = address_key(peer.ip());
-        if !lock(&shared.connects).take(key, shared.now_s()) {
-            shared.refused(peer, &"connecting too often");
-            continue;
-        }
         let id = lock(&open).next_id();
         let task = tokio::spawn(exchange::serve(stream, peer, shared.clone(), Closer { open: open.clone(), id }));
         // The task has not run yet (one thread): registering now cannot miss its end.

@@ -5,6 +5,7 @@
 
 mod client_msg;
 mod ids;
+pub mod join;
 mod replicated;
 mod server_msg;
 mod token;
@@ -17,7 +18,7 @@ pub use replicated::{
     Phase, REPLICATED, SessionView, Stance, ViveAvatar,
 };
 pub use server_msg::{DisconnectReason, GameEvent, NoiseKind, Refusal, ServerMsg, VerdictOutcome, WorkbenchCopy};
-pub use token::{JoinRequest, JoinResponse, TokenUserData, USER_DATA_MAGIC};
+pub use token::{TokenUserData, USER_DATA_MAGIC};
 pub use verify::verify;
 
 use bevy::prelude::*;

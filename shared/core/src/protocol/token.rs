@@ -1,30 +1,10 @@
-//! The join handshake: a join code (+ role) is exchanged for a netcode connect token at the host's
-//! token endpoint (TCP, one JSON line each way). Role and session travel inside the signed token.
-
-use serde::{Deserialize, Serialize};
+//! What travels inside a netcode connect token: the role granted and the session it belongs to, signed
+//! by the server's key (the token is obtained through the join exchange, [`super::join`]).
 
 use super::ids::Role;
 
 /// First bytes of our token user data.
 pub const USER_DATA_MAGIC: [u8; 4] = *b"PHST";
-
-/// What a client asks the token endpoint.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct JoinRequest {
-    /// The join code the host printed.
-    pub code: String,
-    /// The role the player wants.
-    pub role: Role,
-}
-
-/// What the token endpoint answers.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub enum JoinResponse {
-    /// A connect token (netcode wire format) to pass to the netcode client.
-    Token(Vec<u8>),
-    /// Refused, with a reason a person can read.
-    Refused(String),
-}
 
 /// The 256 bytes of user data inside a connect token, as the server reads them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -1,0 +1,157 @@
+//! One connection's join exchange, from the first byte to the token (or the refusal).
+
+use std::net::SocketAddr;
+use std::sync::Arc;
+use std::time::{SystemTime, UNIX_EPOCH};
+
+use heist_shared::protocol::join::{self, JOIN_VERSION, JoinMsg, JoinRefusal, JoinReply, Pake};
+use heist_shared::protocol::{PROTOCOL_ID, Role, TokenUserData};
+use heist_transport::limit::address_key;
+use heist_transport::renetcode::ConnectToken;
+use tokio::io::{AsyncReadExt, AsyncWriteExt};
+use tokio::net::TcpStream;
+
+use super::guesses::Outcome;
+use super::{Closer, Shared, TokenConfig, lock};
+
+/// Largest frame a client sends, bytes (a hello is ~40).
+const MAX_CLIENT_FRAME: usize = 256;
+/// Seconds a token stays valid.
+const TOKEN_EXPIRE_S: u64 = 300;
+/// Seconds of silence after which netcode drops a client.
+const TIMEOUT_S: i32 = 15;
+
+/// Why an exchange ended without a token.
+enum Failure {
+    /// Refused: the client is told why.
+    Refused(JoinRefusal),
+    /// The connection broke or the client sent something that is not a frame.
+    Broken(String),
+}
+
+impl From<std::io::Error> for Failure {
+    fn from(e: std::io::Error) -> Self {
+        Failure::Broken(e.to_string())
+    }
+}
+
+/// Serves one connection within the deadline.
+pub(super) async fn serve(mut stream: TcpStream, peer: SocketAddr, shared: Arc<Shared>, _closer: Closer) {
+    let deadline = shared.config.limits.deadline;
+    let result = match tokio::time::timeout(deadline, exchange(&mut stream, peer, &shared)).await {
+        Ok(r) => r,
+        Err(_) => Err(Failure::Broken(format!("no complete exchange within {} s", deadline.as_secs_f32()))),
+    };
+    match result {
+        Ok(role) => log::info!("token endpoint: gave a {role} token to {peer}"),
+        Err(Failure::Refused(refusal)) => {
+            shared.refused(peer, &refusal);
+            let _ = tokio::time::timeout(deadline, stream.write_all(&join::frame(&JoinReply::Refused(refusal)))).await;
+        }
+        Err(Failure::Broken(why)) => shared.refused(peer, &why),
+    }
+}
+
+/// A guess in flight; counted as abandoned unless it ends with a verdict (a dropped task included).
+struct Attempt<'a> {
+    shared: &'a Shared,
+    peer: SocketAddr,
+    ended: bool,
+}
+
+impl<'a> Attempt<'a> {
+    fn begin(shared: &'a Shared, peer: SocketAddr) -> Result<Self, Failure> {
+        lock(&shared.guesses).begin(address_key(peer.ip()), shared.now_s()).map_err(Failure::Refused)?;
+        Ok(Self { shared, peer, ended: false })
+    }
+
+    /// Records the outcome; returns the seconds to wait before answering.
+    fn end(mut self, outcome: Outcome) -> f64 {
+        self.ended = true;
+        let verdict = lock(&self.shared.guesses).end(address_key(self.peer.ip()), outcome, self.shared.now_s());
+        if let Some(period) = verdict.locked_for_s {
+            let why = format!("{} wrong join codes: refusing this address for {period:.0} s", self.shared.config.limits.guesses.max);
+            self.shared.refused(self.peer, &why);
+        }
+        verdict.delay_s
+    }
+}
+
+impl Drop for Attempt<'_> {
+    fn drop(&mut self) {
+        if !self.ended {
+            lock(&self.shared.guesses).end(address_key(self.peer.ip()), Outcome::Abandoned, self.shared.now_s());
+        }
+    }
+}
+
+async fn read_frame(stream: &mut TcpStream) -> Result<Vec<u8>, Failure> {
+    let mut header = [0u8; 2];
+    stream.read_exact(&mut header).await?;
+    let len = join::frame_len(header, MAX_CLIENT_FRAME).map_err(|e| Failure::Refused(JoinRefusal::BadRequest(e)))?;
+    let mut body = vec![0u8; len];
+    stream.read_exact(&mut body).await?;
+    Ok(body)
+}
+
+fn decode(body: &[u8]) -> Result<JoinMsg, Failure> {
+    join::decode(body).map_err(|e| Failure::Refused(JoinRefusal::BadRequest(e)))
+}
+
+/// The exchange itself: hello, challenge, confirmation, token.
+async fn exchange(stream: &mut TcpStream, peer: SocketAddr, shared: &Shared) -> Result<Role, Failure> {
+    let hello = read_frame(stream).await?;
+    let JoinMsg::Hello { version, role, pake } = decode(&hello)? else {
+        return Err(Failure::Refused(JoinRefusal::BadRequest("the exchange starts with a hello".into())));
+    };
+    if version != JOIN_VERSION {
+        return Err(Failure::Refused(JoinRefusal::Version { server: JOIN_VERSION, client: version }));
+    }
+    let code = shared.config.codes.current();
+    if code.is_expired() {
+        log::warn!("token endpoint: {peer} tried to join but the join code has expired (type `rotate` for a new one)");
+        return Err(Failure::Refused(JoinRefusal::CodeExpired));
+    }
+    let attempt = Attempt::begin(shared, peer)?;
+    let (server, ours) = Pake::server(&code.code);
+    let challenge = join::frame(&JoinReply::Challenge { pake: ours });
+    stream.write_all(&challenge).await?;
+    let confirm = read_frame(stream).await?;
+    let JoinMsg::Confirm { mac } = decode(&confirm)? else {
+        return Err(Failure::Refused(JoinRefusal::BadRequest("expected the confirmation".into())));
+    };
+    let keys = server.finish(&pake, &hello, &challenge[2..]).map_err(|e| Failure::Refused(JoinRefusal::BadRequest(e)))?;
+    if keys.client_mac != blake3::Hash::from(mac) {
+        let delay = attempt.end(Outcome::Wrong);
+        tokio::time::sleep(std::time::Duration::from_secs_f64(delay)).await;
+        return Err(Failure::Refused(JoinRefusal::WrongCode));
+    }
+    attempt.end(Outcome::Right);
+    if shared.config.roles.is_taken(role) {
+        return Err(Failure::Refused(JoinRefusal::RoleTaken(role)));
+    }
+    let token = mint(&shared.config, role).map_err(|e| Failure::Refused(JoinRefusal::Internal(e)))?;
+    let sealed = keys.seal(&token).map_err(|e| Failure::Refused(JoinRefusal::Internal(e)))?;
+    stream.write_all(&join::frame(&JoinReply::Token { sealed })).await?;
+    Ok(role)
+}
+
+/// A connect token for `role` in netcode's wire format.
+fn mint(config: &TokenConfig, role: Role) -> Result<Vec<u8>, String> {
+    let now = SystemTime::now().duration_since(UNIX_EPOCH).unwrap_or_default();
+    let user_data = TokenUserData { role, session: config.session }.encode();
+    let token = ConnectToken::generate(
+        now,
+        PROTOCOL_ID,
+        TOKEN_EXPIRE_S,
+        rand::random(),
+        TIMEOUT_S,
+        vec![config.server_addr],
+        Some(&user_data),
+        &config.private_key,
+    )
+    .map_err(|e| format!("could not mint a token: {e}"))?;
+    let mut bytes = Vec::new();
+    token.write(&mut bytes).map_err(|e| format!("could not encode the token: {e}"))?;
+    Ok(bytes)
+}
