@@ -3,14 +3,15 @@
 use bevy::prelude::*;
 use bevy_replicon::shared::message::registry::RemoteMessageRegistry;
 use bevy_replicon_renet::RenetClient;
-use glam::Vec2;
+use glam::{Quat, Vec2, Vec3};
 use heist_client::JoinError;
+use heist_shared::protocol::join::JoinRefusal;
 use heist_server::ServerOptions;
 use heist_shared::protocol::{
-    CaseId, ClientMsg, DisconnectReason, ItemId, ItemKind, ItemView, LobbyMsg, PhantomMsg, Phase, Refusal, Role,
-    ViveMsg,
+    CaseId, ClientMsg, DisconnectReason, GameEvent, ItemId, ItemKind, ItemView, LobbyMsg, PhantomMsg, PhantomTool,
+    Phase, Refusal, Role, ViveMsg, WarningKind,
 };
-use heist_tests::{HZ, Session, bot_heist, join};
+use heist_tests::{HZ, Session, join};
 
 /// Both players joined and ready; returns (session, vive index, phantom index).
 fn heist_in_progress() -> (Session, usize, usize) {
@@ -40,7 +41,7 @@ fn a_second_claimant_of_a_role_is_refused_at_the_token_endpoint() {
     assert!(s.step_until(5 * HZ, |s| s.server.game().is_present(Role::Vive)));
     match join(&s.server, Role::Vive, |_| {}) {
         Err(e) => match e.downcast::<JoinError>() {
-            Ok(JoinError::Refused(reason)) => assert!(reason.contains("Vive role is already taken"), "{reason}"),
+            Ok(JoinError::Refused(reason)) => assert_eq!(reason, JoinRefusal::RoleTaken(Role::Vive)),
             other => panic!("unexpected error {other:?}"),
         },
         Ok(_) => panic!("a second Vive got a token"),
@@ -172,4 +173,74 @@ fn an_insecure_server_admits_a_tokenless_client_by_its_claimed_role() {
     s.clients.push(app);
     assert!(s.step_until(5 * HZ, |s| s.inbox(0).role == Some(Role::Phantom)));
     assert!(s.server.game().is_present(Role::Phantom));
+}
+
+#[test]
+fn the_speed_hack_is_refused_and_gains_no_ground() {
+    let (mut s, vive, _phantom) = heist_in_progress();
+    let start = s.server.game().vive.position;
+    // Every frame: a second's worth of moves east, then an action to fast-forward them.
+    let mut seq = 0;
+    for _ in 0..HZ {
+        for _ in 0..60 {
+            seq += 1;
+            let mv = ViveMsg::Move { seq, direction: Vec2::X, gait: Default::default(), facing: 0.0 };
+            s.send(vive, ClientMsg::Vive(mv));
+        }
+        s.send(vive, ClientMsg::Vive(ViveMsg::Break(CaseId(999))));
+        s.step();
+    }
+    let mut ticks = HZ;
+    while ticks < 3 * HZ && s.inbox(vive).disconnect.is_none() {
+        s.step();
+        ticks += 1;
+    }
+    let inbox = s.inbox(vive);
+    assert!(inbox.refusals.contains(&Refusal::RateLimited), "told why: {:?}", &inbox.refusals[..5]);
+    assert_eq!(inbox.disconnect, Some(DisconnectReason::Abuse), "sustained abuse ends in a disconnection");
+    let walked = s.server.game().vive.position.distance(start);
+    // One tick of walking per tick stepped, plus the banked credit and the fast-forward debt.
+    let most = heist_shared::rules::WALK_SPEED * (ticks + 30 + 4) as f32 / 60.0;
+    assert!(walked <= most + 1e-3, "walked {walked:.2} m in {ticks} ticks (at most {most:.2})");
+}
+
+#[test]
+fn warning_spam_is_refused_and_never_reaches_vive_in_bulk() {
+    let (mut s, vive, phantom) = heist_in_progress();
+    s.step_until(HZ, |_| false);
+    let before = s.inbox(vive).events.iter().filter(|e| matches!(e, GameEvent::Warning(_))).count();
+    for _ in 0..200 {
+        s.send(phantom, ClientMsg::Phantom(PhantomMsg::Warn(WarningKind::Hide)));
+    }
+    assert!(s.step_until(5 * HZ, |s| s.inbox(phantom).disconnect.is_some()), "the spammer is disconnected");
+    s.step_until(HZ, |_| false);
+    let warnings = s.inbox(vive).events.iter().filter(|e| matches!(e, GameEvent::Warning(_))).count() - before;
+    assert_eq!(warnings, 3, "Vive hears the burst of three, not 200");
+    let phantom_inbox = s.inbox(phantom);
+    assert!(phantom_inbox.refusals.iter().all(|r| *r == Refusal::RateLimited), "{:?}", phantom_inbox.refusals);
+    assert_eq!(phantom_inbox.disconnect, Some(DisconnectReason::Abuse));
+    assert!(s.clients[vive].world().resource::<RenetClient>().is_connected(), "Vive stays connected");
+}
+
+#[test]
+fn a_tool_pose_from_vive_moves_nothing() {
+    let (mut s, vive, phantom) = heist_in_progress();
+    let pose = PhantomMsg::ToolPose { position: Vec3::new(0.3, 0.4, 0.5), rotation: Quat::IDENTITY };
+    s.send(vive, ClientMsg::Phantom(pose.clone()));
+    assert!(s.step_until(2 * HZ, |s| !s.inbox(vive).refusals.is_empty()));
+    assert_eq!(s.inbox(vive).refusals, [Refusal::WrongRole]);
+    let tool = |s: &mut Session, c: usize| {
+        let world = s.clients[c].world_mut();
+        world.query::<&PhantomTool>().iter(world).next().copied()
+    };
+    assert_eq!(tool(&mut s, phantom), Some(PhantomTool::default()), "the tool did not move");
+    assert_eq!(s.server.game().tool, PhantomTool::default());
+    // Phantom's own pose does move it, and Vive sees it.
+    s.send(phantom, ClientMsg::Phantom(pose));
+    assert!(s.step_until(2 * HZ, |s| s.server.game().tool.position == Vec3::new(0.3, 0.4, 0.5)));
+    let seen = (0..2 * HZ).any(|_| {
+        s.step();
+        tool(&mut s, vive).is_some_and(|t| t.position == Vec3::new(0.3, 0.4, 0.5))
+    });
+    assert!(seen, "Vive's client sees Phantom's tool where Phantom put it");
 }

@@ -8,6 +8,7 @@ use heist_client::Inbox;
 pub use heist_server::demo::{Heist, join};
 use heist_server::{HostedServer, ServerOptions, build_server};
 use heist_shared::protocol::{Phase, Role, SessionView};
+pub use heist_transport::renetcode::ConnectToken;
 
 /// Ticks per second of game time.
 pub const HZ: u64 = 60;
@@ -81,4 +82,72 @@ pub fn bot_heist(options: ServerOptions, style: heist_bots::ViveStyle, max_game_
     let phase = heist.run(max_game_s);
     let game = heist.server.game();
     (phase, heist.server.log().to_vec(), game.elapsed_s)
+}
+
+/// An attacker on the network with a real connect token: a bare netcode client over its own UDP socket,
+/// with no checks, sending whatever the test tells it to.
+pub struct UdpAttacker {
+    /// Its socket.
+    pub socket: std::net::UdpSocket,
+    /// Its netcode state.
+    pub netcode: heist_transport::renetcode::NetcodeClient,
+    /// The server's game address.
+    pub server: std::net::SocketAddr,
+}
+
+impl UdpAttacker {
+    /// An attacker holding `token`; it has sent nothing yet.
+    pub fn new(token: heist_transport::renetcode::ConnectToken) -> Self {
+        let server = token.server_addresses[0].expect("the token names the server");
+        let socket = std::net::UdpSocket::bind("127.0.0.1:0").expect("a loopback socket");
+        socket.set_nonblocking(true).expect("non-blocking");
+        let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
+        let auth = heist_transport::renetcode::ClientAuthentication::Secure { connect_token: token };
+        let netcode = heist_transport::renetcode::NetcodeClient::new(now, auth).expect("netcode starts");
+        Self { socket, netcode, server }
+    }
+
+    /// Reads what the server sent and sends netcode's next handshake or keep-alive packet.
+    pub fn pump(&mut self) {
+        let mut buf = [0u8; 1500];
+        while let Ok((len, _)) = self.socket.recv_from(&mut buf) {
+            let _ = self.netcode.process_packet(&mut buf[..len]);
+        }
+        if let Some((packet, to)) = self.netcode.update(std::time::Duration::from_secs_f64(1.0 / 60.0)) {
+            let _ = self.socket.send_to(packet, to);
+        }
+    }
+
+    /// Sends raw bytes to the server.
+    pub fn send_raw(&self, bytes: &[u8]) {
+        self.socket.send_to(bytes, self.server).expect("loopback send");
+    }
+
+    /// Seals `payload` with the session key (once connected) and sends it.
+    pub fn send_sealed(&mut self, payload: &[u8]) {
+        if let Ok((to, bytes)) = self.netcode.generate_payload_packet(payload) {
+            let _ = self.socket.send_to(bytes, to);
+        }
+    }
+
+    /// Tells the server it leaves.
+    pub fn leave(&mut self) {
+        if let Ok((to, bytes)) = self.netcode.disconnect() {
+            let _ = self.socket.send_to(bytes, to);
+        }
+    }
+}
+
+/// A renet slice (channel `channel`, reliable) with a full 1200-byte payload: what renet 2.0.1 indexes by.
+pub fn renet_slice(channel: u8, message_id: u8, index: u8, count: u8) -> Vec<u8> {
+    let mut p = vec![2, 1, channel, message_id, index, count, 0x44, 0xB0]; // 0x44B0 = varint 1200
+    p.extend_from_slice(&[0x5A; 1200]);
+    p
+}
+
+/// A token for `role` from `server`'s endpoint, as any holder of the join code gets one.
+pub fn token_for(server: &HostedServer, role: Role) -> heist_transport::renetcode::ConnectToken {
+    let tokens = server.tokens.as_ref().expect("a secure server");
+    heist_client::request_token(tokens.addr, &tokens.codes.current().code, role, std::time::Duration::from_secs(5))
+        .expect("a token")
 }

@@ -1,5 +1,8 @@
 //! `heist-server`: host a Phantom Heist session, join one as a bot, or watch a whole demo heist.
 
+mod logging;
+
+use std::io::BufRead as _;
 use std::net::SocketAddr;
 use std::path::PathBuf;
 use std::time::Duration;
@@ -9,6 +12,7 @@ use bevy::prelude::*;
 use clap::{Parser, Subcommand, ValueEnum};
 use heist_bots::{PhantomBotPlugin, ViveBotPlugin, ViveStyle};
 use heist_server::game::GameOptions;
+use heist_server::session::LogEcho;
 use heist_server::{Clock, ServerOptions, build_server};
 use heist_shared::level::Level;
 use heist_shared::protocol::Role;
@@ -16,6 +20,9 @@ use heist_shared::protocol::Role;
 #[derive(Parser)]
 #[command(name = "heist-server", about = "Phantom Heist: the authoritative server, its demo and its bots")]
 struct Cli {
+    /// How log lines are written (stderr); `RUST_LOG` chooses which (e.g. `RUST_LOG=debug`).
+    #[arg(long, value_enum, default_value_t = logging::Format::Text, global = true)]
+    log_format: logging::Format,
     #[command(subcommand)]
     command: Command,
 }
@@ -71,9 +78,17 @@ enum Command {
         /// UDP game address; the token endpoint listens on the same port over TCP.
         #[arg(long, default_value = "127.0.0.1:5757")]
         bind: SocketAddr,
-        /// Seed for the copies and the guards.
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
+        /// The address players reach the server at, put in their tokens (a NAT, a relay). Needed with an
+        /// unspecified --bind (0.0.0.0) when no interface with a route is found.
+        #[arg(long)]
+        advertise: Option<SocketAddr>,
+        /// Seed for the copies and the guards (default: random; it decides which copy is real, so it is
+        /// only told when the heist ends).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Minutes a join code works; type `rotate` for a new one sooner.
+        #[arg(long, default_value_t = 30)]
+        code_ttl: u64,
         /// Level file (default: the shipped museum).
         #[arg(long)]
         level: Option<PathBuf>,
@@ -105,7 +120,10 @@ fn load_level(path: Option<PathBuf>) -> anyhow::Result<Level> {
 }
 
 fn main() -> std::process::ExitCode {
-    match run(Cli::parse()) {
+    let cli = Cli::parse();
+    let quiet = matches!(cli.command, Command::Demo { .. } | Command::Sweep { .. });
+    logging::init(cli.log_format, if quiet { "warn" } else { "info" });
+    match run(cli) {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
@@ -120,7 +138,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let mut options = ServerOptions::local_test(seed);
             options.level = load_level(level)?;
             options.game = GameOptions { seed, time_limit_s: time_limit };
-            options.echo_log = true;
+            options.echo_log = LogEcho::Stdout;
             println!("Phantom Heist demo: {} with seed {seed}, both bots over loopback UDP", options.level.name);
             heist_server::demo::run_demo(options, vive.into())?;
             Ok(())
@@ -132,25 +150,40 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             println!("{tally}");
             Ok(())
         }
-        Command::Host { bind, seed, level, insecure } => {
+        Command::Host { bind, advertise, seed, code_ttl, level, insecure } => {
             if insecure {
                 eprintln!("WARNING: --insecure: anyone who reaches {bind} can join as any role. LAN development only!");
             }
             let options = ServerOptions {
                 level: load_level(level)?,
-                game: GameOptions { seed, time_limit_s: None },
+                game: GameOptions { seed: seed.unwrap_or_else(rand::random), time_limit_s: None },
                 bind,
                 token_bind: bind,
                 insecure,
                 clock: Clock::RealTime,
-                echo_log: true,
+                echo_log: LogEcho::Tracing,
                 abuse_limit: 50,
-                advertise: None,
+                advertise,
+                code_ttl: Duration::from_secs(code_ttl.max(1) * 60),
+                token_limits: Default::default(),
             };
             let mut server = build_server(options)?;
-            println!("hosting on {} (UDP game, TCP tokens)", server.addr);
-            if !insecure {
-                println!("join code: {}", server.join_code);
+            if server.advertised == server.addr {
+                println!("hosting on {} (UDP game, TCP tokens)", server.addr);
+            } else {
+                println!("hosting on {} (UDP game, TCP tokens); players connect to {}", server.addr, server.advertised);
+            }
+            if let Some(tokens) = &server.tokens {
+                println!("join code: {}", tokens.codes.current().describe());
+                println!("type `rotate` and Enter for a new join code");
+                let codes = tokens.codes.clone();
+                std::thread::Builder::new().name("host-console".into()).spawn(move || {
+                    for line in std::io::stdin().lock().lines().map_while(Result::ok) {
+                        if line.trim() == "rotate" {
+                            println!("new join code: {} (the old one no longer works)", codes.rotate().describe());
+                        }
+                    }
+                })?;
             }
             server.app.run();
             Ok(())

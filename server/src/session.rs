@@ -14,13 +14,25 @@ use crate::net::NetSystems;
 #[derive(Resource)]
 pub struct GameState(pub Game);
 
+/// Where the session log's lines go besides [`SessionLog::lines`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LogEcho {
+    /// Nowhere (tests, sweeps).
+    #[default]
+    Off,
+    /// Printed to stdout as they are written (the demo's live log).
+    Stdout,
+    /// As `tracing` events of target `session` (a hosted server: text or JSON with the rest of the log).
+    Tracing,
+}
+
 /// Human-readable log of the session.
 #[derive(Resource, Default)]
 pub struct SessionLog {
     /// Lines so far.
     pub lines: Vec<String>,
-    /// Print each line to stdout as it is written.
-    pub echo: bool,
+    /// Where each line also goes.
+    pub echo: LogEcho,
     /// Also record debug lines (refusals).
     pub verbose: bool,
 }
@@ -28,11 +40,12 @@ pub struct SessionLog {
 impl SessionLog {
     /// Records a line stamped with game time.
     pub fn line(&mut self, t: f32, text: String) {
-        let line = format!("[{t:7.2}s] {text}");
-        if self.echo {
-            println!("{line}");
+        match self.echo {
+            LogEcho::Off => {}
+            LogEcho::Stdout => println!("[{t:7.2}s] {text}"),
+            LogEcho::Tracing => info!(target: "session", game_time_s = f64::from(t), "{text}"),
         }
-        self.lines.push(line);
+        self.lines.push(format!("[{t:7.2}s] {text}"));
     }
 
     /// Records a line only in verbose mode.
@@ -45,6 +58,10 @@ impl SessionLog {
     /// Describes a game event.
     pub fn event(&mut self, t: f32, game: &Game, event: &GameEvent) {
         let text = match event {
+            GameEvent::PhaseChanged(p @ (Phase::Won | Phase::Lost(_))) => {
+                // Only now may the seed be told: it decides which copies are real.
+                format!("phase: {p:?} (seed {0}; `--seed {0}` replays this session)", game.seed)
+            }
             GameEvent::PhaseChanged(p) => format!("phase: {p:?}"),
             GameEvent::GuardAlert { guard, alert, position } => {
                 let name = game.guards.get(usize::from(guard.0)).map_or("?", |g| g.name.as_str());
@@ -126,7 +143,7 @@ fn spawn_mirrors(mut commands: Commands, game: Res<GameState>) {
     let both = (Replicated, Audience::Both);
     commands.spawn((both, Mirror::Session, session_view(g)));
     commands.spawn((both, Mirror::Vive, vive_view(g)));
-    commands.spawn((both, PhantomTool::default()));
+    commands.spawn((both, g.tool));
     for i in 0..g.guards.len() {
         commands.spawn((both, Mirror::Guard(i), guard_view(g, i)));
     }
@@ -146,6 +163,7 @@ fn mirror_game(
     mut guards: Query<(&Mirror, &mut GuardView)>,
     mut cases: Query<(&Mirror, &mut CaseView)>,
     mut items: Query<(&Mirror, &mut ItemView)>,
+    mut tool: Query<&mut PhantomTool>,
 ) {
     let g = &game.0;
     for mut s in &mut session {
@@ -153,6 +171,9 @@ fn mirror_game(
     }
     for mut v in &mut vive {
         v.set_if_neq(vive_view(g));
+    }
+    for mut t in &mut tool {
+        t.set_if_neq(g.tool);
     }
     for (m, mut v) in &mut guards {
         if let Mirror::Guard(i) = *m {

@@ -5,6 +5,7 @@ use bevy_replicon::prelude::*;
 use bevy_replicon::shared::backend::connected_client::NetworkId;
 use heist_shared::protocol::{ClientRole, DisconnectReason, Role, ServerMsg, TokenUserData};
 
+use super::limits::MessageLimits;
 use super::transport::GameTransport;
 use super::{Auth, NetSettings};
 use crate::session::{GameState, SessionLog};
@@ -18,6 +19,8 @@ pub struct Player {
     pub strikes: f32,
     /// Set once the client is being disconnected for abuse.
     pub expelled: bool,
+    /// How much of each message kind it may still send.
+    pub limits: MessageLimits,
 }
 
 /// Which client entity plays which role.
@@ -72,14 +75,21 @@ pub(super) fn admit(
     mut log: ResMut<SessionLog>,
     mut messages: MessageWriter<ToClients<ServerMsg>>,
     mut disconnects: MessageWriter<DisconnectRequest>,
+    time: Res<Time<Real>>,
 ) {
     let client = add.entity;
-    let user_data = ids.get(client).ok().zip(transport.as_ref()).and_then(|(id, t)| t.user_data(id.get()));
+    let network_id = ids.get(client).ok().map(|id| id.get());
+    let user_data = network_id.zip(transport.as_ref()).and_then(|(id, t)| t.user_data(id));
+    let peer = network_id
+        .zip(transport.as_ref())
+        .and_then(|(id, t)| t.client_addr(id))
+        .map_or_else(|| "an unknown address".to_owned(), |a| a.to_string());
     let claim = user_data.as_ref().and_then(TokenUserData::decode);
     let claim = match (&settings.auth, claim) {
         (Auth::Secure { session, .. }, Some(c)) if c.session == *session => c,
         (Auth::Insecure, Some(c)) => c,
         _ => {
+            warn!("refused the connection from {peer}: its token is foreign or missing");
             log.line(game.0.elapsed_s, "a client with a foreign or missing token was refused".into());
             refuse_and_disconnect(client, DisconnectReason::BadToken, &mut messages, &mut disconnects);
             return;
@@ -87,14 +97,17 @@ pub(super) fn admit(
     };
     let role = claim.role;
     if roles.get(role).is_some() {
+        warn!("refused the connection from {peer}: the {role} role is taken");
         log.line(game.0.elapsed_s, format!("a second {role} was refused: the role is taken"));
         refuse_and_disconnect(client, DisconnectReason::RoleTaken(role), &mut messages, &mut disconnects);
         return;
     }
     *roles.slot(role) = Some(client);
     settings.roles.set(role, true);
-    commands.entity(client).insert((Player { role, strikes: 0.0, expelled: false }, ClientRole(role)));
+    let limits = MessageLimits::new(time.elapsed_secs_f64());
+    commands.entity(client).insert((Player { role, strikes: 0.0, expelled: false, limits }, ClientRole(role)));
     game.0.join(role);
+    info!("{role} joined from {peer}");
     log.line(game.0.elapsed_s, format!("{role} joined"));
     messages.write(ToClients {
         targets: SendTargets::Single(ClientId::Client(client)),

@@ -5,6 +5,7 @@
 //! replicon's send).
 
 mod admission;
+pub mod limits;
 pub mod receive;
 pub mod send;
 pub mod tokens;
@@ -16,7 +17,8 @@ use std::time::{SystemTime, UNIX_EPOCH};
 use bevy::prelude::*;
 use bevy_replicon::prelude::*;
 use bevy_replicon_renet::renet::ConnectionConfig;
-use bevy_replicon_renet::{RenetChannelsExt, RenetServer};
+use bevy_replicon_renet::renet::ServerEvent;
+use bevy_replicon_renet::{RenetChannelsExt, RenetServer, RenetServerEvent};
 use heist_shared::protocol::{PROTOCOL_ID, Role};
 use heist_transport::IntakeLimits;
 use heist_transport::renetcode::{ServerAuthentication, ServerConfig};
@@ -88,6 +90,7 @@ impl Plugin for ServerNetPlugin {
             .add_systems(Startup, start_transport)
             .add_observer(admission::admit)
             .add_observer(admission::forget)
+            .add_observer(log_disconnect)
             .configure_sets(PreUpdate, NetSystems::Receive.after(ServerSystems::Receive))
             .configure_sets(PostUpdate, NetSystems::Send.before(ServerSystems::Send))
             .add_systems(PreUpdate, receive::apply_client_messages.in_set(NetSystems::Receive))
@@ -136,9 +139,43 @@ fn start_transport(
     }
 }
 
+/// Says why renet let a client go (a channel overflow, a malformed packet, a timeout).
+fn log_disconnect(event: On<RenetServerEvent>) {
+    if let ServerEvent::ClientDisconnected { client_id, reason } = &**event {
+        info!("client {client_id} disconnected: {reason}");
+    }
+}
+
 /// Binds the game socket (loopback for tests, any address for hosting).
 pub fn bind_game_socket(addr: SocketAddr) -> std::io::Result<UdpSocket> {
     UdpSocket::bind(addr)
+}
+
+/// The address to tell players when the server listens on every interface (`bound` is unspecified, like
+/// 0.0.0.0): the interface address of the default route, or an error saying to pass `--advertise`. Tokens
+/// carrying 0.0.0.0 would send remote players nowhere.
+pub fn advertise_for(bound: SocketAddr) -> anyhow::Result<SocketAddr> {
+    match route_address(bound) {
+        Some(ip) => {
+            let addr = SocketAddr::new(ip, bound.port());
+            info!("listening on {bound}: advertising {addr} to players (the default route's interface; --advertise sets another)");
+            Ok(addr)
+        }
+        None => anyhow::bail!(
+            "--bind {bound} listens on every interface, but no interface with a route was found to tell players about: \
+             pass --advertise ADDR (the address players reach)"
+        ),
+    }
+}
+
+/// The local address the system would send from towards the internet (no packet is sent: connecting a
+/// UDP socket only chooses a route). `None` without a route, or when it is only loopback.
+fn route_address(bound: SocketAddr) -> Option<std::net::IpAddr> {
+    let (local, probe) = if bound.is_ipv4() { ("0.0.0.0:0", "192.0.2.1:9") } else { ("[::]:0", "[2001:db8::1]:9") };
+    let socket = UdpSocket::bind(local).ok()?;
+    socket.connect(probe).ok()?;
+    let ip = socket.local_addr().ok()?.ip();
+    (!ip.is_unspecified() && !ip.is_loopback()).then_some(ip)
 }
 
 /// The role a connected client entity plays, if admitted.

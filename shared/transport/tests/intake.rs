@@ -80,6 +80,42 @@ fn renetcode_panics_on_the_crashing_prefix_from_a_pending_address() {
 }
 
 #[test]
+fn renetcode_panics_on_a_short_datagram_with_a_long_sequence_from_a_connected_address() {
+    let memory = MemoryServer::new();
+    let config = ServerConfig {
+        current_time: START,
+        max_clients: 4,
+        protocol_id: heist_transport::memory::PROTOCOL_ID,
+        public_addresses: vec![SERVER_ADDR],
+        authentication: ServerAuthentication::Secure { private_key: [0x42; 32] },
+    };
+    let mut bare = NetcodeServer::new(config);
+    let player = addr(67, 4000);
+    let mut client = NetcodeClient::new(START, ClientAuthentication::Secure { connect_token: memory.token(78) }).unwrap();
+    // The handshake by hand: request, challenge, response, keep-alive.
+    for _ in 0..4 {
+        if let Some((packet, _)) = client.update(heist_transport::memory::FRAME) {
+            let mut packet = packet.to_vec();
+            let answer = match bare.process_packet(player, &mut packet) {
+                heist_transport::renetcode::ServerResult::PacketToSend { payload, .. }
+                | heist_transport::renetcode::ServerResult::ClientConnected { payload, .. } => payload.to_vec(),
+                _ => Vec::new(),
+            };
+            if !answer.is_empty() {
+                let mut answer = answer;
+                let _ = client.process_packet(&mut answer);
+            }
+        }
+    }
+    assert!(bare.is_client_connected(78), "connected by hand");
+    let mut short = short_with_long_sequence();
+    let panicked = quiet(|| {
+        let _ = bare.process_packet(player, &mut short);
+    });
+    assert!(panicked.is_err(), "renetcode 2.0.0 subtracts the tag length from a 9-byte rest and panics");
+}
+
+#[test]
 fn renet_panics_on_an_out_of_range_slice() {
     let mut bare = RenetServer::new(Default::default());
     bare.add_connection(1);
