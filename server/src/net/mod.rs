@@ -16,9 +16,8 @@ use std::time::{SystemTime, UNIX_EPOCH};
 
 use bevy::prelude::*;
 use bevy_replicon::prelude::*;
-use bevy_replicon_renet::renet::ConnectionConfig;
 use bevy_replicon_renet::renet::ServerEvent;
-use bevy_replicon_renet::{RenetChannelsExt, RenetServer, RenetServerEvent};
+use bevy_replicon_renet::{RenetServer, RenetServerEvent};
 use heist_shared::protocol::{PROTOCOL_ID, Role};
 use heist_transport::IntakeLimits;
 use heist_transport::renetcode::{ServerAuthentication, ServerConfig};
@@ -127,12 +126,7 @@ fn start_transport(
     };
     match transport::GameTransport::new(socket, config, IntakeLimits::default()) {
         Ok(transport) => {
-            let connection = ConnectionConfig {
-                server_channels_config: channels.server_configs(),
-                client_channels_config: channels.client_configs(),
-                ..Default::default()
-            };
-            commands.insert_resource(RenetServer::new(connection));
+            commands.insert_resource(RenetServer::new(heist_client::connection_config(&channels)));
             commands.insert_resource(transport);
         }
         Err(e) => error!("cannot start the game transport on {addr}: {e}"),
@@ -158,7 +152,9 @@ pub fn advertise_for(bound: SocketAddr) -> anyhow::Result<SocketAddr> {
     match route_address(bound) {
         Some(ip) => {
             let addr = SocketAddr::new(ip, bound.port());
-            info!("listening on {bound}: advertising {addr} to players (the default route's interface; --advertise sets another)");
+            info!(
+                "listening on {bound}: advertising {addr} to players (the default route's interface; --advertise sets another)"
+            );
             Ok(addr)
         }
         None => anyhow::bail!(

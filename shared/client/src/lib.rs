@@ -110,6 +110,16 @@ fn fill_inbox(mut messages: MessageReader<ServerMsg>, mut inbox: ResMut<Inbox>) 
     }
 }
 
+/// renet's channels for the registered protocol: the same on the server and every client (call after all
+/// protocol registration).
+pub fn connection_config(channels: &RepliconChannels) -> ConnectionConfig {
+    ConnectionConfig {
+        server_channels_config: channels.server_configs(),
+        client_channels_config: channels.client_configs(),
+        ..Default::default()
+    }
+}
+
 /// Creates the netcode transport for `token` (call after [`ClientNetPlugin`] is added and all protocol
 /// registration is done, before the first update).
 pub fn connect(app: &mut App, token: ConnectToken) -> Result<(), JoinError> {
@@ -136,12 +146,7 @@ fn insert_transport(app: &mut App, server: std::net::SocketAddr, auth: ClientAut
     let now = SystemTime::now().duration_since(UNIX_EPOCH).unwrap_or_default();
     let intake = ClientIntake::new(now, auth).map_err(|e| JoinError::Transport(e.to_string()))?;
     let transport = transport::ClientTransport::new(socket, intake).map_err(JoinError::Socket)?;
-    let channels = app.world().resource::<RepliconChannels>();
-    let connection = ConnectionConfig {
-        server_channels_config: channels.server_configs(),
-        client_channels_config: channels.client_configs(),
-        ..Default::default()
-    };
+    let connection = connection_config(app.world().resource::<RepliconChannels>());
     app.insert_resource(RenetClient::new(connection)).insert_resource(transport);
     Ok(())
 }

@@ -28,7 +28,11 @@ pub struct ClientIntake {
 impl ClientIntake {
     /// A client connecting with `authentication`, at time `now` (since the Unix epoch).
     pub fn new(now: Duration, authentication: ClientAuthentication) -> Result<Self, NetcodeError> {
-        Ok(Self { netcode: NetcodeClient::new(now, authentication)?, slices: SliceGuard::new(CLIENT_MAX_SLICES), refused: 0 })
+        Ok(Self {
+            netcode: NetcodeClient::new(now, authentication)?,
+            slices: SliceGuard::new(CLIENT_MAX_SLICES),
+            refused: 0,
+        })
     }
 
     /// The server's address.

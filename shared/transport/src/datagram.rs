@@ -2,8 +2,9 @@
 //!
 //! renetcode 2.0.0 trusts the sequence length in a packet's prefix byte and slices an 8-byte buffer with
 //! it (`packet.rs:375`): a prefix announcing 9..=15 bytes panics the server when it comes from a pending or
-//! connected address. Every datagram passes [`check_datagram`] first, so netcode only ever sees headers
-//! it can parse.
+//! connected address; a datagram too short for its announced sequence and tag underflows its tag
+//! arithmetic; a sequence near `u64::MAX` overflows its replay window. Every datagram passes
+//! [`check_datagram`] first, so netcode only ever sees headers it can parse.
 
 use crate::error::DatagramRefusal;
 
@@ -101,8 +102,19 @@ pub fn check_datagram(bytes: &[u8], direction: Direction) -> Result<PacketKind, 
     if bytes.len() < 1 + sequence_len + MAC_BYTES {
         return Err(DatagramRefusal::TooShort(bytes.len()));
     }
+    // Replay protection adds its window (256) to the sequence before decrypting; near u64::MAX that
+    // overflows (renetcode 2.0.0, replay_protection.rs:25). Real sequences count up from 0.
+    let mut sequence = [0u8; 8];
+    sequence[..sequence_len].copy_from_slice(&bytes[1..1 + sequence_len]);
+    if u64::from_le_bytes(sequence) > MAX_SEQUENCE {
+        return Err(DatagramRefusal::SequenceOutOfRange);
+    }
     Ok(kind)
 }
+
+/// Largest packet sequence accepted: far beyond any real connection (2⁶³ packets), far below where
+/// netcode's replay window arithmetic overflows.
+pub const MAX_SEQUENCE: u64 = 1 << 63;
 
 #[cfg(test)]
 mod tests {
@@ -150,6 +162,16 @@ mod tests {
         let mut prefixed = request();
         prefixed[0] = 0x10;
         assert_eq!(check_datagram(&prefixed, Direction::ToServer), Err(DatagramRefusal::BadPrefix(0x10)));
+    }
+
+    #[test]
+    fn a_sequence_near_the_end_of_u64_is_refused() {
+        let mut d = vec![0x84];
+        d.extend_from_slice(&[0xFF; 8]);
+        d.extend_from_slice(&[0u8; MAC_BYTES]);
+        assert_eq!(check_datagram(&d, Direction::ToServer), Err(DatagramRefusal::SequenceOutOfRange));
+        d[8] = 0x7F;
+        assert_eq!(check_datagram(&d, Direction::ToServer), Ok(PacketKind::KeepAlive));
     }
 
     #[test]

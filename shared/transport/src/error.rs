@@ -22,6 +22,9 @@ pub enum DatagramRefusal {
     /// The prefix announces a sequence longer than 8 bytes (the renetcode 2.0.0 panic).
     #[error("sequence length {0} in the prefix (at most 8)")]
     BadSequenceLength(u8),
+    /// A sequence number no connection reaches (netcode's replay window overflows near `u64::MAX`).
+    #[error("sequence number beyond 2^63")]
+    SequenceOutOfRange,
     /// A connection request whose prefix is not 0.
     #[error("connection request with prefix {0:#04x}")]
     BadPrefix(u8),

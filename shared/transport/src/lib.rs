@@ -2,7 +2,7 @@
 //! single byte of them: it runs netcode (renetcode) and renet as bevy_renet's netcode transport does, but
 //! checks every datagram's header before netcode parses it ([`datagram`]), every decrypted renet packet
 //! before renet parses it ([`payload`]), and limits the rate of both ([`limit`]). renetcode 2.0.0 and
-//! renet 2.0.1 panic on packets these checks refuse (docs/decisions.md has the reports).
+//! renet 2.0.1 panic on packets these checks refuse (docs/decisions.md has the four reports).
 //!
 //! No Bevy and no socket: [`ServerIntake`] and [`ClientIntake`] take datagrams and a send function, so the
 //! game, the tests and the fuzz target drive the same code.

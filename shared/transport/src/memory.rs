@@ -180,7 +180,8 @@ impl RawClient {
             let packet = packet.to_vec();
             let _ = server.deliver(self.addr, &packet);
         }
-        let (mine, rest): (Vec<_>, Vec<_>) = std::mem::take(&mut server.sent).into_iter().partition(|(to, _)| *to == self.addr);
+        let (mine, rest): (Vec<_>, Vec<_>) =
+            std::mem::take(&mut server.sent).into_iter().partition(|(to, _)| *to == self.addr);
         server.sent = rest;
         for (_, mut datagram) in mine {
             let _ = self.netcode.process_packet(&mut datagram);

@@ -118,7 +118,7 @@ impl ServerIntake {
             now_s: 0.0,
             connections: HashMap::new(),
             stats: IntakeStats::default(),
-            log: RefusalLog::new("UDP intake"),
+            log: RefusalLog::new("heist_transport::server", "UDP intake"),
         }
     }
 
@@ -183,11 +183,13 @@ impl ServerIntake {
     pub fn update(&mut self, renet: &mut RenetServer, send: &mut Send<'_>) {
         for id in self.netcode.clients_id() {
             let result = self.netcode.update_client(id);
-            self.stats.bytes_out += handle(result, renet, &mut self.connections, &self.limits, self.now_s, send).bytes_out;
+            self.stats.bytes_out +=
+                handle(result, renet, &mut self.connections, &self.limits, self.now_s, send).bytes_out;
         }
         for id in renet.disconnections_id() {
             let result = self.netcode.disconnect(id);
-            self.stats.bytes_out += handle(result, renet, &mut self.connections, &self.limits, self.now_s, send).bytes_out;
+            self.stats.bytes_out +=
+                handle(result, renet, &mut self.connections, &self.limits, self.now_s, send).bytes_out;
         }
     }
 
@@ -214,7 +216,8 @@ impl ServerIntake {
     pub fn disconnect_all(&mut self, renet: &mut RenetServer, send: &mut Send<'_>) {
         for id in self.netcode.clients_id() {
             let result = self.netcode.disconnect(id);
-            self.stats.bytes_out += handle(result, renet, &mut self.connections, &self.limits, self.now_s, send).bytes_out;
+            self.stats.bytes_out +=
+                handle(result, renet, &mut self.connections, &self.limits, self.now_s, send).bytes_out;
         }
     }
 

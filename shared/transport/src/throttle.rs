@@ -23,6 +23,7 @@ struct Source {
 /// Logs refusals with their peer address, throttled per source.
 #[derive(Debug)]
 pub struct RefusalLog {
+    target: &'static str,
     what: &'static str,
     window_start_s: f64,
     lines: usize,
@@ -31,9 +32,9 @@ pub struct RefusalLog {
 }
 
 impl RefusalLog {
-    /// `what` names the refusing part in each line ("UDP intake", "token endpoint").
-    pub fn new(what: &'static str) -> Self {
-        Self { what, window_start_s: 0.0, lines: 0, sources: HashMap::new(), unlisted: 0 }
+    /// Lines go to log target `target`; `what` names the refusing part in each ("UDP intake").
+    pub fn new(target: &'static str, what: &'static str) -> Self {
+        Self { target, what, window_start_s: 0.0, lines: 0, sources: HashMap::new(), unlisted: 0 }
     }
 
     /// Records one refusal of something from `peer` at `now_s`.
@@ -47,7 +48,7 @@ impl RefusalLog {
         let source = self.sources.entry(peer.ip()).or_default();
         if !known && self.lines < LINES_PER_WINDOW {
             self.lines += 1;
-            log::warn!("{}: refused {peer}: {reason}", self.what);
+            log::warn!(target: self.target, "{}: refused {peer}: {reason}", self.what);
         } else {
             source.suppressed += 1;
             source.last = reason.to_string();
@@ -67,14 +68,20 @@ impl RefusalLog {
             }
             if lines < LINES_PER_WINDOW {
                 lines += 1;
-                log::warn!("{}: refused {} more from {ip} in {WINDOW_S} s (last: {})", self.what, s.suppressed, s.last);
+                log::warn!(
+                    target: self.target,
+                    "{}: refused {} more from {ip} in {WINDOW_S} s (last: {})",
+                    self.what,
+                    s.suppressed,
+                    s.last
+                );
             } else {
                 quiet += s.suppressed;
             }
         }
         quiet += self.unlisted;
         if quiet > 0 {
-            log::warn!("{}: refused {quiet} more from other addresses in {WINDOW_S} s", self.what);
+            log::warn!(target: self.target, "{}: refused {quiet} more from other addresses in {WINDOW_S} s", self.what);
         }
         self.window_start_s = now_s;
         self.lines = 0;

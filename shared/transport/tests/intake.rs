@@ -1,12 +1,16 @@
 //! The intake against the packets that panic renetcode 2.0.0 and renet 2.0.1, and against thousands of
 //! random and mutated datagrams from unknown, pending and connected addresses.
 
+#![allow(clippy::unwrap_used)] // helpers outside the #[test] fns unwrap too: a panic fails the test
+
 use std::net::SocketAddr;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 use heist_transport::memory::{MemoryClient, MemoryServer, RawClient, SERVER_ADDR, START, run};
 use heist_transport::renet::{DefaultChannel, RenetServer};
-use heist_transport::renetcode::{ClientAuthentication, NetcodeClient, NetcodeServer, ServerAuthentication, ServerConfig};
+use heist_transport::renetcode::{
+    ClientAuthentication, NetcodeClient, NetcodeServer, ServerAuthentication, ServerConfig,
+};
 use heist_transport::{DatagramRefusal, PayloadRefusal, Refused};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
@@ -49,7 +53,8 @@ fn plays(server: &mut MemoryServer, client: &mut MemoryClient, id: u64) -> bool 
     run(server, &mut [client], 20);
     let got_small = std::iter::from_fn(|| server.renet.receive_message(id, DefaultChannel::ReliableOrdered))
         .any(|m| m[..] == [1, 2, 3]);
-    let got_big = std::iter::from_fn(|| client.renet.receive_message(DefaultChannel::ReliableOrdered)).any(|m| m[..] == big[..]);
+    let got_big =
+        std::iter::from_fn(|| client.renet.receive_message(DefaultChannel::ReliableOrdered)).any(|m| m[..] == big[..]);
     got_small && got_big && client.renet.is_connected()
 }
 
@@ -79,8 +84,8 @@ fn renetcode_panics_on_the_crashing_prefix_from_a_pending_address() {
     assert!(panicked.is_err(), "renetcode 2.0.0 panics");
 }
 
-#[test]
-fn renetcode_panics_on_a_short_datagram_with_a_long_sequence_from_a_connected_address() {
+/// A bare netcode server (no intake) with client 78 connected from the returned address.
+fn bare_connected() -> (NetcodeServer, SocketAddr) {
     let memory = MemoryServer::new();
     let config = ServerConfig {
         current_time: START,
@@ -91,28 +96,47 @@ fn renetcode_panics_on_a_short_datagram_with_a_long_sequence_from_a_connected_ad
     };
     let mut bare = NetcodeServer::new(config);
     let player = addr(67, 4000);
-    let mut client = NetcodeClient::new(START, ClientAuthentication::Secure { connect_token: memory.token(78) }).unwrap();
+    let mut client =
+        NetcodeClient::new(START, ClientAuthentication::Secure { connect_token: memory.token(78) }).unwrap();
     // The handshake by hand: request, challenge, response, keep-alive.
     for _ in 0..4 {
         if let Some((packet, _)) = client.update(heist_transport::memory::FRAME) {
             let mut packet = packet.to_vec();
-            let answer = match bare.process_packet(player, &mut packet) {
+            let mut answer = match bare.process_packet(player, &mut packet) {
                 heist_transport::renetcode::ServerResult::PacketToSend { payload, .. }
                 | heist_transport::renetcode::ServerResult::ClientConnected { payload, .. } => payload.to_vec(),
                 _ => Vec::new(),
             };
             if !answer.is_empty() {
-                let mut answer = answer;
                 let _ = client.process_packet(&mut answer);
             }
         }
     }
     assert!(bare.is_client_connected(78), "connected by hand");
+    (bare, player)
+}
+
+#[test]
+fn renetcode_panics_on_a_short_datagram_with_a_long_sequence_from_a_connected_address() {
+    let (mut bare, player) = bare_connected();
     let mut short = short_with_long_sequence();
     let panicked = quiet(|| {
         let _ = bare.process_packet(player, &mut short);
     });
     assert!(panicked.is_err(), "renetcode 2.0.0 subtracts the tag length from a 9-byte rest and panics");
+}
+
+#[test]
+fn renetcode_overflows_its_replay_window_on_a_huge_sequence_where_overflow_is_checked() {
+    // Found by the fuzz target. Debug builds (and the fuzzer) check overflow; release builds wrap.
+    let (mut bare, player) = bare_connected();
+    let mut huge = vec![0x84];
+    huge.extend_from_slice(&[0xFF; 8]);
+    huge.extend_from_slice(&[0u8; 16]);
+    let panicked = quiet(|| {
+        let _ = bare.process_packet(player, &mut huge);
+    });
+    assert_eq!(panicked.is_err(), cfg!(debug_assertions), "replay_protection.rs:25 adds 256 to u64::MAX");
 }
 
 #[test]
@@ -141,7 +165,10 @@ fn the_intake_refuses_every_known_crash_and_keeps_serving() {
             server.deliver(from, &crashing_prefix()),
             Err(Refused::Datagram(DatagramRefusal::BadSequenceLength(15)))
         );
-        assert_eq!(server.deliver(from, &short_with_long_sequence()), Err(Refused::Datagram(DatagramRefusal::TooShort(18))));
+        assert_eq!(
+            server.deliver(from, &short_with_long_sequence()),
+            Err(Refused::Datagram(DatagramRefusal::TooShort(18)))
+        );
     }
     let out_of_range = connected.seal(&slice_packet(0, 5, 2));
     assert_eq!(
@@ -156,6 +183,30 @@ fn the_intake_refuses_every_known_crash_and_keeps_serving() {
     // A pending client's payload is ignored by netcode; it never reaches renet either way.
     let from_pending = pending.seal(&slice_packet(0, 5, 2));
     let _ = server.deliver(pending.addr, &from_pending);
+    assert!(plays(&mut server, &mut player, 1), "the player still plays");
+}
+
+#[test]
+fn a_client_refuses_crafted_datagrams_even_from_the_servers_address() {
+    // A spoofer on the LAN can send from the server's address; the bare netcode client would panic.
+    let server = MemoryServer::new();
+    let auth = ClientAuthentication::Secure { connect_token: server.token(5) };
+    let mut bare = NetcodeClient::new(START, auth).unwrap();
+    let mut crash = crashing_prefix();
+    assert!(quiet(|| bare.process_packet(&mut crash).is_some()).is_err(), "renetcode 2.0.0 panics in the client too");
+
+    let mut server = MemoryServer::new();
+    let mut player = server.client(addr(1, 1000), 1);
+    run(&mut server, &mut [&mut player], 10);
+    for datagram in [crashing_prefix(), short_with_long_sequence()] {
+        let mut d = datagram.clone();
+        assert!(matches!(player.intake.receive(SERVER_ADDR, &mut d, &mut player.renet), Err(Refused::Datagram(_))));
+    }
+    let mut from_elsewhere = vec![0x05; 40];
+    assert_eq!(
+        player.intake.receive(addr(66, 1), &mut from_elsewhere, &mut player.renet),
+        Err(Refused::Datagram(DatagramRefusal::NotFromServer))
+    );
     assert!(plays(&mut server, &mut player, 1), "the player still plays");
 }
 
@@ -288,4 +339,14 @@ fn random_and_mutated_datagrams_never_stop_a_player_from_joining_and_playing() {
             Ok(())
         })
         .unwrap_or_else(|e| panic!("{e}"));
+}
+
+#[test]
+fn the_intake_refuses_a_sequence_that_would_overflow_the_replay_window() {
+    let mut server = MemoryServer::new();
+    let connected = RawClient::connected(&mut server, addr(3, 3000), 3);
+    let mut d = vec![0x84];
+    d.extend_from_slice(&[0xFF; 8]);
+    d.extend_from_slice(&[0u8; 16]);
+    assert_eq!(server.deliver(connected.addr, &d), Err(Refused::Datagram(DatagramRefusal::SequenceOutOfRange)));
 }

@@ -11,7 +11,7 @@ mod server_msg;
 mod token;
 mod verify;
 
-pub use client_msg::{ClientMsg, Gait, LobbyMsg, PhantomMsg, ViveMsg, WarningKind};
+pub use client_msg::{ClientMsg, Gait, LobbyMsg, PhantomMsg, ViveMsg, WarningKind, decode as decode_client_msg};
 pub use ids::{CaseId, GuardId, ItemId, Role};
 pub use replicated::{
     Audience, CaseView, ClientRole, GuardAlert, GuardView, ItemKind, ItemPlace, ItemView, LossReason, PhantomTool,
