@@ -1,6 +1,8 @@
 //! The network edge under attack on loopback: crafted and random datagrams, idle and slow connections,
 //! code guessing, and what a passive observer of a join sees.
 
+#![allow(clippy::unwrap_used)] // helpers outside the #[test] fns unwrap too: a panic fails the test
+
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream, UdpSocket};
 use std::sync::{Arc, Mutex};
@@ -110,7 +112,12 @@ fn crafted_datagrams_from_every_kind_of_address_leave_a_real_heist_running() {
             break;
         }
     }
-    assert_eq!(heist.server.game().phase, Phase::Won, "{:#?}", &heist.server.log()[heist.server.log().len().saturating_sub(15)..]);
+    assert_eq!(
+        heist.server.game().phase,
+        Phase::Won,
+        "{:#?}",
+        &heist.server.log()[heist.server.log().len().saturating_sub(15)..]
+    );
 }
 
 #[test]

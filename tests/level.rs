@@ -1,5 +1,7 @@
 //! Level files: the shipped one loads; a bad one gives an error naming the file, the place and the problem.
 
+#![allow(clippy::unwrap_used)] // helpers outside the #[test] fns unwrap too: a panic fails the test
+
 use heist_shared::level::{Level, LevelError};
 
 fn write(name: &str, text: &str) -> std::path::PathBuf {

@@ -5,8 +5,8 @@ use bevy_replicon::shared::message::registry::RemoteMessageRegistry;
 use bevy_replicon_renet::RenetClient;
 use glam::{Quat, Vec2, Vec3};
 use heist_client::JoinError;
-use heist_shared::protocol::join::JoinRefusal;
 use heist_server::ServerOptions;
+use heist_shared::protocol::join::JoinRefusal;
 use heist_shared::protocol::{
     CaseId, ClientMsg, DisconnectReason, GameEvent, ItemId, ItemKind, ItemView, LobbyMsg, PhantomMsg, PhantomTool,
     Phase, Refusal, Role, ViveMsg, WarningKind,

@@ -82,7 +82,7 @@ impl Heist {
         let trace = std::env::var_os("HEIST_TRACE").is_some();
         for _ in 0..max_ticks {
             self.step();
-            if trace && self.ticks % 30 == 0 {
+            if trace && self.ticks.is_multiple_of(30) {
                 let g = self.server.game();
                 let guards: Vec<String> = g
                     .guards

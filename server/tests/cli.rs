@@ -1,5 +1,7 @@
 //! The server binary as a user meets it: bad input gives a clear message, never a panic.
 
+#![allow(clippy::unwrap_used)] // helpers outside the #[test] fns unwrap too: a panic fails the test
+
 use std::process::Command;
 
 fn write(name: &str, text: &str) -> std::path::PathBuf {

@@ -151,6 +151,7 @@ fn kind_of(items: &Query<&ItemView>, item: ItemId) -> Option<ArtifactKind> {
 }
 
 /// Server events become [`HeistEvent`]s; a copy on the workbench goes to the haptic rig.
+#[allow(clippy::too_many_arguments)]
 fn receive(
     mut inbox: ResMut<Inbox>,
     mut events: MessageWriter<HeistEvent>,
@@ -353,7 +354,7 @@ fn keys(
             d += dir;
         }
     }
-    if d != Vec3::ZERO && !state.exploration.is_some() {
+    if d != Vec3::ZERO && state.exploration.is_none() {
         let map = haptics.map;
         let at = *state.hand_target.get_or_insert(Vec3::new(0.0, 0.06, 0.07));
         let next = (at + d * 0.1 * time.delta_secs()).clamp(Vec3::splat(-0.12), Vec3::splat(0.12));

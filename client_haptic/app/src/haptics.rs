@@ -82,6 +82,9 @@ pub struct RateWindow {
     pub with_copy: bool,
 }
 
+/// What the tree-building worker sends back: the tree and whether it came from the cache, or why not.
+type BuiltTree = Result<(InnerSphereTree, bool), String>;
+
 /// The running rig and what it renders (a non-send resource: the device lives on the haptic thread, this
 /// is the game thread's handle).
 pub struct Haptics {
@@ -94,7 +97,7 @@ pub struct Haptics {
     pub map: WorkspaceMap,
     /// The gem's packed volume [`REFERENCE_DEPTH_M`] deep in a flat face, m³ (see [`haptic_material`]).
     pub tool_reference_volume_m3: f32,
-    building: Option<(ItemId, Receiver<Result<(InnerSphereTree, bool), String>>, Material)>,
+    building: Option<(ItemId, Receiver<BuiltTree>, Material)>,
     /// The copy being felt.
     pub on_bench: Option<OnBench>,
     /// Force samples drained this frame (1 kHz; preallocated).
@@ -376,7 +379,7 @@ mod tests {
     fn a_broken_mesh_is_refused_with_the_reason() {
         let mesh =
             HapticMesh { vertices: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], triangles: vec![[0, 1, 2]] };
-        let err = build_tree(&mesh, 100, None).err().expect("refused");
+        let err = build_tree(&mesh, 100, None).expect_err("refused");
         assert!(err.contains("not a closed surface"), "{err}");
     }
 }

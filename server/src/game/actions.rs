@@ -2,8 +2,8 @@
 
 use glam::Vec2;
 use heist_shared::protocol::{
-    CaseId, Gait, GameEvent, ItemId, ItemKind, ItemPlace, NoiseKind, PhantomMsg, PhantomTool, Phase, Refusal, Role, ServerMsg,
-    Stance, VerdictOutcome, ViveMsg, WorkbenchCopy,
+    CaseId, Gait, GameEvent, ItemId, ItemKind, ItemPlace, NoiseKind, PhantomMsg, PhantomTool, Phase, Refusal, Role,
+    ServerMsg, Stance, VerdictOutcome, ViveMsg, WorkbenchCopy,
 };
 use heist_shared::rules;
 
@@ -151,7 +151,7 @@ impl Game {
             return Err(Refusal::WorkbenchBusy);
         }
         self.in_reach(self.level.workbench)?;
-        let copy = WorkbenchCopy { item: id, mesh: truth.mesh.clone(), material: truth.material.clone() };
+        let copy = WorkbenchCopy { item: id, mesh: truth.mesh.clone(), material: truth.material };
         self.take_from_hands(id)?;
         self.items[usize::from(id.0)].place = ItemPlace::Workbench;
         self.workbench = Some(id);

@@ -64,6 +64,11 @@ struct Args {
 }
 
 fn main() -> anyhow::Result<()> {
+    // Log lines (none by default) to stderr, chosen with RUST_LOG like every binary of the workspace.
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(tracing_subscriber::EnvFilter::from_default_env())
+        .with_writer(std::io::stderr)
+        .try_init();
     let args = Args::parse();
     let specs =
         presets::by_name(&args.device).with_context(|| format!("no device preset matches {:?}", args.device))?;
