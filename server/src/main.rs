@@ -48,8 +48,8 @@ impl From<Style> for ViveStyle {
 enum Command {
     /// Host a session on loopback with both bots, print the live log and the result.
     Demo {
-        /// Seed for the copies and the guards.
-        #[arg(long, default_value_t = 1)]
+        /// Seed for the copies and the guards (default 10: a heist the bots win).
+        #[arg(long, default_value_t = 10)]
         seed: u64,
         /// Level file (default: the shipped museum).
         #[arg(long)]

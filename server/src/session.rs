@@ -43,7 +43,9 @@ impl SessionLog {
         match self.echo {
             LogEcho::Off => {}
             LogEcho::Stdout => println!("[{t:7.2}s] {text}"),
-            LogEcho::Tracing => info!(target: "session", game_time_s = f64::from(t), "{text}"),
+            LogEcho::Tracing => {
+                info!(target: "session", game_time_s = (f64::from(t) * 100.0).round() / 100.0, "{text}")
+            }
         }
         self.lines.push(format!("[{t:7.2}s] {text}"));
     }

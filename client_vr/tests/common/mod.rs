@@ -29,8 +29,13 @@ pub fn join_args(extra: &[&str]) -> JoinArgs {
 /// one tick per update; `setup` adds test systems before it connects.
 pub fn vive_client(server: &HostedServer, args: &JoinArgs, setup: impl FnOnce(&mut App)) -> App {
     let endpoint = server.tokens.as_ref().expect("secure server").addr;
-    let token =
-        heist_client::request_token(endpoint, &server.join_code().expect("a secure server").code, Role::Vive, Duration::from_secs(5)).expect("token");
+    let token = heist_client::request_token(
+        endpoint,
+        &server.join_code().expect("a secure server").code,
+        Role::Vive,
+        Duration::from_secs(5),
+    )
+    .expect("token");
     let mut app = client_vr::cli::app(args, &Mode::Headless).expect("the app builds");
     app.insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f64(1.0 / TICK_HZ)));
     setup(&mut app);

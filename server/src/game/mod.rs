@@ -15,8 +15,8 @@ use glam::Vec2;
 use heist_shared::artifact::{ArtifactKind, Briefing};
 use heist_shared::level::{Level, NavGraph, WallSet};
 use heist_shared::protocol::{
-    CaseId, ClientMsg, GameEvent, ItemId, ItemKind, ItemPlace, LobbyMsg, LossReason, NoiseKind, Phase, PhantomTool, Refusal,
-    Role, ServerMsg, Stance, verify,
+    CaseId, ClientMsg, GameEvent, ItemId, ItemKind, ItemPlace, LobbyMsg, LossReason, NoiseKind, PhantomTool, Phase,
+    Refusal, Role, ServerMsg, Stance, verify,
 };
 use heist_shared::rules;
 use rand_chacha::ChaCha8Rng;

@@ -261,7 +261,11 @@ fn an_action_applies_the_inputs_sent_before_it_first() {
     for seq in 1..=10 {
         vive(&mut g, walk(seq, dir)).unwrap();
     }
-    assert_eq!(vive(&mut g, ViveMsg::Break(heist_shared::protocol::CaseId(0))), Ok(()), "in reach after the queued steps");
+    assert_eq!(
+        vive(&mut g, ViveMsg::Break(heist_shared::protocol::CaseId(0))),
+        Ok(()),
+        "in reach after the queued steps"
+    );
     assert_eq!(g.vive.last_input_seq, 10);
     assert!(g.vive.position.distance(east_of(start, 10)) < 1e-4);
 }
@@ -309,7 +313,10 @@ fn fast_forwarded_running_is_heard() {
         .filter(|o| {
             matches!(
                 o,
-                Outgoing::All(ServerMsg::Event(GameEvent::Noise { kind: heist_shared::protocol::NoiseKind::Footsteps, .. }))
+                Outgoing::All(ServerMsg::Event(GameEvent::Noise {
+                    kind: heist_shared::protocol::NoiseKind::Footsteps,
+                    ..
+                }))
             )
         })
         .count();

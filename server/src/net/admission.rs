@@ -21,6 +21,8 @@ pub struct Player {
     pub expelled: bool,
     /// How much of each message kind it may still send.
     pub limits: MessageLimits,
+    /// Where it connects from (for the log).
+    pub peer: Option<std::net::SocketAddr>,
 }
 
 /// Which client entity plays which role.
@@ -80,10 +82,8 @@ pub(super) fn admit(
     let client = add.entity;
     let network_id = ids.get(client).ok().map(|id| id.get());
     let user_data = network_id.zip(transport.as_ref()).and_then(|(id, t)| t.user_data(id));
-    let peer = network_id
-        .zip(transport.as_ref())
-        .and_then(|(id, t)| t.client_addr(id))
-        .map_or_else(|| "an unknown address".to_owned(), |a| a.to_string());
+    let peer_addr = network_id.zip(transport.as_ref()).and_then(|(id, t)| t.client_addr(id));
+    let peer = peer_addr.map_or_else(|| "an unknown address".to_owned(), |a| a.to_string());
     let claim = user_data.as_ref().and_then(TokenUserData::decode);
     let claim = match (&settings.auth, claim) {
         (Auth::Secure { session, .. }, Some(c)) if c.session == *session => c,
@@ -105,7 +105,9 @@ pub(super) fn admit(
     *roles.slot(role) = Some(client);
     settings.roles.set(role, true);
     let limits = MessageLimits::new(time.elapsed_secs_f64());
-    commands.entity(client).insert((Player { role, strikes: 0.0, expelled: false, limits }, ClientRole(role)));
+    commands
+        .entity(client)
+        .insert((Player { role, strikes: 0.0, expelled: false, limits, peer: peer_addr }, ClientRole(role)));
     game.0.join(role);
     info!("{role} joined from {peer}");
     log.line(game.0.elapsed_s, format!("{role} joined"));

@@ -101,7 +101,8 @@ mod tests {
     fn an_honest_vive_client_is_never_limited() {
         // One move per tick for a minute, with the whole of each second arriving at once.
         let mut l = MessageLimits::new(0.0);
-        let mv = ClientMsg::Vive(ViveMsg::Move { seq: 1, direction: glam::Vec2::X, gait: Default::default(), facing: 0.0 });
+        let mv =
+            ClientMsg::Vive(ViveMsg::Move { seq: 1, direction: glam::Vec2::X, gait: Default::default(), facing: 0.0 });
         for second in 0..60 {
             for _ in 0..60 {
                 assert_eq!(l.check(&mv, f64::from(second)), Ok(()));

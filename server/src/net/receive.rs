@@ -36,6 +36,8 @@ pub fn apply_client_messages(
         let now = time.elapsed_secs_f64();
         if let Err(refusal) = player.limits.check(message, now).and_then(|()| game.0.apply(player.role, message)) {
             player.strikes += 1.0;
+            let peer = player.peer.map_or_else(|| "?".to_owned(), |p| p.to_string());
+            info!("refused a {} message from {peer}: {refusal:?}", player.role);
             log.debug(game.0.elapsed_s, format!("{} refused: {refusal:?}", player.role));
             messages.write(ToClients {
                 targets: SendTargets::Single(ClientId::Client(client)),
@@ -43,6 +45,7 @@ pub fn apply_client_messages(
             });
             if player.strikes > settings.abuse_limit as f32 {
                 player.expelled = true;
+                warn!("disconnecting {} at {peer} for abuse", player.role);
                 log.line(game.0.elapsed_s, format!("{} disconnected for abuse", player.role));
                 refuse_and_disconnect(client, DisconnectReason::Abuse, &mut messages, &mut disconnects);
             }

@@ -12,7 +12,12 @@ use heist_transport::renetcode::ConnectToken;
 use crate::JoinError;
 
 /// Exchanges `code` + `role` for a connect token at `endpoint` (the host's game address, TCP).
-pub fn request_token(endpoint: SocketAddr, code: &str, role: Role, timeout: Duration) -> Result<ConnectToken, JoinError> {
+pub fn request_token(
+    endpoint: SocketAddr,
+    code: &str,
+    role: Role,
+    timeout: Duration,
+) -> Result<ConnectToken, JoinError> {
     let unreachable = |source| JoinError::Unreachable { addr: endpoint, source };
     let mut stream = TcpStream::connect_timeout(&endpoint, timeout).map_err(unreachable)?;
     stream.set_read_timeout(Some(timeout)).map_err(unreachable)?;

@@ -70,7 +70,10 @@ impl<'a> Attempt<'a> {
         self.ended = true;
         let verdict = lock(&self.shared.guesses).end(address_key(self.peer.ip()), outcome, self.shared.now_s());
         if let Some(period) = verdict.locked_for_s {
-            let why = format!("{} wrong join codes: refusing this address for {period:.0} s", self.shared.config.limits.guesses.max);
+            let why = format!(
+                "{} wrong join codes: refusing this address for {period:.0} s",
+                self.shared.config.limits.guesses.max
+            );
             self.shared.refused(self.peer, &why);
         }
         verdict.delay_s
@@ -120,7 +123,8 @@ async fn exchange(stream: &mut TcpStream, peer: SocketAddr, shared: &Shared) -> 
     let JoinMsg::Confirm { mac } = decode(&confirm)? else {
         return Err(Failure::Refused(JoinRefusal::BadRequest("expected the confirmation".into())));
     };
-    let keys = server.finish(&pake, &hello, &challenge[2..]).map_err(|e| Failure::Refused(JoinRefusal::BadRequest(e)))?;
+    let keys =
+        server.finish(&pake, &hello, &challenge[2..]).map_err(|e| Failure::Refused(JoinRefusal::BadRequest(e)))?;
     if keys.client_mac != blake3::Hash::from(mac) {
         let delay = attempt.end(Outcome::Wrong);
         tokio::time::sleep(std::time::Duration::from_secs_f64(delay)).await;

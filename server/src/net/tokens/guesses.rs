@@ -96,7 +96,9 @@ impl Guesses {
         let limits = self.limits;
         let mut record = self.records.get(&key).copied().unwrap_or_default();
         if record.locked_until_s > now_s {
-            return Err(JoinRefusal::TooManyWrongCodes { retry_after_s: (record.locked_until_s - now_s).ceil() as u32 });
+            return Err(JoinRefusal::TooManyWrongCodes {
+                retry_after_s: (record.locked_until_s - now_s).ceil() as u32,
+            });
         }
         if record.locked_until_s > 0.0 {
             // The refusal period is over: a fresh count, but the next period will be twice as long.

@@ -124,12 +124,7 @@ pub struct TokenLimits {
 
 impl Default for TokenLimits {
     fn default() -> Self {
-        Self {
-            deadline: Duration::from_secs(2),
-            per_address: 32,
-            total: 256,
-            guesses: GuessLimits::default(),
-        }
+        Self { deadline: Duration::from_secs(2), per_address: 32, total: 256, guesses: GuessLimits::default() }
     }
 }
 
@@ -193,7 +188,7 @@ impl TokenService {
         let shared = Arc::new(Shared {
             started: Instant::now(),
             guesses: Mutex::new(Guesses::new(limits.guesses)),
-            log: Mutex::new(RefusalLog::new("token endpoint")),
+            log: Mutex::new(RefusalLog::new("heist_server::net::tokens", "token endpoint")),
             config,
         });
         let codes = shared.config.codes.clone();
