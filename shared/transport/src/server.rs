@@ -54,6 +54,8 @@ pub enum Refused {
     Datagram(DatagramRefusal),
     /// A connected client's decrypted payload, before renet.
     Payload(PayloadRefusal),
+    /// Passed the checks, but netcode turned it away (bad token, failed authentication, replay...).
+    Netcode(PacketKind),
 }
 
 impl std::fmt::Display for Refused {
@@ -61,6 +63,7 @@ impl std::fmt::Display for Refused {
         match self {
             Refused::Datagram(r) => write!(f, "{r}"),
             Refused::Payload(r) => write!(f, "payload: {r}"),
+            Refused::Netcode(kind) => write!(f, "netcode turned away a {kind:?}"),
         }
     }
 }
@@ -74,6 +77,8 @@ pub struct IntakeStats {
     pub refused_datagrams: u64,
     /// Payloads refused before renet.
     pub refused_payloads: u64,
+    /// Connection requests and payloads that passed the checks but that netcode turned away.
+    pub refused_by_netcode: u64,
     /// Clients disconnected for sending refused payloads.
     pub expelled: u64,
     /// Bytes received.
@@ -140,12 +145,22 @@ impl ServerIntake {
         self.stats.datagrams += 1;
         self.stats.bytes_in += datagram.len() as u64;
         let refusal = match self.admit(from, datagram) {
-            Ok(()) => {
+            Ok(kind) => {
                 let result = self.netcode.process_packet(from, datagram);
+                let ignored = matches!(result, ServerResult::None);
                 let handled = handle(result, renet, &mut self.connections, &self.limits, self.now_s, send);
                 self.stats.bytes_out += handled.bytes_out;
                 return match handled.refused {
                     Some((client_id, refusal)) => Err(self.refused_payload(client_id, refusal, renet)),
+                    // netcode says why only in its own log (`RUST_LOG=renetcode=debug`); a request or a
+                    // payload that led nowhere was turned away: a bad, expired or replayed token, a full
+                    // server, a packet that failed authentication.
+                    None if ignored && matches!(kind, PacketKind::ConnectionRequest | PacketKind::Payload) => {
+                        self.stats.refused_by_netcode += 1;
+                        let why = format!("netcode turned away a {kind:?} (see RUST_LOG=renetcode=debug)");
+                        self.log.refused(from, &why, self.now_s);
+                        Err(Refused::Netcode(kind))
+                    }
                     None => Ok(()),
                 };
             }
@@ -157,12 +172,12 @@ impl ServerIntake {
     }
 
     /// Header check and, for a connection request, the request rate.
-    fn admit(&mut self, from: SocketAddr, datagram: &[u8]) -> Result<(), DatagramRefusal> {
+    fn admit(&mut self, from: SocketAddr, datagram: &[u8]) -> Result<PacketKind, DatagramRefusal> {
         let kind = check_datagram(datagram, Direction::ToServer)?;
         if kind == PacketKind::ConnectionRequest && !self.requests.take(address_key(from.ip()), self.now_s) {
             return Err(DatagramRefusal::RateLimited);
         }
-        Ok(())
+        Ok(kind)
     }
 
     /// Logs a refused payload and disconnects its client once it has sent too many.

@@ -180,6 +180,17 @@ fn the_intake_refuses_every_known_crash_and_keeps_serving() {
         server.deliver(connected.addr, &connected.seal(&slice_packet(1, 7, 8))),
         Err(Refused::Payload(PayloadRefusal::SliceCountChanged { message_id: 1, was: 2, now: 8 }))
     );
+    // A well-formed connection request with a forged token passes the checks; netcode turns it away and
+    // the intake says so.
+    let mut forged = vec![0u8; heist_transport::datagram::CONNECTION_REQUEST_BYTES];
+    forged[1..14].copy_from_slice(heist_transport::datagram::VERSION_INFO);
+    forged[14..22].copy_from_slice(&heist_transport::memory::PROTOCOL_ID.to_le_bytes());
+    forged[22..30].copy_from_slice(&u64::MAX.to_le_bytes());
+    assert_eq!(
+        server.deliver(addr(9, 9001), &forged),
+        Err(Refused::Netcode(heist_transport::datagram::PacketKind::ConnectionRequest))
+    );
+    assert_eq!(server.intake.stats().refused_by_netcode, 1);
     // A pending client's payload is ignored by netcode; it never reaches renet either way.
     let from_pending = pending.seal(&slice_packet(0, 5, 2));
     let _ = server.deliver(pending.addr, &from_pending);
