@@ -13,22 +13,9 @@ use heist_server::net::transport::GameTransport;
 use heist_server::{ServerOptions, build_server};
 use heist_shared::protocol::join::JoinRefusal;
 use heist_shared::protocol::{Phase, Role};
-use heist_tests::{HZ, Heist, UdpAttacker, renet_slice, token_for};
+use heist_tests::{HZ, Heist, UdpAttacker, token_for};
+use heist_transport::memory::crafted::{crashing_prefix, huge_sequence, renet_slice, short_with_long_sequence};
 use rand::{Rng, SeedableRng};
-
-/// The datagram of the issue: prefix 0xF3 (a response announcing a 15-byte sequence) and 17 bytes.
-fn crashing_prefix() -> Vec<u8> {
-    let mut d = vec![0xF3];
-    d.extend_from_slice(&[0xAB; 17]);
-    d
-}
-
-/// A short datagram announcing an 8-byte sequence (netcode's tag arithmetic underflows on it).
-fn short_with_long_sequence() -> Vec<u8> {
-    let mut d = vec![0x84];
-    d.extend_from_slice(&[0xCD; 17]);
-    d
-}
 
 /// renet's channel 0 on the server: the first client channel (replicon's mutation acks, reliable).
 const RELIABLE: u8 = 0;
@@ -55,6 +42,7 @@ fn crafted_datagrams_from_every_kind_of_address_leave_a_real_heist_running() {
     assert!(server.game().is_present(Role::Vive) && intruder.netcode.is_connected(), "the intruder got in");
     intruder.send_raw(&crashing_prefix());
     intruder.send_raw(&short_with_long_sequence());
+    intruder.send_raw(&huge_sequence());
     intruder.send_sealed(&renet_slice(RELIABLE, 0, 5, 2));
     intruder.send_sealed(&renet_slice(RELIABLE, 1, 0, 2));
     intruder.send_sealed(&renet_slice(RELIABLE, 1, 7, 8));

@@ -138,13 +138,6 @@ impl UdpAttacker {
     }
 }
 
-/// A renet slice (channel `channel`, reliable) with a full 1200-byte payload: what renet 2.0.1 indexes by.
-pub fn renet_slice(channel: u8, message_id: u8, index: u8, count: u8) -> Vec<u8> {
-    let mut p = vec![2, 1, channel, message_id, index, count, 0x44, 0xB0]; // 0x44B0 = varint 1200
-    p.extend_from_slice(&[0x5A; 1200]);
-    p
-}
-
 /// A token for `role` from `server`'s endpoint, as any holder of the join code gets one.
 pub fn token_for(server: &HostedServer, role: Role) -> heist_transport::renetcode::ConnectToken {
     let tokens = server.tokens.as_ref().expect("a secure server");

@@ -193,3 +193,38 @@ impl RawClient {
         self.netcode.generate_payload_packet(payload).map(|(_, bytes)| bytes.to_vec()).unwrap_or_default()
     }
 }
+
+/// The crafted packets each of the guarded upstream bugs panics on, for tests and fuzz seeds.
+pub mod crafted {
+    /// A netcode response announcing a 15-byte sequence (renetcode 2.0.0, `packet.rs:375`).
+    pub fn crashing_prefix() -> Vec<u8> {
+        let mut d = vec![0xF3];
+        d.extend_from_slice(&[0xAB; 17]);
+        d
+    }
+
+    /// A keep-alive announcing an 8-byte sequence with 9 bytes left for a 16-byte tag (`crypto.rs:10`).
+    pub fn short_with_long_sequence() -> Vec<u8> {
+        let mut d = vec![0x84];
+        d.extend_from_slice(&[0xCD; 17]);
+        d
+    }
+
+    /// A keep-alive with sequence `u64::MAX` (replay window overflow, `replay_protection.rs:25`).
+    pub fn huge_sequence() -> Vec<u8> {
+        let mut d = vec![0x84];
+        d.extend_from_slice(&[0xFF; 8]);
+        d.extend_from_slice(&[0u8; 16]);
+        d
+    }
+
+    /// A reliable renet slice on `channel` with a full 1200-byte payload (renet checks the size of a
+    /// slice that is not the last before it indexes, so only a full one reaches `slice_constructor.rs:41`).
+    pub fn renet_slice(channel: u8, message_id: u8, index: u8, count: u8) -> Vec<u8> {
+        // Type 2 (reliable slice), sequence 1, then one-byte varints (< 64) and 0x44B0 = varint 1200.
+        assert!(message_id < 64 && index < 64 && count < 64, "one-byte varints only");
+        let mut p = vec![2, 1, channel, message_id, index, count, 0x44, 0xB0];
+        p.extend_from_slice(&[0x5A; 1200]);
+        p
+    }
+}

@@ -6,6 +6,7 @@
 use std::net::SocketAddr;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
+use heist_transport::memory::crafted::{crashing_prefix, huge_sequence, short_with_long_sequence};
 use heist_transport::memory::{MemoryClient, MemoryServer, RawClient, SERVER_ADDR, START, run};
 use heist_transport::renet::{DefaultChannel, RenetServer};
 use heist_transport::renetcode::{
@@ -23,20 +24,6 @@ fn addr(last: u8, port: u16) -> SocketAddr {
 /// that is not the last before it indexes, so only a full one reaches the bad index).
 fn slice_packet(message_id: u64, index: u64, count: u64) -> Vec<u8> {
     varint_slice(true, 2, message_id, index, count, 1200)
-}
-
-/// The crashing datagram of the issue: prefix 0xF3 (a Response announcing a 15-byte sequence) + 17 bytes.
-fn crashing_prefix() -> Vec<u8> {
-    let mut d = vec![0xF3];
-    d.extend_from_slice(&[0xAB; 17]);
-    d
-}
-
-/// A short datagram announcing an 8-byte sequence: netcode's tag arithmetic underflows.
-fn short_with_long_sequence() -> Vec<u8> {
-    let mut d = vec![0x84];
-    d.extend_from_slice(&[0xCD; 17]);
-    d
 }
 
 /// Runs `f`, catching a panic (its message still goes to the test's output).
@@ -62,14 +49,7 @@ fn plays(server: &mut MemoryServer, client: &mut MemoryClient, id: u64) -> bool 
 fn renetcode_panics_on_the_crashing_prefix_from_a_pending_address() {
     // The upstream bug, reproduced on the bare library (what the intake stands in front of).
     let memory = MemoryServer::new();
-    let config = ServerConfig {
-        current_time: START,
-        max_clients: 4,
-        protocol_id: heist_transport::memory::PROTOCOL_ID,
-        public_addresses: vec![SERVER_ADDR],
-        authentication: ServerAuthentication::Secure { private_key: [0x42; 32] },
-    };
-    let mut bare = NetcodeServer::new(config);
+    let mut bare = bare_server();
     let attacker = addr(66, 4000);
     // The connection request a real token holder sends makes the address pending.
     let auth = ClientAuthentication::Secure { connect_token: memory.token(77) };
@@ -84,17 +64,21 @@ fn renetcode_panics_on_the_crashing_prefix_from_a_pending_address() {
     assert!(panicked.is_err(), "renetcode 2.0.0 panics");
 }
 
-/// A bare netcode server (no intake) with client 78 connected from the returned address.
-fn bare_connected() -> (NetcodeServer, SocketAddr) {
-    let memory = MemoryServer::new();
-    let config = ServerConfig {
+/// A bare netcode server (no intake) with the in-memory network's key and address.
+fn bare_server() -> NetcodeServer {
+    NetcodeServer::new(ServerConfig {
         current_time: START,
         max_clients: 4,
         protocol_id: heist_transport::memory::PROTOCOL_ID,
         public_addresses: vec![SERVER_ADDR],
         authentication: ServerAuthentication::Secure { private_key: [0x42; 32] },
-    };
-    let mut bare = NetcodeServer::new(config);
+    })
+}
+
+/// A bare netcode server (no intake) with client 78 connected from the returned address.
+fn bare_connected() -> (NetcodeServer, SocketAddr) {
+    let memory = MemoryServer::new();
+    let mut bare = bare_server();
     let player = addr(67, 4000);
     let mut client =
         NetcodeClient::new(START, ClientAuthentication::Secure { connect_token: memory.token(78) }).unwrap();
@@ -130,9 +114,7 @@ fn renetcode_panics_on_a_short_datagram_with_a_long_sequence_from_a_connected_ad
 fn renetcode_overflows_its_replay_window_on_a_huge_sequence_where_overflow_is_checked() {
     // Found by the fuzz target. Debug builds (and the fuzzer) check overflow; release builds wrap.
     let (mut bare, player) = bare_connected();
-    let mut huge = vec![0x84];
-    huge.extend_from_slice(&[0xFF; 8]);
-    huge.extend_from_slice(&[0u8; 16]);
+    let mut huge = huge_sequence();
     let panicked = quiet(|| {
         let _ = bare.process_packet(player, &mut huge);
     });
@@ -356,8 +338,8 @@ fn random_and_mutated_datagrams_never_stop_a_player_from_joining_and_playing() {
 fn the_intake_refuses_a_sequence_that_would_overflow_the_replay_window() {
     let mut server = MemoryServer::new();
     let connected = RawClient::connected(&mut server, addr(3, 3000), 3);
-    let mut d = vec![0x84];
-    d.extend_from_slice(&[0xFF; 8]);
-    d.extend_from_slice(&[0u8; 16]);
-    assert_eq!(server.deliver(connected.addr, &d), Err(Refused::Datagram(DatagramRefusal::SequenceOutOfRange)));
+    assert_eq!(
+        server.deliver(connected.addr, &huge_sequence()),
+        Err(Refused::Datagram(DatagramRefusal::SequenceOutOfRange))
+    );
 }
