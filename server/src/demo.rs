@@ -11,6 +11,7 @@ use bevy::time::TimeUpdateStrategy;
 use heist_bots::{PhantomBotPlugin, ViveBotPlugin, ViveStyle};
 use heist_client::{ClientNetPlugin, request_token};
 use heist_shared::protocol::{Phase, Role, TICK_HZ};
+use heist_transport::renetcode::ConnectToken;
 
 use crate::{HostedServer, ServerOptions, build_server};
 
@@ -26,10 +27,15 @@ pub fn stepped_client_app() -> App {
     app
 }
 
+/// A connect token for `role` from `server`'s endpoint with its current code, as a player gets one.
+pub fn token(server: &HostedServer, role: Role) -> anyhow::Result<ConnectToken> {
+    let tokens = server.tokens.as_ref().context("the server runs without a token endpoint")?;
+    Ok(request_token(tokens.addr, &tokens.codes.current().code, role, TOKEN_TIMEOUT)?)
+}
+
 /// Joins `server` as `role` through its token endpoint; `plugins` add the bot (or test probes).
 pub fn join(server: &HostedServer, role: Role, setup: impl FnOnce(&mut App)) -> anyhow::Result<App> {
-    let tokens = server.tokens.as_ref().context("the server runs without a token endpoint")?;
-    let token = request_token(tokens.addr, &tokens.codes.current().code, role, TOKEN_TIMEOUT)?;
+    let token = token(server, role)?;
     let mut app = stepped_client_app();
     setup(&mut app);
     app.finish();

@@ -28,14 +28,7 @@ pub fn join_args(extra: &[&str]) -> JoinArgs {
 /// The real headless Vive client app, joined to `server` through its token endpoint, its clock stepped
 /// one tick per update; `setup` adds test systems before it connects.
 pub fn vive_client(server: &HostedServer, args: &JoinArgs, setup: impl FnOnce(&mut App)) -> App {
-    let endpoint = server.tokens.as_ref().expect("secure server").addr;
-    let token = heist_client::request_token(
-        endpoint,
-        &server.join_code().expect("a secure server").code,
-        Role::Vive,
-        Duration::from_secs(5),
-    )
-    .expect("token");
+    let token = heist_server::demo::token(server, Role::Vive).expect("token");
     let mut app = client_vr::cli::app(args, &Mode::Headless).expect("the app builds");
     app.insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f64(1.0 / TICK_HZ)));
     setup(&mut app);

@@ -5,7 +5,7 @@
 use heist_shared::protocol::{ClientMsg, LobbyMsg, PhantomMsg, Refusal, ViveMsg};
 use heist_transport::limit::{Bucket, Rate};
 
-/// The kinds of client message, each with its own rate.
+/// The kinds of client message, each with its own rate (in [`MsgKind::ALL`]'s order).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MsgKind {
     /// `Ready`.
@@ -68,8 +68,7 @@ impl MessageLimits {
     /// `Ok` when `msg` is within its kind's rate (it takes a token), else the refusal.
     pub fn check(&mut self, msg: &ClientMsg, now_s: f64) -> Result<(), Refusal> {
         let Some(kind) = MsgKind::of(msg) else { return Ok(()) };
-        let i = MsgKind::ALL.iter().position(|&k| k == kind).unwrap_or_default();
-        if self.0[i].take(kind.rate(), now_s) { Ok(()) } else { Err(Refusal::RateLimited) }
+        if self.0[kind as usize].take(kind.rate(), now_s) { Ok(()) } else { Err(Refusal::RateLimited) }
     }
 }
 
@@ -77,6 +76,13 @@ impl MessageLimits {
 mod tests {
     use super::*;
     use heist_shared::protocol::WarningKind;
+
+    #[test]
+    fn every_kind_has_its_own_bucket_in_declaration_order() {
+        for (i, kind) in MsgKind::ALL.into_iter().enumerate() {
+            assert_eq!(kind as usize, i);
+        }
+    }
 
     #[test]
     fn a_warning_a_second_passes_a_flood_does_not() {

@@ -2,12 +2,12 @@
 //! packets back out. Stands where bevy_renet's `NetcodeServerTransport` would (same schedule slots), so a
 //! datagram that would panic renetcode or renet never reaches them.
 
-use std::io::ErrorKind;
 use std::net::{SocketAddr, UdpSocket};
 
 use bevy::prelude::*;
 use bevy_replicon_renet::{RenetReceive, RenetSend, RenetServer, RenetServerPlugin};
 use heist_transport::renetcode::{NETCODE_USER_DATA_BYTES, ServerConfig};
+use heist_transport::socket::{self, send_to};
 use heist_transport::{IntakeLimits, IntakeStats, ServerIntake};
 
 /// Datagrams read per frame at most: a flood waits in the kernel's buffer (and is dropped there) instead
@@ -19,15 +19,14 @@ pub const MAX_DATAGRAMS_PER_FRAME: usize = 4096;
 pub struct GameTransport {
     socket: UdpSocket,
     intake: ServerIntake,
-    /// Larger than netcode's 1400 so an oversized datagram is seen as such, not silently cut.
-    buffer: Box<[u8; 1500]>,
+    buffer: Box<[u8; socket::BUFFER_BYTES]>,
 }
 
 impl GameTransport {
     /// Serves `socket` (made non-blocking) with a netcode server made from `config`.
     pub fn new(socket: UdpSocket, config: ServerConfig, limits: IntakeLimits) -> std::io::Result<Self> {
         socket.set_nonblocking(true)?;
-        Ok(Self { socket, intake: ServerIntake::new(config, limits), buffer: Box::new([0; 1500]) })
+        Ok(Self { socket, intake: ServerIntake::new(config, limits), buffer: Box::new([0; socket::BUFFER_BYTES]) })
     }
 
     /// The user data in a connected client's token.
@@ -67,31 +66,16 @@ pub(super) fn add_systems(app: &mut App) {
     );
 }
 
-fn send_to(socket: &UdpSocket) -> impl FnMut(SocketAddr, &[u8]) + '_ {
-    move |to, bytes| {
-        if let Err(e) = socket.send_to(bytes, to) {
-            debug!("cannot send {} bytes to {to}: {e}", bytes.len());
-        }
-    }
-}
-
 fn receive(mut transport: ResMut<GameTransport>, mut renet: ResMut<RenetServer>, time: Res<Time<Real>>) {
     let GameTransport { socket, intake, buffer } = &mut *transport;
     intake.advance(time.delta());
     let mut send = send_to(socket);
-    for _ in 0..MAX_DATAGRAMS_PER_FRAME {
-        match socket.recv_from(&mut buffer[..]) {
-            Ok((len, from)) => {
-                // Refusals are counted and logged (throttled) by the intake.
-                let _ = intake.receive(from, &mut buffer[..len], &mut renet, &mut send);
-            }
-            Err(e) if e.kind() == ErrorKind::WouldBlock => break,
-            Err(e) if matches!(e.kind(), ErrorKind::Interrupted | ErrorKind::ConnectionReset) => continue,
-            Err(e) => {
-                error!("the game socket failed: {e}");
-                break;
-            }
-        }
+    let drained = socket::drain(socket, buffer, MAX_DATAGRAMS_PER_FRAME, |from, datagram| {
+        // Refusals are counted and logged (throttled) by the intake.
+        let _ = intake.receive(from, datagram, &mut renet, &mut send);
+    });
+    if let Err(e) = drained {
+        error!("the game socket failed: {e}");
     }
     intake.update(&mut renet, &mut send);
 }

@@ -2,12 +2,12 @@
 //! renet, renet's packets back out. Stands where bevy_renet's `NetcodeClientTransport` would (same
 //! schedule slots), so a datagram spoofed from the server's address cannot panic the client.
 
-use std::io::ErrorKind;
 use std::net::{SocketAddr, UdpSocket};
 
 use bevy::prelude::*;
 use bevy_replicon_renet::{RenetClient, RenetClientPlugin, RenetReceive, RenetSend};
 use heist_transport::renetcode::{DisconnectReason, NetcodeError};
+use heist_transport::socket::{self, send_to};
 use heist_transport::{ClientIntake, TransportError};
 
 /// Datagrams read per frame at most, so a flood cannot stall a frame.
@@ -18,7 +18,7 @@ pub const MAX_DATAGRAMS_PER_FRAME: usize = 1024;
 pub struct ClientTransport {
     socket: UdpSocket,
     intake: ClientIntake,
-    buffer: Box<[u8; 1500]>,
+    buffer: Box<[u8; socket::BUFFER_BYTES]>,
     /// Why the transport stopped, once it has.
     pub stopped: Option<String>,
 }
@@ -27,7 +27,7 @@ impl ClientTransport {
     /// Serves `socket` (made non-blocking) for `intake`.
     pub fn new(socket: UdpSocket, intake: ClientIntake) -> std::io::Result<Self> {
         socket.set_nonblocking(true)?;
-        Ok(Self { socket, intake, buffer: Box::new([0; 1500]), stopped: None })
+        Ok(Self { socket, intake, buffer: Box::new([0; socket::BUFFER_BYTES]), stopped: None })
     }
 
     /// Why netcode gave up, if it did.
@@ -66,14 +66,6 @@ pub(crate) fn add_systems(app: &mut App) {
     );
 }
 
-fn send_to(socket: &UdpSocket) -> impl FnMut(SocketAddr, &[u8]) + '_ {
-    move |to, bytes| {
-        if let Err(e) = socket.send_to(bytes, to) {
-            debug!("cannot send {} bytes to {to}: {e}", bytes.len());
-        }
-    }
-}
-
 fn stop(stopped: &mut Option<String>, error: TransportError) {
     if stopped.is_none() {
         // Said once: the transport keeps reporting the same reason every frame.
@@ -92,20 +84,13 @@ fn receive(mut transport: ResMut<ClientTransport>, mut renet: ResMut<RenetClient
         stop(stopped, e);
         return;
     }
-    for _ in 0..MAX_DATAGRAMS_PER_FRAME {
-        match socket.recv_from(&mut buffer[..]) {
-            Ok((len, from)) => {
-                if let Err(r) = intake.receive(from, &mut buffer[..len], &mut renet) {
-                    debug!("refused a datagram from {from}: {r}");
-                }
-            }
-            Err(e) if e.kind() == ErrorKind::WouldBlock => break,
-            Err(e) if matches!(e.kind(), ErrorKind::Interrupted | ErrorKind::ConnectionReset) => continue,
-            Err(e) => {
-                stop(stopped, TransportError::Io(e));
-                break;
-            }
+    let drained = socket::drain(socket, buffer, MAX_DATAGRAMS_PER_FRAME, |from, datagram| {
+        if let Err(r) = intake.receive(from, datagram, &mut renet) {
+            debug!("refused a datagram from {from}: {r}");
         }
+    });
+    if let Err(e) = drained {
+        stop(stopped, TransportError::Io(e));
     }
     intake.finish_update(time.delta(), &mut send);
 }

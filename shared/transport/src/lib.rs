@@ -4,8 +4,8 @@
 //! before renet parses it ([`payload`]), and limits the rate of both ([`limit`]). renetcode 2.0.0 and
 //! renet 2.0.1 panic on packets these checks refuse (docs/decisions.md has the four reports).
 //!
-//! No Bevy and no socket: [`ServerIntake`] and [`ClientIntake`] take datagrams and a send function, so the
-//! game, the tests and the fuzz target drive the same code.
+//! No Bevy and no socket of their own: [`ServerIntake`] and [`ClientIntake`] take datagrams and a send
+//! function, so the game (through [`socket`]), the tests and the fuzz target drive the same code.
 #![warn(missing_docs)]
 
 pub mod client;
@@ -16,6 +16,7 @@ pub mod limit;
 pub mod memory;
 pub mod payload;
 pub mod server;
+pub mod socket;
 pub mod throttle;
 
 pub use client::ClientIntake;

@@ -34,6 +34,13 @@ pub struct IntakeLimits {
     pub tracked_addresses: usize,
 }
 
+impl IntakeLimits {
+    /// The rate at which refused payloads are forgiven: one a second, `refused_payloads_limit` at once.
+    fn refusal_rate(&self) -> Rate {
+        Rate::new(1.0, self.refused_payloads_limit)
+    }
+}
+
 impl Default for IntakeLimits {
     fn default() -> Self {
         Self {
@@ -93,20 +100,26 @@ struct Connection {
     addr: SocketAddr,
     slices: SliceGuard,
     datagrams: Bucket,
-    strikes: f64,
-    strikes_at_s: f64,
+    /// Refused payloads it may still send; empty means disconnect.
+    refusals: Bucket,
     expelled: bool,
+}
+
+/// What acting on netcode's results reads and changes: the connected clients, the clock, the counts.
+#[derive(Debug)]
+struct Peers {
+    limits: IntakeLimits,
+    now_s: f64,
+    connections: HashMap<u64, Connection>,
+    stats: IntakeStats,
 }
 
 /// Checks and forwards every datagram of the game socket.
 #[derive(Debug)]
 pub struct ServerIntake {
     netcode: NetcodeServer,
-    limits: IntakeLimits,
-    now_s: f64,
     requests: KeyedLimiter<IpAddr>,
-    connections: HashMap<u64, Connection>,
-    stats: IntakeStats,
+    peers: Peers,
     log: RefusalLog,
 }
 
@@ -119,19 +132,16 @@ impl ServerIntake {
         Self {
             netcode: NetcodeServer::new(config),
             requests: KeyedLimiter::new(limits.requests_per_address, limits.requests_total, limits.tracked_addresses),
-            limits,
-            now_s: 0.0,
-            connections: HashMap::new(),
-            stats: IntakeStats::default(),
+            peers: Peers { limits, now_s: 0.0, connections: HashMap::new(), stats: IntakeStats::default() },
             log: RefusalLog::new("heist_transport::server", "UDP intake"),
         }
     }
 
     /// Advances time by `dt` (netcode expires pending clients with it).
     pub fn advance(&mut self, dt: Duration) {
-        self.now_s += dt.as_secs_f64();
+        self.peers.now_s += dt.as_secs_f64();
         self.netcode.update(dt);
-        self.log.roll(self.now_s);
+        self.log.roll(self.peers.now_s);
     }
 
     /// Takes one datagram from `from`: checks it, lets netcode process it, passes a payload on to renet.
@@ -142,23 +152,21 @@ impl ServerIntake {
         renet: &mut RenetServer,
         send: &mut Send<'_>,
     ) -> Result<(), Refused> {
-        self.stats.datagrams += 1;
-        self.stats.bytes_in += datagram.len() as u64;
+        self.peers.stats.datagrams += 1;
+        self.peers.stats.bytes_in += datagram.len() as u64;
         let refusal = match self.admit(from, datagram) {
             Ok(kind) => {
                 let result = self.netcode.process_packet(from, datagram);
                 let ignored = matches!(result, ServerResult::None);
-                let handled = handle(result, renet, &mut self.connections, &self.limits, self.now_s, send);
-                self.stats.bytes_out += handled.bytes_out;
-                return match handled.refused {
+                return match self.peers.handle(result, renet, send) {
                     Some((client_id, refusal)) => Err(self.refused_payload(client_id, refusal, renet)),
                     // netcode says why only in its own log (`RUST_LOG=renetcode=debug`); a request or a
                     // payload that led nowhere was turned away: a bad, expired or replayed token, a full
                     // server, a packet that failed authentication.
                     None if ignored && matches!(kind, PacketKind::ConnectionRequest | PacketKind::Payload) => {
-                        self.stats.refused_by_netcode += 1;
+                        self.peers.stats.refused_by_netcode += 1;
                         let why = format!("netcode turned away a {kind:?} (see RUST_LOG=renetcode=debug)");
-                        self.log.refused(from, &why, self.now_s);
+                        self.log.refused(from, &why, self.peers.now_s);
                         Err(Refused::Netcode(kind))
                     }
                     None => Ok(()),
@@ -166,15 +174,15 @@ impl ServerIntake {
             }
             Err(r) => r,
         };
-        self.stats.refused_datagrams += 1;
-        self.log.refused(from, &refusal, self.now_s);
+        self.peers.stats.refused_datagrams += 1;
+        self.log.refused(from, &refusal, self.peers.now_s);
         Err(Refused::Datagram(refusal))
     }
 
     /// Header check and, for a connection request, the request rate.
     fn admit(&mut self, from: SocketAddr, datagram: &[u8]) -> Result<PacketKind, DatagramRefusal> {
         let kind = check_datagram(datagram, Direction::ToServer)?;
-        if kind == PacketKind::ConnectionRequest && !self.requests.take(address_key(from.ip()), self.now_s) {
+        if kind == PacketKind::ConnectionRequest && !self.requests.take(address_key(from.ip()), self.peers.now_s) {
             return Err(DatagramRefusal::RateLimited);
         }
         Ok(kind)
@@ -182,12 +190,13 @@ impl ServerIntake {
 
     /// Logs a refused payload and disconnects its client once it has sent too many.
     fn refused_payload(&mut self, client_id: u64, refusal: PayloadRefusal, renet: &mut RenetServer) -> Refused {
-        self.stats.refused_payloads += 1;
-        let Some(c) = self.connections.get_mut(&client_id) else { return Refused::Payload(refusal) };
-        self.log.refused(c.addr, &Refused::Payload(refusal), self.now_s);
-        if c.strikes > self.limits.refused_payloads_limit && !c.expelled {
+        let Peers { limits, now_s, connections, stats } = &mut self.peers;
+        stats.refused_payloads += 1;
+        let Some(c) = connections.get_mut(&client_id) else { return Refused::Payload(refusal) };
+        self.log.refused(c.addr, &Refused::Payload(refusal), *now_s);
+        if !c.refusals.take(limits.refusal_rate(), *now_s) && !c.expelled {
             c.expelled = true;
-            self.stats.expelled += 1;
+            stats.expelled += 1;
             log::warn!("UDP intake: disconnecting client {client_id} at {}: too many refused payloads", c.addr);
             renet.disconnect(client_id);
         }
@@ -197,14 +206,10 @@ impl ServerIntake {
     /// Keep-alives, timeouts and the disconnections renet asked for; call once per frame after receiving.
     pub fn update(&mut self, renet: &mut RenetServer, send: &mut Send<'_>) {
         for id in self.netcode.clients_id() {
-            let result = self.netcode.update_client(id);
-            self.stats.bytes_out +=
-                handle(result, renet, &mut self.connections, &self.limits, self.now_s, send).bytes_out;
+            self.peers.handle(self.netcode.update_client(id), renet, send);
         }
         for id in renet.disconnections_id() {
-            let result = self.netcode.disconnect(id);
-            self.stats.bytes_out +=
-                handle(result, renet, &mut self.connections, &self.limits, self.now_s, send).bytes_out;
+            self.peers.handle(self.netcode.disconnect(id), renet, send);
         }
     }
 
@@ -215,7 +220,7 @@ impl ServerIntake {
             for packet in packets {
                 match self.netcode.generate_payload_packet(id, &packet) {
                     Ok((addr, bytes)) => {
-                        self.stats.bytes_out += bytes.len() as u64;
+                        self.peers.stats.bytes_out += bytes.len() as u64;
                         send(addr, bytes);
                     }
                     Err(e) => {
@@ -230,9 +235,7 @@ impl ServerIntake {
     /// Disconnects every client at once (the server is stopping).
     pub fn disconnect_all(&mut self, renet: &mut RenetServer, send: &mut Send<'_>) {
         for id in self.netcode.clients_id() {
-            let result = self.netcode.disconnect(id);
-            self.stats.bytes_out +=
-                handle(result, renet, &mut self.connections, &self.limits, self.now_s, send).bytes_out;
+            self.peers.handle(self.netcode.disconnect(id), renet, send);
         }
     }
 
@@ -248,7 +251,7 @@ impl ServerIntake {
 
     /// Counts so far.
     pub fn stats(&self) -> IntakeStats {
-        self.stats
+        self.peers.stats
     }
 }
 
@@ -258,80 +261,59 @@ impl Connection {
             addr,
             slices: SliceGuard::new(limits.max_slices),
             datagrams: Bucket::full(limits.datagrams_per_client, now_s),
-            strikes: 0.0,
-            strikes_at_s: now_s,
+            refusals: Bucket::full(limits.refusal_rate(), now_s),
             expelled: false,
         }
     }
 
-    /// Checks one decrypted payload; a refusal adds a strike (leaking one a second).
+    /// Checks one decrypted payload: the connection's datagram rate, then its slices.
     fn check(&mut self, payload: &[u8], limits: &IntakeLimits, now_s: f64) -> Result<(), PayloadRefusal> {
-        let result = if self.datagrams.take(limits.datagrams_per_client, now_s) {
-            self.slices.check(payload)
-        } else {
-            Err(PayloadRefusal::RateLimited)
+        if !self.datagrams.take(limits.datagrams_per_client, now_s) {
+            return Err(PayloadRefusal::RateLimited);
+        }
+        self.slices.check(payload)
+    }
+}
+
+impl Peers {
+    /// Acts on one netcode result: sends what it says to send, passes a checked payload to renet; returns
+    /// the payload refusal, if that is what it came to.
+    fn handle(
+        &mut self,
+        result: ServerResult<'_, '_>,
+        renet: &mut RenetServer,
+        send: &mut Send<'_>,
+    ) -> Option<(u64, PayloadRefusal)> {
+        let mut sent = |addr, bytes: &[u8]| {
+            self.stats.bytes_out += bytes.len() as u64;
+            send(addr, bytes);
         };
-        if result.is_err() {
-            self.strikes = (self.strikes - (now_s - self.strikes_at_s)).max(0.0) + 1.0;
-            self.strikes_at_s = now_s;
-        }
-        result
-    }
-}
-
-/// What acting on one netcode result did.
-struct Handled {
-    bytes_out: u64,
-    refused: Option<(u64, PayloadRefusal)>,
-}
-
-impl Handled {
-    fn sent(bytes: usize) -> Self {
-        Self { bytes_out: bytes as u64, refused: None }
-    }
-}
-
-/// Acts on one netcode result: sends what it says to send, passes a checked payload to renet.
-fn handle(
-    result: ServerResult<'_, '_>,
-    renet: &mut RenetServer,
-    connections: &mut HashMap<u64, Connection>,
-    limits: &IntakeLimits,
-    now_s: f64,
-    send: &mut Send<'_>,
-) -> Handled {
-    match result {
-        ServerResult::None => Handled::sent(0),
-        ServerResult::PacketToSend { addr, payload } => {
-            send(addr, payload);
-            Handled::sent(payload.len())
-        }
-        ServerResult::Payload { client_id, payload } => {
-            let Some(connection) = connections.get_mut(&client_id) else { return Handled::sent(0) };
-            match connection.check(payload, limits, now_s) {
-                Ok(()) => {
-                    // Only fails for an unknown client, which netcode just vouched for.
-                    let _ = renet.process_packet_from(payload, client_id);
-                    Handled::sent(0)
+        match result {
+            ServerResult::None => {}
+            ServerResult::PacketToSend { addr, payload } => sent(addr, payload),
+            ServerResult::Payload { client_id, payload } => {
+                let connection = self.connections.get_mut(&client_id)?;
+                if let Err(r) = connection.check(payload, &self.limits, self.now_s) {
+                    return Some((client_id, r));
                 }
-                Err(r) => Handled { bytes_out: 0, refused: Some((client_id, r)) },
+                // Only fails for an unknown client, which netcode just vouched for.
+                let _ = renet.process_packet_from(payload, client_id);
+            }
+            ServerResult::ClientConnected { client_id, addr, payload, .. } => {
+                log::info!("UDP intake: client {client_id} connected from {addr}");
+                sent(addr, payload);
+                self.connections.insert(client_id, Connection::new(addr, &self.limits, self.now_s));
+                renet.add_connection(client_id);
+            }
+            ServerResult::ClientDisconnected { client_id, addr, payload } => {
+                log::info!("UDP intake: client {client_id} at {addr} disconnected");
+                if let Some(p) = payload {
+                    sent(addr, p);
+                }
+                self.connections.remove(&client_id);
+                renet.remove_connection(client_id);
             }
         }
-        ServerResult::ClientConnected { client_id, addr, payload, .. } => {
-            log::info!("UDP intake: client {client_id} connected from {addr}");
-            connections.insert(client_id, Connection::new(addr, limits, now_s));
-            renet.add_connection(client_id);
-            send(addr, payload);
-            Handled::sent(payload.len())
-        }
-        ServerResult::ClientDisconnected { client_id, addr, payload } => {
-            log::info!("UDP intake: client {client_id} at {addr} disconnected");
-            connections.remove(&client_id);
-            renet.remove_connection(client_id);
-            Handled::sent(payload.map_or(0, |p| {
-                send(addr, p);
-                p.len()
-            }))
-        }
+        None
     }
 }
