@@ -10,6 +10,14 @@
 //!    median over the pokes, gives the stiffness;
 //! 2. a light press on a plain part and a stroke down and up: the drag against the motion over the
 //!    normal force gives the friction.
+//!
+//! A hand can only judge what it felt at full force: when the haptic loop stalls (the process was not
+//! scheduled) or the contact data goes stale, the safety layer fades the forces out and back in over two
+//! seconds, the stylus sinks where a wall should have stopped it, and a narrow copy can feel like
+//! nothing at all. The stylus can also fail to follow the hand through a poke (it met nothing, yet
+//! never got in), and one such poke would read as a feature. An exploration that measured during such a
+//! spell, or missed a poke, backs off round the copy, waits until the forces are whole again and starts
+//! over, up to [`ATTEMPTS`] times; in the last one a missed poke reads as the poke before it.
 
 use std::f32::consts::TAU;
 
@@ -27,6 +35,16 @@ pub const TAP_S: f32 = 0.4;
 /// Friction above which a copy feels rough (briefed: smooth 0.1, rough 0.6; felt through the packed
 /// skin's bumps a little higher).
 pub const ROUGH_ABOVE: f32 = 0.45;
+/// Explorations of one copy at most, when the first ones were disturbed.
+pub const ATTEMPTS: u32 = 3;
+/// A tick this much later than the one before means the haptic loop stalled, µs.
+const STALL_US: u64 = 50_000;
+/// Contact data older than this trips the safety layer's watchdog (its default
+/// [`forcecomp::SafetyConfig::watchdog_timeout_s`]), µs.
+const STALE_US: u32 = 32_000;
+/// How long forces are suspect after a stall or stale data: the watchdog's ramp back in (2 s) and a
+/// margin, µs.
+const RECOVER_US: u64 = 2_500_000;
 
 /// Resting force over depth² (see [`Findings::pressure_n_per_m2`]) above which a copy of `kind` feels
 /// hard, N/m². Learnt per kind, like a player learns how a hard crown feels: the crown's thin points give
@@ -83,6 +101,10 @@ pub struct Findings {
     pub friction: f32,
     /// The material class these make.
     pub material: MaterialClass,
+    /// Explorations it took (more than one when the haptic loop was disturbed during one).
+    pub attempts: u32,
+    /// Whether the last exploration was disturbed too (after [`ATTEMPTS`]): the figures are suspect.
+    pub disturbed: bool,
 }
 
 impl Findings {
@@ -93,8 +115,13 @@ impl Findings {
 
     /// The figures, for the log.
     pub fn describe(&self) -> String {
+        let attempts = match (self.attempts, self.disturbed) {
+            (_, true) => format!(" (disturbed in all {} explorations)", self.attempts),
+            (1, false) => String::new(),
+            (n, false) => format!(" ({n} explorations: the earlier ones were disturbed)"),
+        };
         format!(
-            "{} features, stiffness {:.0} N/m ({:.0} kN/m²), friction {:.2}: {}",
+            "{} features, stiffness {:.0} N/m ({:.0} kN/m²), friction {:.2}: {}{attempts}",
             self.feature_count,
             self.stiffness_n_per_m,
             self.pressure_n_per_m2 / 1000.0,
@@ -114,6 +141,10 @@ impl Findings {
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Stage {
     Settle,
+    /// After a disturbance: out to the ring of pokes, waiting there for the forces to come back.
+    Retreat,
+    /// Round the ring of pokes to where they start.
+    Return,
     Taps,
     Approach,
     Press,
@@ -153,6 +184,11 @@ pub struct Exploration {
     surface: f32,
     slide: (f32, f32),
     last: Option<(u64, Vec3)>,
+    /// Haptic-clock time from which the forces are whole again after the last stall or stale data.
+    calm_from_us: u64,
+    /// Whether this attempt measured before `calm_from_us`.
+    disturbed: bool,
+    attempts: u32,
     findings: Option<Findings>,
 }
 
@@ -180,6 +216,9 @@ impl Exploration {
             surface: 0.0,
             slide: (0.0, 0.0),
             last: None,
+            calm_from_us: 0,
+            disturbed: false,
+            attempts: 1,
             findings: None,
         }
     }
@@ -204,7 +243,14 @@ impl Exploration {
         for s in samples {
             self.take(s);
         }
-        if now_us < self.stage_end_us || self.stage == Stage::Done {
+        let measured = matches!(self.stage, Stage::Taps | Stage::SlideDown | Stage::SlideUp);
+        if self.stage == Stage::Taps && now_us >= self.stage_end_us {
+            let missed = self.missed().any(|missed| missed);
+            self.disturbed |= missed;
+        }
+        // A disturbed attempt stops at once when another is allowed; the last one runs to its end.
+        let start_over = measured && self.disturbed && self.attempts < ATTEMPTS;
+        if (now_us < self.stage_end_us && !start_over) || self.stage == Stage::Done {
             return false;
         }
         let (y, r_out, r_in, y_press) = ring(self.kind);
@@ -212,17 +258,25 @@ impl Exploration {
         let at = self.goal.sample(now_us).translation;
         let line = |from: Vec3, to: Vec3, duration_s: f32| HandGoal::Line { from, to, duration_s, start_us: start };
         let axis = Vec3::new(0.0, y_press, 0.0);
+        let centre = Vec3::new(0.0, y, 0.0);
         let (next, goal, seconds) = match self.stage {
-            Stage::Settle => {
-                self.taps_start_us = start;
-                let taps = HandGoal::Taps {
-                    centre: Vec3::new(0.0, y, 0.0),
-                    r_out,
-                    r_in,
-                    n: TAPS as u32,
-                    tap_s: TAP_S,
-                    start_us: start,
-                };
+            _ if start_over => {
+                // Straight out from the axis (never across the copy) to the ring, and wait there.
+                self.attempts += 1;
+                let out = Vec3::new(at.x, 0.0, at.z).try_normalize().unwrap_or(Vec3::X) * r_out;
+                let wait = self.calm_from_us.saturating_sub(start).max(600_000) as f32 * 1e-6;
+                (Stage::Retreat, line(at, centre + out, 0.5), wait)
+            }
+            Stage::Retreat => {
+                // Round the ring, the way the pokes go, back to their first angle.
+                let start_rad = (-at.z).atan2(at.x).rem_euclid(TAU);
+                let turns = (1.0 - start_rad / TAU).fract();
+                let round = HandGoal::Orbit { centre, radius: r_out, start_rad, period_s: 3.0, turns, start_us: start };
+                (Stage::Return, round, 3.0 * turns + 0.05)
+            }
+            Stage::Settle | Stage::Return => {
+                self.restart_taps(start);
+                let taps = HandGoal::Taps { centre, r_out, r_in, n: TAPS as u32, tap_s: TAP_S, start_us: start };
                 (Stage::Taps, taps, TAPS as f32 * TAP_S + 0.05)
             }
             Stage::Taps => {
@@ -248,6 +302,16 @@ impl Exploration {
         true
     }
 
+    /// Forgets what the taps and strokes found, for a fresh start at `start_us`.
+    fn restart_taps(&mut self, start_us: u64) {
+        self.taps_start_us = start_us;
+        self.tap_touch.fill(None);
+        self.tap_min.fill(f32::INFINITY);
+        self.tap_hold.fill(Hold::default());
+        self.slide = (0.0, 0.0);
+        self.disturbed = false;
+    }
+
     fn take(&mut self, s: &ForceSample) {
         let p = s.tool_position;
         let radial = Vec3::new(p.x, 0.0, p.z).length();
@@ -255,6 +319,12 @@ impl Exploration {
             Some((t, q)) if s.t_us > t => (p - q) / ((s.t_us - t) as f32 * 1e-6),
             _ => Vec3::ZERO,
         };
+        let stalled = self.last.is_some_and(|(t, _)| s.t_us > t + STALL_US);
+        if stalled || s.data_age_us > STALE_US {
+            self.calm_from_us = s.t_us + RECOVER_US;
+        }
+        let measuring = matches!(self.stage, Stage::Taps | Stage::SlideDown | Stage::SlideUp);
+        self.disturbed |= measuring && s.t_us < self.calm_from_us;
         self.last = Some((s.t_us, p));
         let touching = s.contact_force.length() > TOUCH_N;
         match self.stage {
@@ -293,12 +363,34 @@ impl Exploration {
         }
     }
 
-    /// The profile of the taps: where each first touched, or how deep it got.
+    /// Which pokes were missed: the stylus met nothing, yet did not get even halfway in (or nothing was
+    /// sampled while it should have been in), or it met something where no copy reaches (within 5 mm of
+    /// where the poke starts, 10 mm outside the kind's look).
+    fn missed(&self) -> impl Iterator<Item = bool> + '_ {
+        let (_, r_out, r_in, _) = ring(self.kind);
+        let halfway = 0.5 * (r_out + r_in);
+        self.tap_touch.iter().zip(&self.tap_min).map(move |(touch, min)| match touch {
+            Some(r) => *r > r_out - 0.005,
+            None => !min.is_finite() || *min >= halfway,
+        })
+    }
+
+    /// The profile of the taps: where each first touched, or how deep it got; a missed poke reads as the
+    /// one before it (the last one before it that was not missed).
     fn profile(&self) -> Vec<f32> {
-        self.tap_touch
+        let raw: Vec<Option<f32>> = self
+            .tap_touch
             .iter()
             .zip(&self.tap_min)
-            .map(|(touch, min)| touch.unwrap_or(if min.is_finite() { *min } else { 0.0 }))
+            .zip(self.missed())
+            .map(|((touch, min), missed)| (!missed).then(|| touch.unwrap_or(*min)))
+            .collect();
+        let Some(last) = raw.iter().rev().flatten().next() else { return vec![0.0; raw.len()] };
+        raw.iter()
+            .scan(*last, |before, r| {
+                *before = r.unwrap_or(*before);
+                Some(*before)
+            })
             .collect()
     }
 
@@ -350,12 +442,21 @@ impl Exploration {
             (false, false) => MaterialClass::SoftSmooth,
             (false, true) => MaterialClass::SoftRough,
         };
-        Findings { profile, feature_count, stiffness_n_per_m, pressure_n_per_m2, friction, material }
+        Findings {
+            profile,
+            feature_count,
+            stiffness_n_per_m,
+            pressure_n_per_m2,
+            friction,
+            material,
+            attempts: self.attempts,
+            disturbed: self.disturbed,
+        }
     }
 }
 
 /// Places `copy` on the bench of a running [`crate::haptics::Haptics`] (sim device) and explores it;
-/// gives up after a minute for the build and a minute for the exploration. Used by the tests and the
+/// gives up after a minute for the build and a minute for each exploration. Used by the tests and the
 /// `feel_copies` example; the client runs the same steps from its systems.
 pub fn feel(
     h: &mut crate::haptics::Haptics,
@@ -380,10 +481,10 @@ pub fn feel(
         h.hand.as_mut().map(|c| c.set(to_device(&map, goal))).ok_or("the device has no steerable hand")
     };
     hand(h, ex.goal())?;
-    let deadline = Instant::now() + Duration::from_secs(60);
+    let deadline = Instant::now() + Duration::from_secs(60) * ATTEMPTS;
     while !ex.done() {
         if Instant::now() > deadline {
-            return Err("the exploration did not end within a minute".into());
+            return Err(format!("the exploration did not end within {ATTEMPTS} minutes"));
         }
         std::thread::sleep(Duration::from_millis(8));
         h.poll();
@@ -432,6 +533,101 @@ pub fn to_device(map: &haptic_rig::WorkspaceMap, goal: HandGoal) -> HandGoal {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Runs an exploration of an idol on a hand that follows its goal exactly and touches nothing, with
+    /// frames every 8 ms; `tick(t_us)` says whether the haptic loop ticks at `t_us` and how old its
+    /// contact data is. Returns the findings and the stages seen, with the time each began.
+    fn run(tick: impl FnMut(u64) -> Option<u32>) -> (Findings, Vec<(Stage, u64)>) {
+        run_held(tick, |_, _| None)
+    }
+
+    /// [`run`], with the tool held at `held(stage, t_us)` instead of the goal when that says so.
+    fn run_held(
+        mut tick: impl FnMut(u64) -> Option<u32>,
+        held: impl Fn(Stage, u64) -> Option<Vec3>,
+    ) -> (Findings, Vec<(Stage, u64)>) {
+        let mut ex = Exploration::new(ArtifactKind::Idol, 0);
+        let mut stages = vec![(ex.stage, 0)];
+        let mut samples = Vec::new();
+        for frame in 1..40_000u64 {
+            let now = frame * 8_000;
+            samples.clear();
+            for t_us in (now - 8_000..now).step_by(1_000) {
+                if let Some(data_age_us) = tick(t_us) {
+                    let tool_position = held(ex.stage, t_us).unwrap_or(ex.goal().sample(t_us).translation);
+                    samples.push(ForceSample { t_us, tool_position, data_age_us, ..ForceSample::default() });
+                }
+            }
+            if ex.step(now, &samples) {
+                stages.push((ex.stage, ex.stage_start_us));
+                let (_, r_out, ..) = ring(ArtifactKind::Idol);
+                if ex.stage == Stage::Return {
+                    for dt in (0..3_000_000).step_by(100_000) {
+                        let p = ex.goal().sample(ex.stage_start_us + dt).translation;
+                        assert!((Vec3::new(p.x, 0.0, p.z).length() - r_out).abs() < 1e-4, "round the ring");
+                    }
+                }
+            }
+            if let Some(f) = ex.findings() {
+                return (f.clone(), stages);
+            }
+        }
+        panic!("the exploration never ended: {stages:?}");
+    }
+
+    #[test]
+    fn an_undisturbed_exploration_takes_one_attempt() {
+        let (findings, stages) = run(|_| Some(1_000));
+        assert_eq!((findings.attempts, findings.disturbed), (1, false));
+        assert!(!stages.iter().any(|(s, _)| *s == Stage::Retreat), "{stages:?}");
+    }
+
+    #[test]
+    fn a_stall_during_the_taps_starts_over_once_the_forces_are_whole_again() {
+        // The process is not scheduled for 1.5 s, 5 s in (during the taps).
+        let (findings, stages) = run(|t| (!(5_000_000..6_500_000).contains(&t)).then_some(1_000));
+        assert_eq!((findings.attempts, findings.disturbed), (2, false), "{stages:?}");
+        let at = |stage| stages.iter().filter(|(s, _)| *s == stage).map(|(_, t)| *t).collect::<Vec<_>>();
+        let retreat = at(Stage::Retreat);
+        assert_eq!(retreat.len(), 1, "{stages:?}");
+        assert!(retreat[0] < 6_600_000, "the disturbed attempt stops at once: {stages:?}");
+        let taps = at(Stage::Taps);
+        assert_eq!(taps.len(), 2, "{stages:?}");
+        assert!(taps[1] >= 6_500_000 + RECOVER_US, "the new taps wait for the forces: {stages:?}");
+        assert_eq!(at(Stage::Return).len(), 1, "{stages:?}");
+    }
+
+    #[test]
+    fn a_poke_the_stylus_did_not_follow_starts_over_and_in_the_last_attempt_reads_as_the_one_before() {
+        let (_, r_out, ..) = ring(ArtifactKind::Idol);
+        // The stylus stays out through the eighth poke of the first attempt (its taps start 1.01 s in).
+        let poke = 1_010_000 + (7.0 * TAP_S * 1e6) as u64..1_010_000 + (8.0 * TAP_S * 1e6) as u64;
+        let held = |stage, t| (stage == Stage::Taps && poke.contains(&t)).then_some(Vec3::new(r_out, 0.0, 0.0));
+        let (findings, stages) = run_held(|_| Some(1_000), held);
+        assert_eq!(stages.iter().filter(|(s, _)| *s == Stage::Taps).count(), 2, "{stages:?}");
+        assert_eq!((findings.attempts, findings.disturbed), (2, false), "{stages:?}");
+        // Every attempt: the last one fills the missed poke from its neighbour.
+        let mut ex = Exploration::new(ArtifactKind::Idol, 0);
+        ex.tap_min.fill(0.02);
+        ex.tap_min[7] = r_out;
+        ex.tap_min[3] = 0.025;
+        assert!(ex.missed().enumerate().all(|(k, missed)| missed == (k == 7)));
+        let profile = ex.profile();
+        assert_eq!((profile[3], profile[7], profile[8]), (0.025, 0.02, 0.02));
+        ex.tap_min[0] = r_out;
+        assert_eq!(ex.profile()[0], 0.02, "the first poke reads as the last one");
+        ex.tap_touch[5] = Some(r_out - 0.001);
+        ex.tap_touch[6] = Some(0.035);
+        let missed: Vec<usize> = ex.missed().enumerate().filter_map(|(k, m)| m.then_some(k)).collect();
+        assert_eq!(missed, [0, 5, 7], "a touch where no copy reaches is missed too");
+    }
+
+    #[test]
+    fn stale_contact_data_all_along_ends_after_the_last_attempt_marked_disturbed() {
+        let (findings, stages) = run(|_| Some(STALE_US + 1));
+        assert_eq!((findings.attempts, findings.disturbed), (ATTEMPTS, true), "{stages:?}");
+        assert!(findings.describe().contains("disturbed in all 3 explorations"), "{}", findings.describe());
+    }
 
     #[test]
     fn the_plain_part_is_the_middle_of_the_longest_low_stretch() {
