@@ -101,9 +101,10 @@ pub struct Findings {
     pub friction: f32,
     /// The material class these make.
     pub material: MaterialClass,
-    /// Explorations it took (more than one when the haptic loop was disturbed during one).
+    /// Explorations it took (more than one when an earlier one was disturbed or missed a poke).
     pub attempts: u32,
-    /// Whether the last exploration was disturbed too (after [`ATTEMPTS`]): the figures are suspect.
+    /// Whether the last exploration was disturbed or missed a poke too (after [`ATTEMPTS`]): the figures
+    /// are suspect.
     pub disturbed: bool,
 }
 
@@ -153,6 +154,13 @@ enum Stage {
     Done,
 }
 
+impl Stage {
+    /// Whether the stage measures the copy (so a disturbance during it spoils the attempt).
+    fn measures(self) -> bool {
+        matches!(self, Stage::Taps | Stage::SlideDown | Stage::SlideUp)
+    }
+}
+
 /// Mean radius and mean inward contact force over the rest at the bottom of a poke.
 #[derive(Clone, Copy, Debug, Default)]
 struct Hold {
@@ -186,7 +194,7 @@ pub struct Exploration {
     last: Option<(u64, Vec3)>,
     /// Haptic-clock time from which the forces are whole again after the last stall or stale data.
     calm_from_us: u64,
-    /// Whether this attempt measured before `calm_from_us`.
+    /// Whether this attempt measured before `calm_from_us` or missed a poke.
     disturbed: bool,
     attempts: u32,
     findings: Option<Findings>,
@@ -243,13 +251,12 @@ impl Exploration {
         for s in samples {
             self.take(s);
         }
-        let measured = matches!(self.stage, Stage::Taps | Stage::SlideDown | Stage::SlideUp);
         if self.stage == Stage::Taps && now_us >= self.stage_end_us {
             let missed = self.missed().any(|missed| missed);
             self.disturbed |= missed;
         }
         // A disturbed attempt stops at once when another is allowed; the last one runs to its end.
-        let start_over = measured && self.disturbed && self.attempts < ATTEMPTS;
+        let start_over = self.stage.measures() && self.disturbed && self.attempts < ATTEMPTS;
         if (now_us < self.stage_end_us && !start_over) || self.stage == Stage::Done {
             return false;
         }
@@ -323,8 +330,7 @@ impl Exploration {
         if stalled || s.data_age_us > STALE_US {
             self.calm_from_us = s.t_us + RECOVER_US;
         }
-        let measuring = matches!(self.stage, Stage::Taps | Stage::SlideDown | Stage::SlideUp);
-        self.disturbed |= measuring && s.t_us < self.calm_from_us;
+        self.disturbed |= self.stage.measures() && s.t_us < self.calm_from_us;
         self.last = Some((s.t_us, p));
         let touching = s.contact_force.length() > TOUCH_N;
         match self.stage {
