@@ -24,12 +24,13 @@ pub const TOOL_DIAMETER: f32 = 0.01;
 /// bunny about 10 cm.
 pub const BUNNY_SCALE: f32 = 0.01;
 
-/// The bunny shipped with the project (`shared/data/bunny.obj`), or `$COLLETTE_BUNNY` when set.
+/// The bunny shipped with the project (`assets/meshes/bunny.obj`, the Stanford bunny, public domain), or
+/// `$COLLETTE_BUNNY` when set.
 pub fn default_bunny_path() -> PathBuf {
     if let Some(p) = std::env::var_os("COLLETTE_BUNNY") {
         return PathBuf::from(p);
     }
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/bunny.obj")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/meshes/bunny.obj")
 }
 
 /// Loads the bunny from an OBJ file, scaled by [`BUNNY_SCALE`] to metres and centred on its box centre.
