@@ -14,10 +14,11 @@
 //! A hand can only judge what it felt at full force: when the haptic loop stalls (the process was not
 //! scheduled) or the contact data goes stale, the safety layer fades the forces out and back in over two
 //! seconds, the stylus sinks where a wall should have stopped it, and a narrow copy can feel like
-//! nothing at all. The stylus can also fail to follow the hand through a poke (it met nothing, yet
-//! never got in), and one such poke would read as a feature. An exploration that measured during such a
-//! spell, or missed a poke, backs off round the copy, waits until the forces are whole again and starts
-//! over, up to [`ATTEMPTS`] times; in the last one a missed poke reads as the poke before it.
+//! nothing at all. An exploration that measured during such a spell backs off round the copy, waits
+//! until the forces are whole again and starts over, up to [`ATTEMPTS`] times. A single poke can also
+//! go wrong with the forces whole: the stylus fails to follow the hand (it met nothing, yet never got
+//! in) or first touches where no copy reaches; one such poke would read as a feature (or as the only
+//! plain part to rest on), so a missed poke reads as the poke before it and is never rested on.
 
 use std::f32::consts::TAU;
 
@@ -27,6 +28,7 @@ use haptic_rig::ForceSample;
 use heist_shared::artifact::{self, ArtifactKind, Briefing, MaterialClass};
 
 use crate::device::HandGoal;
+use crate::haptics::TOOL_DIAMETER_M;
 
 /// Pokes around the copy.
 pub const TAPS: usize = 48;
@@ -101,10 +103,9 @@ pub struct Findings {
     pub friction: f32,
     /// The material class these make.
     pub material: MaterialClass,
-    /// Explorations it took (more than one when an earlier one was disturbed or missed a poke).
+    /// Explorations it took (more than one when the haptic loop was disturbed during one).
     pub attempts: u32,
-    /// Whether the last exploration was disturbed or missed a poke too (after [`ATTEMPTS`]): the figures
-    /// are suspect.
+    /// Whether the last exploration was disturbed too (after [`ATTEMPTS`]): the figures are suspect.
     pub disturbed: bool,
 }
 
@@ -194,7 +195,7 @@ pub struct Exploration {
     last: Option<(u64, Vec3)>,
     /// Haptic-clock time from which the forces are whole again after the last stall or stale data.
     calm_from_us: u64,
-    /// Whether this attempt measured before `calm_from_us` or missed a poke.
+    /// Whether this attempt measured before `calm_from_us`.
     disturbed: bool,
     attempts: u32,
     findings: Option<Findings>,
@@ -251,10 +252,6 @@ impl Exploration {
         for s in samples {
             self.take(s);
         }
-        if self.stage == Stage::Taps && now_us >= self.stage_end_us {
-            let missed = self.missed().any(|missed| missed);
-            self.disturbed |= missed;
-        }
         // A disturbed attempt stops at once when another is allowed; the last one runs to its end.
         let start_over = self.stage.measures() && self.disturbed && self.attempts < ATTEMPTS;
         if (now_us < self.stage_end_us && !start_over) || self.stage == Stage::Done {
@@ -290,7 +287,7 @@ impl Exploration {
                 self.press_angle = self.plain_angle();
                 self.press_normal = Vec3::new(self.press_angle.cos(), 0.0, -self.press_angle.sin());
                 let k = ((self.press_angle / TAU * TAPS as f32).round() as usize) % TAPS;
-                self.surface = self.tap_touch[k].unwrap_or(r_in + 0.007);
+                self.surface = self.touches()[k].unwrap_or(r_in + 0.007);
                 (Stage::Approach, line(at, axis + self.press_normal * r_out, 0.4), 0.5)
             }
             Stage::Approach => (Stage::Press, line(at, axis + self.press_normal * (self.surface - REACH_M), 0.5), 0.8),
@@ -370,15 +367,21 @@ impl Exploration {
     }
 
     /// Which pokes were missed: the stylus met nothing, yet did not get even halfway in (or nothing was
-    /// sampled while it should have been in), or it met something where no copy reaches (within 5 mm of
-    /// where the poke starts, 10 mm outside the kind's look).
+    /// sampled while it should have been in), or it met something where no copy reaches: no copy is wider
+    /// than its kind's look, so a first touch lies within the look's radius and the stylus's (2 mm spare).
     fn missed(&self) -> impl Iterator<Item = bool> + '_ {
         let (_, r_out, r_in, _) = ring(self.kind);
         let halfway = 0.5 * (r_out + r_in);
+        let reach = 0.5 * artifact::look(self.kind).size_m[0] + 0.5 * TOOL_DIAMETER_M + 0.002;
         self.tap_touch.iter().zip(&self.tap_min).map(move |(touch, min)| match touch {
-            Some(r) => *r > r_out - 0.005,
+            Some(r) => *r > reach,
             None => !min.is_finite() || *min >= halfway,
         })
+    }
+
+    /// Where each poke first touched, but for the missed ones.
+    fn touches(&self) -> Vec<Option<f32>> {
+        self.tap_touch.iter().zip(self.missed()).map(|(touch, missed)| touch.filter(|_| !missed)).collect()
     }
 
     /// The profile of the taps: where each first touched, or how deep it got; a missed poke reads as the
@@ -421,12 +424,12 @@ impl Exploration {
         // Stiffness: the median, over the pokes that met a plain part, of the force at rest over the depth
         // since first touch. Plain parts: the amphora's belly (the lower touches; its ridges are narrow
         // and give way), the idol's body and the crown's points (the higher touches).
-        let touched: Vec<f32> = self.tap_touch.iter().flatten().copied().collect();
+        let touches = self.touches();
+        let touched: Vec<f32> = touches.iter().flatten().copied().collect();
         let (lo, hi) = touched.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &r| (a.min(r), b.max(r)));
         let mid = 0.5 * (lo + hi);
         let plain = |r: f32| if self.kind == ArtifactKind::Amphora { r <= mid } else { r >= mid };
-        let rests: Vec<(f32, f32)> = self
-            .tap_touch
+        let rests: Vec<(f32, f32)> = touches
             .iter()
             .zip(&self.tap_hold)
             .filter_map(|(touch, hold)| {
@@ -604,15 +607,17 @@ mod tests {
     }
 
     #[test]
-    fn a_poke_the_stylus_did_not_follow_starts_over_and_in_the_last_attempt_reads_as_the_one_before() {
+    fn a_poke_the_stylus_did_not_follow_reads_as_the_one_before() {
         let (_, r_out, ..) = ring(ArtifactKind::Idol);
-        // The stylus stays out through the eighth poke of the first attempt (its taps start 1.01 s in).
+        // The stylus stays out through the eighth poke (the taps start 1.01 s in).
         let poke = 1_010_000 + (7.0 * TAP_S * 1e6) as u64..1_010_000 + (8.0 * TAP_S * 1e6) as u64;
         let held = |stage, t| (stage == Stage::Taps && poke.contains(&t)).then_some(Vec3::new(r_out, 0.0, 0.0));
         let (findings, stages) = run_held(|_| Some(1_000), held);
-        assert_eq!(stages.iter().filter(|(s, _)| *s == Stage::Taps).count(), 2, "{stages:?}");
-        assert_eq!((findings.attempts, findings.disturbed), (2, false), "{stages:?}");
-        // Every attempt: the last one fills the missed poke from its neighbour.
+        assert_eq!(stages.iter().filter(|(s, _)| *s == Stage::Taps).count(), 1, "{stages:?}");
+        assert_eq!((findings.attempts, findings.disturbed), (1, false), "{stages:?}");
+        assert_eq!(findings.profile[7], findings.profile[6], "{:?}", findings.profile);
+        assert!(findings.profile[7] < r_out - 0.01, "{:?}", findings.profile);
+        // A missed poke reads as the one before it, the first as the last.
         let mut ex = Exploration::new(ArtifactKind::Idol, 0);
         ex.tap_min.fill(0.02);
         ex.tap_min[7] = r_out;
@@ -622,10 +627,13 @@ mod tests {
         assert_eq!((profile[3], profile[7], profile[8]), (0.025, 0.02, 0.02));
         ex.tap_min[0] = r_out;
         assert_eq!(ex.profile()[0], 0.02, "the first poke reads as the last one");
-        ex.tap_touch[5] = Some(r_out - 0.001);
-        ex.tap_touch[6] = Some(0.035);
+        let reach = 0.5 * artifact::look(ArtifactKind::Idol).size_m[0] + 0.5 * TOOL_DIAMETER_M + 0.002;
+        ex.tap_touch[5] = Some(reach + 0.001);
+        ex.tap_touch[6] = Some(reach - 0.001);
         let missed: Vec<usize> = ex.missed().enumerate().filter_map(|(k, m)| m.then_some(k)).collect();
         assert_eq!(missed, [0, 5, 7], "a touch where no copy reaches is missed too");
+        assert_eq!((ex.touches()[5], ex.touches()[6]), (None, Some(reach - 0.001)), "never rested on");
+        assert!(r_out - 0.005 > reach + 0.001, "closer than where the poke starts");
     }
 
     #[test]
