@@ -1,40 +1,87 @@
 //! Feels every copy of each artifact for the given seeds through the real haptic loop (sim device) and
-//! prints what touch found next to the truth: the figures behind the touch bot's thresholds.
+//! prints what touch found next to the truth: the figures behind the touch bot's thresholds, and how
+//! often it misjudges a copy when felt again and again.
 //!
 //!     cargo run --release -p client_haptic --no-default-features --example feel_copies -- 3 5 7
+//!     cargo run --release -p client_haptic --no-default-features --example feel_copies -- \
+//!         --heist --kind idol --real --repeat 16 10
 
+use clap::Parser;
 use client_haptic::explore::feel;
 use client_haptic::haptics::{Haptics, HapticsSettings};
-use heist_shared::artifact::{ArtifactKind, build_mesh, generate_copies};
+use heist_shared::artifact::{ArtifactKind, build_mesh, copy_mesh_seed, generate_copies, target_seed};
 use heist_shared::protocol::{ItemId, WorkbenchCopy};
 
+#[derive(Parser)]
+struct Args {
+    /// Only this kind: crown, amphora or idol.
+    #[arg(long, value_parser = parse_kind)]
+    kind: Option<ArtifactKind>,
+    /// Only the real one of each kind.
+    #[arg(long)]
+    real: bool,
+    /// The copies of the heist with each seed on the shipped museum (as the server makes them), instead
+    /// of the copies generated from the seed itself.
+    #[arg(long)]
+    heist: bool,
+    /// Feel each copy this many times.
+    #[arg(long, default_value_t = 1)]
+    repeat: u32,
+    /// Seeds whose copies are felt.
+    #[arg(required = true)]
+    seeds: Vec<u64>,
+}
+
+fn parse_kind(s: &str) -> Result<ArtifactKind, String> {
+    ArtifactKind::ALL.into_iter().find(|k| k.name() == s).ok_or_else(|| format!("{s:?} is not crown, amphora or idol"))
+}
+
 fn main() -> anyhow::Result<()> {
-    let seeds: Vec<u64> = std::env::args().skip(1).map(|a| a.parse()).collect::<Result<_, _>>()?;
+    let args = Args::parse();
     let mut h = Haptics::start(HapticsSettings::default())?;
     std::thread::sleep(std::time::Duration::from_millis(2500));
-    println!("kind,seed,count,material,felt_count,felt_material,stiffness_n_per_m,pressure_n_per_m2,friction");
-    let mut item = 0;
-    for &seed in &seeds {
-        for kind in ArtifactKind::ALL {
-            let (copies, _) = generate_copies(kind, seed, 3);
-            for t in &copies {
-                item += 1;
-                let copy =
-                    WorkbenchCopy { item: ItemId(item), mesh: build_mesh(t, seed), material: t.material.material() };
-                let f = feel(&mut h, &copy, kind).map_err(anyhow::Error::msg)?;
-                println!(
-                    "{kind:?},{seed},{},{:?},{},{:?},{:.0},{:.0},{:.2}",
-                    t.feature_count,
-                    t.material,
-                    f.feature_count,
-                    f.material,
-                    f.stiffness_n_per_m,
-                    f.pressure_n_per_m2,
-                    f.friction
-                );
+    println!(
+        "kind,seed,count,material,felt_count,felt_material,stiffness_n_per_m,pressure_n_per_m2,friction,\
+         stroke_contact,attempts,presses,right"
+    );
+    let (mut item, mut felt, mut wrong) = (0, 0, 0);
+    for &seed in &args.seeds {
+        for kind in ArtifactKind::ALL.into_iter().filter(|k| args.kind.is_none_or(|only| only == *k)) {
+            // The shipped museum's targets are one of each kind, in this order, three copies each.
+            let target = ArtifactKind::ALL.iter().position(|k| *k == kind).unwrap_or(0);
+            let copies_seed = if args.heist { target_seed(seed, target) } else { seed };
+            let (copies, real) = generate_copies(kind, copies_seed, 3);
+            for (c, t) in copies.iter().enumerate().filter(|(c, _)| !args.real || *c == real) {
+                let mesh = build_mesh(t, if args.heist { copy_mesh_seed(copies_seed, c) } else { seed });
+                for _ in 0..args.repeat {
+                    item += 1;
+                    let copy =
+                        WorkbenchCopy { item: ItemId(item), mesh: mesh.clone(), material: t.material.material() };
+                    let f = feel(&mut h, &copy, kind).map_err(anyhow::Error::msg)?;
+                    let right = f.feature_count == t.feature_count && f.material == t.material;
+                    (felt, wrong) = (felt + 1, wrong + u32::from(!right));
+                    if !right || f.presses > 1 || f.attempts > 1 {
+                        let mm: Vec<String> = f.profile.iter().map(|r| format!("{:.1}", r * 1e3)).collect();
+                        eprintln!("{kind:?} seed {seed}: {}; profile (mm) {}", f.describe(), mm.join(" "));
+                    }
+                    println!(
+                        "{kind:?},{seed},{},{:?},{},{:?},{:.0},{:.0},{:.2},{:.2},{},{},{right}",
+                        t.feature_count,
+                        t.material,
+                        f.feature_count,
+                        f.material,
+                        f.stiffness_n_per_m,
+                        f.pressure_n_per_m2,
+                        f.friction,
+                        f.stroke_contact,
+                        f.attempts,
+                        f.presses,
+                    );
+                }
             }
         }
     }
     h.stop();
+    eprintln!("{wrong} of {felt} explorations misjudged their copy");
     Ok(())
 }

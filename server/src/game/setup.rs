@@ -35,11 +35,11 @@ pub(super) fn new_game(level: Level, options: &GameOptions) -> Game {
     let mut copies = Vec::new();
     let mut targets = Vec::new();
     for (t, spec) in level.targets.iter().enumerate() {
-        let target_seed = options.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15).wrapping_add(t as u64);
+        let target_seed = artifact::target_seed(options.seed, t);
         let (traits, real_index) = artifact::generate_copies(spec.kind, target_seed, spec.copies);
         targets.push(Target { kind: spec.kind, briefing: artifact::briefing(&traits[real_index]), secured: false });
         for (c, tr) in traits.into_iter().enumerate() {
-            let mesh = artifact::build_mesh(&tr, target_seed.wrapping_add(c as u64 * 7919));
+            let mesh = artifact::build_mesh(&tr, artifact::copy_mesh_seed(target_seed, c));
             let material = tr.material.material();
             let kind = ItemKind::Copy { artifact: spec.kind, look: artifact::look(spec.kind) };
             copies.push((kind, CopyTruth { target: t, traits: tr, real: c == real_index, mesh, material }));

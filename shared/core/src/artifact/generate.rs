@@ -20,6 +20,17 @@ enum Forgery {
     Both,
 }
 
+/// The seed of a heist's `target`-th target (in the level's order): its copies' traits come from
+/// [`generate_copies`] with it, and their meshes from [`copy_mesh_seed`].
+pub fn target_seed(heist_seed: u64, target: usize) -> u64 {
+    heist_seed.wrapping_mul(0x9E37_79B9_7F4A_7C15).wrapping_add(target as u64)
+}
+
+/// The seed of the mesh of a target's `copy`-th copy (in [`generate_copies`]'s order).
+pub fn copy_mesh_seed(target_seed: u64, copy: usize) -> u64 {
+    target_seed.wrapping_add(copy as u64 * 7919)
+}
+
 /// Generates the traits of `count` copies and the index of the real one; deterministic for a seed.
 ///
 /// `count` is raised to [`MIN_COPIES`] if smaller. Every fake differs from the real copy in its feature count, its material or both; the
