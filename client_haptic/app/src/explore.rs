@@ -9,7 +9,9 @@
 //!    Each poke that met the surface also rests there: the force over the depth since first touch,
 //!    median over the pokes, gives the stiffness;
 //! 2. a light press on a plain part and a stroke down and up: the drag against the motion over the
-//!    normal force gives the friction.
+//!    normal force gives the friction. A stroke that was mostly out of touch (the press met nothing)
+//!    says nothing about the friction: the hand backs off and presses again, a little deeper, up to
+//!    [`ATTEMPTS`] times.
 //!
 //! A hand can only judge what it felt at full force: when the haptic loop stalls (the process was not
 //! scheduled) or the contact data goes stale, the safety layer fades the forces out and back in over two
@@ -30,8 +32,16 @@ use heist_shared::artifact::{self, ArtifactKind, Briefing, MaterialClass};
 use crate::device::HandGoal;
 use crate::haptics::TOOL_DIAMETER_M;
 
-/// Pokes around the copy.
+/// Pokes around a crown or an amphora.
 pub const TAPS: usize = 48;
+/// Pokes around an idol: its V notches are narrow at the depth the stylus reaches, and with 48 pokes
+/// (4.7 mm apart) one whose bottom fell between two pokes read shallow; 96 pokes take 19 s longer.
+pub const IDOL_TAPS: usize = 96;
+
+/// Pokes around a copy of `kind`.
+pub fn taps(kind: ArtifactKind) -> usize {
+    if kind == ArtifactKind::Idol { IDOL_TAPS } else { TAPS }
+}
 /// Seconds per poke.
 pub const TAP_S: f32 = 0.4;
 /// Friction above which a copy feels rough (briefed: smooth 0.1, rough 0.6; felt through the packed
@@ -71,6 +81,13 @@ const TOUCH_N: f32 = 0.05;
 const REACH_M: f32 = 0.003;
 /// Length of the strokes down and up, m.
 const SLIDE_M: f32 = 0.012;
+/// How much deeper each press after one that met nothing reaches, m.
+const DEEPER_M: f32 = 0.002;
+/// A touch this much farther out than an idol's median touch is not on the idol, m (its body's touches
+/// spread by about ±1 mm).
+const SPIKE_M: f32 = 0.0025;
+/// Pokes either side of the press's angle whose touches give the surface pressed.
+const PRESS_SPAN: usize = 2;
 
 /// Where a kind's features are, from its public look: (height of the ring of pokes, outer radius, inner
 /// radius, height of the plain part for the press), metres in the workbench frame.
@@ -105,6 +122,10 @@ pub struct Findings {
     pub material: MaterialClass,
     /// Explorations it took (more than one when the haptic loop was disturbed during one).
     pub attempts: u32,
+    /// Presses in the last exploration (more than one when a stroke was mostly out of touch).
+    pub presses: u32,
+    /// Share of the last stroke's sliding samples that were in touch, 0–1.
+    pub stroke_contact: f32,
     /// Whether the last exploration was disturbed too (after [`ATTEMPTS`]): the figures are suspect.
     pub disturbed: bool,
 }
@@ -122,12 +143,17 @@ impl Findings {
             (1, false) => String::new(),
             (n, false) => format!(" ({n} explorations: the earlier ones were disturbed)"),
         };
+        let presses = match self.presses {
+            0 | 1 => String::new(),
+            n => format!(" ({n} presses: the earlier strokes met nothing)"),
+        };
         format!(
-            "{} features, stiffness {:.0} N/m ({:.0} kN/m²), friction {:.2}: {}{attempts}",
+            "{} features, stiffness {:.0} N/m ({:.0} kN/m²), friction {:.2} ({:.0} % of the stroke in touch): {}{attempts}{presses}",
             self.feature_count,
             self.stiffness_n_per_m,
             self.pressure_n_per_m2 / 1000.0,
             self.friction,
+            100.0 * self.stroke_contact,
             self.material.adjective()
         )
     }
@@ -192,6 +218,9 @@ pub struct Exploration {
     press_normal: Vec3,
     surface: f32,
     slide: (f32, f32),
+    /// Sliding samples of this stroke: all of them, and those in touch.
+    stroke: (u32, u32),
+    presses: u32,
     last: Option<(u64, Vec3)>,
     /// Haptic-clock time from which the forces are whole again after the last stall or stale data.
     calm_from_us: u64,
@@ -217,13 +246,15 @@ impl Exploration {
             stage_start_us: now_us,
             stage_end_us: now_us + 1_000_000,
             taps_start_us: 0,
-            tap_touch: vec![None; TAPS],
-            tap_min: vec![f32::INFINITY; TAPS],
-            tap_hold: vec![Hold::default(); TAPS],
+            tap_touch: vec![None; taps(kind)],
+            tap_min: vec![f32::INFINITY; taps(kind)],
+            tap_hold: vec![Hold::default(); taps(kind)],
             press_angle: 0.0,
             press_normal: Vec3::X,
             surface: 0.0,
             slide: (0.0, 0.0),
+            stroke: (0, 0),
+            presses: 1,
             last: None,
             calm_from_us: 0,
             disturbed: false,
@@ -280,19 +311,37 @@ impl Exploration {
             }
             Stage::Settle | Stage::Return => {
                 self.restart_taps(start);
-                let taps = HandGoal::Taps { centre, r_out, r_in, n: TAPS as u32, tap_s: TAP_S, start_us: start };
-                (Stage::Taps, taps, TAPS as f32 * TAP_S + 0.05)
+                let n = taps(self.kind);
+                let goal = HandGoal::Taps { centre, r_out, r_in, n: n as u32, tap_s: TAP_S, start_us: start };
+                (Stage::Taps, goal, n as f32 * TAP_S + 0.05)
             }
             Stage::Taps => {
                 self.press_angle = self.plain_angle();
                 self.press_normal = Vec3::new(self.press_angle.cos(), 0.0, -self.press_angle.sin());
-                let k = ((self.press_angle / TAU * TAPS as f32).round() as usize) % TAPS;
-                self.surface = self.touches()[k].unwrap_or(r_in + 0.007);
+                let n = taps(self.kind);
+                let k = ((self.press_angle / TAU * n as f32).round() as usize) % n;
+                // Where the pokes there first touched (the median of the nearest, so one that went wrong
+                // does not decide); where none touched, a little outside the pokes' reach.
+                let touches = self.touches();
+                let near = (n + k - PRESS_SPAN..=n + k + PRESS_SPAN).filter_map(|i| touches[i % n]).collect();
+                self.surface = median(near).unwrap_or(r_in + 0.007);
                 (Stage::Approach, line(at, axis + self.press_normal * r_out, 0.4), 0.5)
             }
-            Stage::Approach => (Stage::Press, line(at, axis + self.press_normal * (self.surface - REACH_M), 0.5), 0.8),
-            Stage::Press => (Stage::SlideDown, line(at, at - Vec3::Y * SLIDE_M, 0.5), 0.55),
+            Stage::Approach => {
+                let reach = REACH_M + DEEPER_M * (self.presses - 1) as f32;
+                (Stage::Press, line(at, axis + self.press_normal * (self.surface - reach), 0.5), 0.8)
+            }
+            Stage::Press => {
+                self.slide = (0.0, 0.0);
+                self.stroke = (0, 0);
+                (Stage::SlideDown, line(at, at - Vec3::Y * SLIDE_M, 0.5), 0.55)
+            }
             Stage::SlideDown => (Stage::SlideUp, line(at, at + Vec3::Y * SLIDE_M, 0.5), 0.55),
+            Stage::SlideUp if self.stroke_missed() && self.presses < ATTEMPTS => {
+                // The press met nothing: back off and press again, deeper.
+                self.presses += 1;
+                (Stage::Approach, line(at, axis + self.press_normal * r_out, 0.4), 0.5)
+            }
             Stage::SlideUp => {
                 self.findings = Some(self.conclude());
                 (Stage::Done, line(at, axis + self.press_normal * (r_out + 0.02), 0.4), 0.4)
@@ -313,7 +362,14 @@ impl Exploration {
         self.tap_min.fill(f32::INFINITY);
         self.tap_hold.fill(Hold::default());
         self.slide = (0.0, 0.0);
+        self.stroke = (0, 0);
+        self.presses = 1;
         self.disturbed = false;
+    }
+
+    /// Whether the stroke was mostly out of touch (or never slid): it says nothing about the friction.
+    fn stroke_missed(&self) -> bool {
+        2 * self.stroke.1 < self.stroke.0 || self.stroke.0 == 0
     }
 
     fn take(&mut self, s: &ForceSample) {
@@ -334,7 +390,7 @@ impl Exploration {
             Stage::Taps => {
                 let since = s.t_us.saturating_sub(self.taps_start_us) as f32 * 1e-6 / TAP_S;
                 let (k, u) = (since.floor() as usize, since.fract());
-                if k >= TAPS || s.t_us < self.taps_start_us {
+                if k >= self.tap_touch.len() || s.t_us < self.taps_start_us {
                     return;
                 }
                 // Where the stylus first met the surface on the way in; how deep it got where it met none.
@@ -357,9 +413,13 @@ impl Exploration {
                 let normal = s.contact_force.dot(self.press_normal);
                 // Only while really sliding: friction opposes the vertical motion. Summed over both strokes,
                 // the packing's bumps push as much with the motion as against it and cancel.
-                if normal > TOUCH_N && velocity.y.abs() > 0.005 {
-                    self.slide.0 += -s.contact_force.y * velocity.y.signum();
-                    self.slide.1 += normal;
+                if velocity.y.abs() > 0.005 {
+                    self.stroke.0 += 1;
+                    if normal > TOUCH_N {
+                        self.stroke.1 += 1;
+                        self.slide.0 += -s.contact_force.y * velocity.y.signum();
+                        self.slide.1 += normal;
+                    }
                 }
             }
             _ => {}
@@ -369,10 +429,16 @@ impl Exploration {
     /// Which pokes were missed: the stylus met nothing, yet did not get even halfway in (or nothing was
     /// sampled while it should have been in), or it met something where no copy reaches: no copy is wider
     /// than its kind's look, so a first touch lies within the look's radius and the stylus's (2 mm spare).
+    /// Nothing on an idol stands out from its body (its features are notches), so there a touch more than
+    /// [`SPIKE_M`] farther out than the median touch is missed too.
     fn missed(&self) -> impl Iterator<Item = bool> + '_ {
         let (_, r_out, r_in, _) = ring(self.kind);
         let halfway = 0.5 * (r_out + r_in);
-        let reach = 0.5 * artifact::look(self.kind).size_m[0] + 0.5 * TOOL_DIAMETER_M + 0.002;
+        let mut reach = 0.5 * artifact::look(self.kind).size_m[0] + 0.5 * TOOL_DIAMETER_M + 0.002;
+        if self.kind == ArtifactKind::Idol {
+            let within = self.tap_touch.iter().flatten().copied().filter(|r| *r <= reach).collect();
+            reach = reach.min(median(within).map_or(f32::INFINITY, |body| body + SPIKE_M));
+        }
         self.tap_touch.iter().zip(&self.tap_min).map(move |(touch, min)| match touch {
             Some(r) => *r > reach,
             None => !min.is_finite() || *min >= halfway,
@@ -412,14 +478,14 @@ impl Exploration {
             ArtifactKind::Amphora => lowest_run_middle(&profile),
             ArtifactKind::Idol => lowest_run_middle(&profile.iter().map(|r| -r).collect::<Vec<_>>()),
         };
-        TAU * pick as f32 / TAPS as f32
+        TAU * pick as f32 / profile.len() as f32
     }
 
     fn conclude(&self) -> Findings {
         let profile = self.profile();
         let feature_count = match self.kind {
             ArtifactKind::Crown | ArtifactKind::Amphora => artifact::count_high_runs(&profile),
-            ArtifactKind::Idol => artifact::count_high_runs(&profile.iter().map(|r| -r).collect::<Vec<_>>()),
+            ArtifactKind::Idol => count_notches(&profile),
         };
         // Stiffness: the median, over the pokes that met a plain part, of the force at rest over the depth
         // since first touch. Plain parts: the amphora's belly (the lower touches; its ridges are narrow
@@ -459,6 +525,8 @@ impl Exploration {
             friction,
             material,
             attempts: self.attempts,
+            presses: self.presses,
+            stroke_contact: if self.stroke.0 > 0 { self.stroke.1 as f32 / self.stroke.0 as f32 } else { 0.0 },
             disturbed: self.disturbed,
         }
     }
@@ -505,6 +573,46 @@ pub fn feel(
     ex.findings().cloned().ok_or_else(|| "no findings".into())
 }
 
+/// The median of `v` (the upper one of an even count), if any.
+fn median(mut v: Vec<f32>) -> Option<f32> {
+    v.sort_by(f32::total_cmp);
+    v.get(v.len() / 2).copied()
+}
+
+/// Notches in an idol's circular profile of [`IDOL_TAPS`] pokes, measured from its body (the median:
+/// notches are under half the circle) rather than from its widest touch. A notch spans four pokes or
+/// more; a single poke that touched too early or too late (seen 3.6 mm below the body and 2 mm above,
+/// between pokes that read the body) is no notch, so each poke reads as the median of itself and its two
+/// neighbours. A notch starts 30 % of the way from the body down to the deepest poke and ends 15 % of the
+/// way (hysteresis); a profile varying less than [`artifact::MIN_FEATURE_SIZE_M`] has none.
+fn count_notches(profile: &[f32]) -> u32 {
+    let n = profile.len();
+    let profile: Vec<f32> = (0..n)
+        .map(|i| median(vec![profile[(i + n - 1) % n], profile[i], profile[(i + 1) % n]]).unwrap_or(0.0))
+        .collect();
+    let (Some(body), Some(start)) =
+        (median(profile.clone()), profile.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1)).map(|(i, _)| i))
+    else {
+        return 0;
+    };
+    let deepest = profile.iter().copied().fold(f32::INFINITY, f32::min);
+    if body - deepest < artifact::MIN_FEATURE_SIZE_M {
+        return 0;
+    }
+    let (enter, leave) = (body - 0.3 * (body - deepest), body - 0.15 * (body - deepest));
+    let (mut inside, mut notches) = (false, 0);
+    // Starting at the widest poke, the circle begins and ends outside a notch: none is cut in two.
+    for i in 0..profile.len() {
+        let r = profile[(start + i) % profile.len()];
+        if !inside && r < enter {
+            (inside, notches) = (true, notches + 1);
+        } else if inside && r > leave {
+            inside = false;
+        }
+    }
+    notches
+}
+
 /// Index at the middle of the longest stretch within 25 % of the profile's minimum.
 fn lowest_run_middle(profile: &[f32]) -> usize {
     let n = profile.len();
@@ -543,18 +651,32 @@ pub fn to_device(map: &haptic_rig::WorkspaceMap, goal: HandGoal) -> HandGoal {
 mod tests {
     use super::*;
 
-    /// Runs an exploration of an idol on a hand that follows its goal exactly and touches nothing, with
-    /// frames every 8 ms; `tick(t_us)` says whether the haptic loop ticks at `t_us` and how old its
-    /// contact data is. Returns the findings and the stages seen, with the time each began.
-    fn run(tick: impl FnMut(u64) -> Option<u32>) -> (Findings, Vec<(Stage, u64)>) {
-        run_held(tick, |_, _| None)
+    /// Radius of the frictionless vertical cylinder the tests' idol is, m: the look's.
+    fn body_radius() -> f32 {
+        0.5 * artifact::look(ArtifactKind::Idol).size_m[0]
     }
 
-    /// [`run`], with the tool held at `held(stage, t_us)` instead of the goal when that says so.
+    /// Depth of the tests' idol's one notch, 5 mm deep, in the 9 pokes 20–28 (round π), m.
+    fn notch(p: Vec3) -> f32 {
+        let angle = (-p.z).atan2(p.x).rem_euclid(TAU);
+        if (angle - std::f32::consts::PI).abs() < 0.55 { 0.005 } else { 0.0 }
+    }
+
+    /// Runs an exploration of an idol (a cylinder of [`body_radius`] with a [`notch`], 200 N/m) on a hand that follows
+    /// its goal exactly, with frames every 8 ms; `tick(t_us)` says whether the haptic loop ticks at
+    /// `t_us` and how old its contact data is. Returns the findings and the stages seen, with the time
+    /// each began.
+    fn run(tick: impl FnMut(u64) -> Option<u32>) -> (Findings, Vec<(Stage, u64)>) {
+        let (findings, stages, _) = run_held(tick, |_, _| None);
+        (findings, stages)
+    }
+
+    /// [`run`], with the tool held at `held(exploration, t_us)` instead of the goal when that says so;
+    /// also returns the exploration.
     fn run_held(
         mut tick: impl FnMut(u64) -> Option<u32>,
-        held: impl Fn(Stage, u64) -> Option<Vec3>,
-    ) -> (Findings, Vec<(Stage, u64)>) {
+        held: impl Fn(&Exploration, u64) -> Option<Vec3>,
+    ) -> (Findings, Vec<(Stage, u64)>, Exploration) {
         let mut ex = Exploration::new(ArtifactKind::Idol, 0);
         let mut stages = vec![(ex.stage, 0)];
         let mut samples = Vec::new();
@@ -563,8 +685,17 @@ mod tests {
             samples.clear();
             for t_us in (now - 8_000..now).step_by(1_000) {
                 if let Some(data_age_us) = tick(t_us) {
-                    let tool_position = held(ex.stage, t_us).unwrap_or(ex.goal().sample(t_us).translation);
-                    samples.push(ForceSample { t_us, tool_position, data_age_us, ..ForceSample::default() });
+                    let tool_position = held(&ex, t_us).unwrap_or(ex.goal().sample(t_us).translation);
+                    let out = Vec3::new(tool_position.x, 0.0, tool_position.z);
+                    let depth = (body_radius() - notch(out) - out.length()).max(0.0);
+                    let contact_force = out.normalize_or_zero() * 200.0 * depth;
+                    samples.push(ForceSample {
+                        t_us,
+                        tool_position,
+                        contact_force,
+                        data_age_us,
+                        ..ForceSample::default()
+                    });
                 }
             }
             if ex.step(now, &samples) {
@@ -578,17 +709,75 @@ mod tests {
                 }
             }
             if let Some(f) = ex.findings() {
-                return (f.clone(), stages);
+                return (f.clone(), stages, ex);
             }
         }
         panic!("the exploration never ended: {stages:?}");
     }
 
     #[test]
-    fn an_undisturbed_exploration_takes_one_attempt() {
+    fn an_undisturbed_exploration_takes_one_attempt_and_one_press() {
         let (findings, stages) = run(|_| Some(1_000));
-        assert_eq!((findings.attempts, findings.disturbed), (1, false));
+        assert_eq!((findings.attempts, findings.disturbed, findings.presses), (1, false, 1), "{stages:?}");
         assert!(!stages.iter().any(|(s, _)| *s == Stage::Retreat), "{stages:?}");
+        assert!(findings.stroke_contact > 0.9, "{findings:?}");
+        let r = body_radius();
+        let (body, notch) = (r - 0.001..r, r - 0.006..r - 0.005);
+        let at = |k: usize| {
+            let phi = TAU * k as f32 / IDOL_TAPS as f32;
+            Vec3::new(phi.cos(), 0.0, -phi.sin())
+        };
+        let felt = |k: usize| if super::tests::notch(at(k)) > 0.0 { notch.clone() } else { body.clone() };
+        assert!(findings.profile.iter().enumerate().all(|(k, p)| felt(k).contains(p)), "{findings:?}");
+        assert_eq!(findings.feature_count, 1, "{findings:?}");
+        assert!(findings.stiffness_n_per_m > 150.0 && findings.stiffness_n_per_m < 250.0, "{findings:?}");
+    }
+
+    #[test]
+    fn a_stroke_that_met_nothing_is_pressed_again_deeper() {
+        let (_, r_out, ..) = ring(ArtifactKind::Idol);
+        let radial = |p: Vec3| Vec3::new(p.x, 0.0, p.z).length();
+        // The stylus stays out through the first stroke; how deep each press reaches for is noted.
+        let deepest = std::cell::RefCell::new([f32::INFINITY; ATTEMPTS as usize]);
+        let held = |ex: &Exploration, t| {
+            if ex.stage == Stage::Press {
+                let d = &mut deepest.borrow_mut()[ex.presses as usize - 1];
+                *d = d.min(radial(ex.goal.sample(t).translation));
+            }
+            (matches!(ex.stage, Stage::SlideDown | Stage::SlideUp) && ex.presses == 1)
+                .then_some(Vec3::new(r_out, 0.0, 0.0))
+        };
+        let (findings, stages, ex) = run_held(|_| Some(1_000), held);
+        let deepest = deepest.into_inner();
+        assert!((deepest[0] - (ex.surface - REACH_M)).abs() < 1e-4, "{deepest:?}");
+        assert!((deepest[0] - deepest[1] - DEEPER_M).abs() < 1e-4, "the second press reaches 2 mm deeper: {deepest:?}");
+        assert_eq!(findings.presses, 2, "{stages:?}");
+        assert_eq!(stages.iter().filter(|(s, _)| *s == Stage::Press).count(), 2, "{stages:?}");
+        assert!(findings.stroke_contact > 0.9, "the second stroke touched: {findings:?}");
+        assert!(findings.describe().contains("2 presses"), "{}", findings.describe());
+        let press = ex.goal.sample(u64::MAX);
+        assert!(radial(press.translation) > r_out, "backed out at the end: {press:?}");
+        assert!((ex.surface - body_radius()).abs() < 0.001, "the surface where the cylinder is: {}", ex.surface);
+        // A stroke that never meets anything ends after the last press, friction unknown (0).
+        let never = |ex: &Exploration, _| {
+            matches!(ex.stage, Stage::SlideDown | Stage::SlideUp).then_some(Vec3::new(r_out, 0.0, 0.0))
+        };
+        let (findings, stages, _) = run_held(|_| Some(1_000), never);
+        assert_eq!((findings.presses, findings.stroke_contact, findings.friction), (ATTEMPTS, 0.0, 0.0), "{stages:?}");
+    }
+
+    #[test]
+    fn a_missed_poke_where_the_press_goes_takes_the_surface_from_the_poke_before() {
+        let (_, r_out, ..) = ring(ArtifactKind::Idol);
+        // The press goes to the first poke's angle, opposite the notch; the stylus stays out through
+        // that poke (the taps start 1.01 s in).
+        let poke = 1_010_000..1_010_000 + (TAP_S * 1e6) as u64;
+        let held =
+            |ex: &Exploration, t| (ex.stage == Stage::Taps && poke.contains(&t)).then_some(Vec3::new(r_out, 0.0, 0.0));
+        let (findings, _, ex) = run_held(|_| Some(1_000), held);
+        assert!(ex.touches()[0].is_none() && ex.press_angle == 0.0, "{findings:?}");
+        assert!((ex.surface - body_radius()).abs() < 0.001, "the surface where the cylinder is: {}", ex.surface);
+        assert_eq!(findings.presses, 1);
     }
 
     #[test]
@@ -611,8 +800,9 @@ mod tests {
         let (_, r_out, ..) = ring(ArtifactKind::Idol);
         // The stylus stays out through the eighth poke (the taps start 1.01 s in).
         let poke = 1_010_000 + (7.0 * TAP_S * 1e6) as u64..1_010_000 + (8.0 * TAP_S * 1e6) as u64;
-        let held = |stage, t| (stage == Stage::Taps && poke.contains(&t)).then_some(Vec3::new(r_out, 0.0, 0.0));
-        let (findings, stages) = run_held(|_| Some(1_000), held);
+        let held =
+            |ex: &Exploration, t| (ex.stage == Stage::Taps && poke.contains(&t)).then_some(Vec3::new(r_out, 0.0, 0.0));
+        let (findings, stages, _) = run_held(|_| Some(1_000), held);
         assert_eq!(stages.iter().filter(|(s, _)| *s == Stage::Taps).count(), 1, "{stages:?}");
         assert_eq!((findings.attempts, findings.disturbed), (1, false), "{stages:?}");
         assert_eq!(findings.profile[7], findings.profile[6], "{:?}", findings.profile);
@@ -641,6 +831,65 @@ mod tests {
         let (findings, stages) = run(|_| Some(STALE_US + 1));
         assert_eq!((findings.attempts, findings.disturbed), (ATTEMPTS, true), "{stages:?}");
         assert!(findings.describe().contains("disturbed in all 3 explorations"), "{}", findings.describe());
+    }
+
+    #[test]
+    fn touches_where_nothing_is_on_an_idol_are_missed_and_the_press_goes_to_its_body() {
+        // Profiles (mm) of the real idol of seed 10's heist, felt with 48 pokes by the feel_copies
+        // example, which read 3, 3, 1 and 3 notches of its 4: touches where nothing is (40.3 mm, 44.4 mm),
+        // and a narrow notch read shallow (pokes 42–44; 30–32 in the last: hence 96 pokes for an idol).
+        let felt = [
+            "36.8 37.0 36.2 36.6 37.1 36.2 31.9 29.0 33.2 35.6 35.4 35.4 35.4 35.8 35.8 36.1 35.5 36.4 33.8 29.4 30.5 36.6 \
+             37.0 35.6 37.0 36.8 36.8 37.2 37.2 35.8 33.4 28.8 34.0 36.0 36.2 35.9 36.2 36.2 36.6 36.8 36.5 36.1 34.4 34.4 \
+             32.2 37.0 37.1 37.1",
+            "36.6 36.8 35.8 36.6 36.5 36.1 31.3 29.0 33.2 35.6 35.1 35.2 35.6 35.6 35.8 36.1 35.3 36.2 33.6 29.3 30.4 36.6 \
+             37.1 35.7 36.9 36.7 36.7 36.7 36.9 36.4 33.4 28.8 34.0 36.2 35.9 35.8 36.3 36.4 40.3 36.8 36.5 36.0 34.4 29.7 \
+             32.3 37.0 37.2 37.0",
+            "36.5 37.1 36.6 36.6 37.1 36.1 31.9 29.0 33.2 35.6 35.4 35.6 35.6 35.8 35.8 36.1 35.6 36.4 33.8 29.4 30.6 36.7 \
+             37.3 35.7 37.1 36.8 36.8 37.1 37.1 36.3 33.5 28.9 34.1 36.1 44.4 35.9 36.3 36.3 36.5 36.9 36.5 36.2 34.4 29.6 \
+             32.3 36.9 37.2 37.0",
+            "36.6 37.4 36.2 36.6 37.0 36.2 31.9 29.0 32.8 35.6 35.4 35.7 35.4 34.9 35.6 36.2 35.4 36.3 33.1 29.4 30.5 36.2 \
+             37.4 35.6 37.2 36.8 36.8 37.2 37.1 36.4 33.5 33.5 34.2 36.2 36.4 35.9 36.4 36.4 36.8 36.6 36.2 36.3 34.3 29.7 \
+             32.2 37.0 37.1 37.1",
+        ];
+        for (i, profile) in felt.iter().enumerate() {
+            let mut ex = Exploration::new(ArtifactKind::Idol, 0);
+            let mm: Vec<f32> = profile.split_whitespace().map(|v| v.parse::<f32>().unwrap() * 1e-3).collect();
+            assert_eq!(mm.len(), 48);
+            (ex.tap_touch, ex.tap_min) = (vec![None; 48], vec![f32::INFINITY; 48]);
+            for (touch, r) in ex.tap_touch.iter_mut().zip(mm) {
+                *touch = Some(r);
+            }
+            let spikes: Vec<usize> = ex.missed().enumerate().filter_map(|(k, m)| m.then_some(k)).collect();
+            assert_eq!(spikes, [vec![], vec![38], vec![34], vec![]][i], "profile {i}");
+            // The press goes to the body, between notches.
+            let k = (ex.plain_angle() / TAU * 48.0).round() as usize % 48;
+            assert!(ex.profile()[k] > 0.035, "profile {i}: poke {k}");
+        }
+    }
+
+    #[test]
+    fn notches_are_counted_from_the_body_and_a_lone_poke_off_it_is_none() {
+        // Four V notches read 4–7 pokes deep, one read shallow (its bottom between two pokes), on a body
+        // of 36 ± 0.6 mm with one poke 3.6 mm in and one 2 mm out, as felt on seed 10's idol.
+        let mut mm: Vec<f32> = (0..IDOL_TAPS).map(|k| if k % 2 == 0 { 36.6 } else { 35.4 }).collect();
+        for (start, depths) in [
+            (10, &[1.0, 3.0, 5.0, 7.2, 5.0, 3.0, 1.0][..]),
+            (34, &[1.5, 4.0, 6.8, 4.0, 1.5][..]),
+            (58, &[1.0, 2.0, 2.7, 2.7, 2.0, 1.0][..]),
+            (80, &[2.0, 5.0, 7.0, 5.0, 2.0][..]),
+        ] {
+            for (k, d) in depths.iter().enumerate() {
+                mm[start + k] = 36.0 - d;
+            }
+        }
+        mm[25] = 32.4;
+        mm[70] = 38.0;
+        let profile: Vec<f32> = mm.iter().map(|v| v * 1e-3).collect();
+        assert_eq!(count_notches(&profile), 4, "{mm:?}");
+        let whole_range = artifact::count_high_runs(&profile.iter().map(|r| -r).collect::<Vec<_>>());
+        assert_eq!(whole_range, 3, "35 % of the whole range misses the shallow notch");
+        assert_eq!(count_notches(&[0.03; 12]), 0, "a round body has none");
     }
 
     #[test]
