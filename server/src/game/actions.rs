@@ -60,7 +60,8 @@ impl Game {
                 Ok(())
             }
             PhantomMsg::Warn(kind) => {
-                self.outgoing.push(Outgoing::To(Role::Vive, ServerMsg::Event(GameEvent::Warning(kind))));
+                // To Vive, and back to Phantom as the confirmation that it went out.
+                self.outgoing.push(Outgoing::All(ServerMsg::Event(GameEvent::Warning(kind))));
                 Ok(())
             }
         }

@@ -332,3 +332,16 @@ fn only_phantom_moves_the_tool() {
     g.apply(Role::Phantom, &ClientMsg::Phantom(pose)).unwrap();
     assert_eq!(g.tool.position, glam::Vec3::new(0.1, 0.2, 0.3));
 }
+
+#[test]
+fn a_warning_reaches_vive_and_phantom_hears_it_went_out() {
+    use heist_shared::protocol::WarningKind;
+    let mut g = started(3);
+    g.drain_outgoing().for_each(drop);
+    g.apply(Role::Phantom, &ClientMsg::Phantom(PhantomMsg::Warn(WarningKind::Hide))).unwrap();
+    let sent: Vec<Outgoing> = g.drain_outgoing().collect();
+    assert!(
+        matches!(sent[..], [Outgoing::All(ServerMsg::Event(GameEvent::Warning(WarningKind::Hide)))]),
+        "one message, to both players: {sent:?}"
+    );
+}
