@@ -175,7 +175,7 @@ pub fn app(
     let mut app = App::new();
     if headless {
         app.add_plugins(MinimalPlugins.set(ScheduleRunnerPlugin::run_loop(Duration::from_secs_f64(1.0 / TICK_HZ))))
-            .add_plugins(bevy::log::LogPlugin::default());
+            .add_plugins(quiet_log());
     } else {
         #[cfg(feature = "spectator")]
         crate::spectator::add_window_plugins(&mut app);
@@ -204,18 +204,41 @@ pub fn app(
     Ok(app)
 }
 
-/// Quits a few seconds after the last practice copy was judged.
+/// The log of `--headless` play: the terminal is the screen reader's, so stdout carries only what is
+/// spoken, and the log (stderr) only warnings and errors unless `RUST_LOG` asks for more; no colour codes
+/// when stderr is not a terminal.
+fn quiet_log() -> bevy::log::LogPlugin {
+    bevy::log::LogPlugin {
+        level: bevy::log::Level::WARN,
+        fmt_layer: |_| {
+            use std::io::IsTerminal as _;
+            let layer = bevy::log::tracing_subscriber::fmt::Layer::default()
+                .with_writer(std::io::stderr)
+                .with_ansi(std::io::stderr().is_terminal());
+            Some(Box::new(layer))
+        },
+        ..default()
+    }
+}
+
+/// Says how the practice went once the last verdict's answer was said, and quits a few seconds later.
 fn quit_when_practice_is_over(
     p: Res<crate::practice::Practice>,
     time: Res<Time<Real>>,
     mut done_at: Local<Option<f32>>,
+    mut told: Local<bool>,
+    mut speaker: NonSendMut<crate::speech::Speaker>,
     mut exit: MessageWriter<AppExit>,
 ) {
     let now = time.elapsed_secs();
     if p.finished() && done_at.is_none() {
         *done_at = Some(now);
     }
-    if done_at.is_some_and(|t| now - t > 4.0) {
+    if done_at.is_some_and(|t| now - t > 0.5) && !*told {
+        *told = true;
+        speaker.say(format!("Practice over: {} right, {} wrong.", p.right, p.wrong));
+    }
+    if done_at.is_some_and(|t| now - t > 4.5) {
         exit.write(AppExit::Success);
     }
 }

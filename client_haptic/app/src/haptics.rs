@@ -231,7 +231,7 @@ impl Haptics {
             if t.0 >= w.0 + WINDOW_US {
                 let done = RateWindow { start_us: w.0, haptic_hz: w.1, collision_hz: w.2, with_copy: w.3 };
                 self.rates.push(done);
-                log::info!(
+                log::debug!(
                     "haptic loop: {} Hz, collision {} Hz{}",
                     done.haptic_hz,
                     done.collision_hz,

@@ -102,10 +102,8 @@ fn answer(mut verdicts: MessageReader<ClientMsg>, mut p: ResMut<Practice>, mut i
         inbox.events.push(GameEvent::Verdict { item: *item, declared_real: *real, outcome });
         // Practice moves on after every verdict, right or wrong.
         p.next += 1;
-        if p.finished() {
-            log::info!("practice: {} right, {} wrong", p.right, p.wrong);
-            println!("PRACTICE: {} right, {} wrong", p.right, p.wrong);
-        } else {
+        // The last one's result is said by the app, after the verdict's answer.
+        if !p.finished() {
             place(&p, &mut inbox);
         }
     }

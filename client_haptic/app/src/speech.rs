@@ -107,8 +107,9 @@ impl Speaker {
     /// Says `text` (queued behind earlier lines).
     pub fn say(&mut self, text: impl Into<String>) {
         let text = text.into();
-        log::info!("SAY: {text}");
-        println!("SAY: {text}");
+        // Printed once, as it is said (a screen reader reads the terminal); the log has it only on request.
+        log::debug!("said: {text}");
+        println!("{text}");
         self.said.push(text.clone());
         self.last = Some(text.clone());
         let _ = self.to_worker.send(text);

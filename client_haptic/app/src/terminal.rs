@@ -11,6 +11,8 @@ use bevy::input::ButtonInput;
 use bevy::input::keyboard::KeyCode;
 use bevy::prelude::*;
 
+use crate::speech::Speaker;
+
 /// The key a typed line stands for.
 pub fn key_for(line: &str) -> Option<KeyCode> {
     Some(match line.trim().to_ascii_lowercase().as_str() {
@@ -28,6 +30,9 @@ pub fn key_for(line: &str) -> Option<KeyCode> {
         _ => return None,
     })
 }
+
+/// What is said when a typed line is no key.
+const HELP: &str = "Type y, n, s, b, r, h, g, c, up, down, or just Enter.";
 
 #[derive(Resource)]
 struct Lines(Mutex<Receiver<String>>);
@@ -55,14 +60,17 @@ impl Plugin for TerminalKeysPlugin {
     }
 }
 
-fn press(mut keys: ResMut<ButtonInput<KeyCode>>, lines: Res<Lines>) {
+fn press(mut keys: ResMut<ButtonInput<KeyCode>>, lines: Res<Lines>, mut speaker: Option<NonSendMut<Speaker>>) {
     keys.release_all();
     keys.clear();
     let rx = lines.0.lock().unwrap_or_else(|p| p.into_inner());
     while let Ok(line) = rx.try_recv() {
         match key_for(&line) {
             Some(k) => keys.press(k),
-            None => println!("SAY: Type y, n, s, b, r, h, g, c, up, down, or just Enter."),
+            None => match speaker.as_mut() {
+                Some(s) => s.say(HELP),
+                None => println!("{HELP}"),
+            },
         }
     }
 }

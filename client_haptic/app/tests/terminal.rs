@@ -1,0 +1,81 @@
+//! The terminal a blind player lives in: with `--headless`, stdout carries each spoken line once and
+//! nothing else (no `SAY:` tags, no log lines, no telemetry), and the log on stderr stays quiet unless
+//! `RUST_LOG` asks for more. Played as a screen-reader user would: answering by typed lines.
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::process::{Command, Stdio};
+use std::sync::mpsc::{self, RecvTimeoutError};
+use std::time::{Duration, Instant};
+
+#[test]
+fn headless_practice_prints_each_spoken_line_once_and_nothing_else() {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_client_haptic"))
+        .args(["practice", "--kind", "crown", "--seed", "3", "--headless", "--audio", "memory"])
+        .env_remove("RUST_LOG")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("client_haptic runs");
+    let mut stdin = child.stdin.take().expect("stdin");
+    let stdout = child.stdout.take().expect("stdout");
+    let mut stderr = child.stderr.take().expect("stderr");
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+            if tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    let log = std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = stderr.read_to_string(&mut s);
+        s
+    });
+    // Three copies, answered real, fake, real as each can be felt; a word that is no key first.
+    let (mut answers, mut lines) = (["y", "n", "y"].into_iter(), Vec::new());
+    let deadline = Instant::now() + Duration::from_secs(240);
+    loop {
+        match rx.recv_timeout(Duration::from_millis(200)) {
+            Ok(line) => {
+                if line.starts_with("You can feel it now") {
+                    if lines.iter().all(|l: &String| !l.starts_with("You can feel it now")) {
+                        writeln!(stdin, "xyzzy").expect("types");
+                    }
+                    writeln!(stdin, "{}", answers.next().unwrap_or("y")).expect("types");
+                }
+                lines.push(line);
+            }
+            Err(RecvTimeoutError::Timeout) => {}
+            Err(RecvTimeoutError::Disconnected) => break,
+        }
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            panic!("the practice did not end within 4 minutes; it printed {lines:#?}");
+        }
+    }
+    let status = child.wait().expect("waits");
+    let log = log.join().expect("the log");
+    assert!(status.success(), "client_haptic exited with {status}; stderr: {log}");
+
+    let count = |prefix: &str| lines.iter().filter(|l| l.starts_with(prefix)).count();
+    assert_eq!(count("Welcome to Phantom Heist."), 1, "{lines:#?}");
+    assert_eq!(count("A copy of the crown is on the bench."), 3, "{lines:#?}");
+    assert_eq!(count("You can feel it now."), 3, "{lines:#?}");
+    assert_eq!(count("You say: "), 3, "{lines:#?}");
+    assert_eq!(
+        count("Type y, n, s, b, r, h, g, c, up, down, or just Enter."),
+        1,
+        "the word that is no key: {lines:#?}"
+    );
+    let last = lines.last().expect("something was said");
+    assert!(last.starts_with("Practice over: ") && last.ends_with(" wrong."), "said last: {lines:#?}");
+    for line in &lines {
+        let sentence = line.ends_with(['.', '!', '?']) && line.chars().next().is_some_and(char::is_uppercase);
+        assert!(sentence && !line.starts_with("SAY:") && !line.contains('\u{1b}'), "not a spoken line: {line:?}");
+    }
+    for noise in ["INFO", "DEBUG", "haptic loop", "SAY", "said:", "\u{1b}["] {
+        assert!(!log.contains(noise), "the log is quiet by default, yet has {noise:?}: {log}");
+    }
+}
