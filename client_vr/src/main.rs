@@ -3,7 +3,19 @@
 use clap::Parser as _;
 use client_vr::cli::{Cli, Command, join, xr_check};
 
-fn main() -> anyhow::Result<()> {
+/// Errors end the program on one line (`error: what: why`), never with a backtrace, even with
+/// `RUST_BACKTRACE` set.
+fn main() -> std::process::ExitCode {
+    match run() {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+fn run() -> anyhow::Result<()> {
     match Cli::parse().command {
         Command::Join(args) => join(&args),
         Command::XrCheck => xr_check(),

@@ -79,3 +79,19 @@ fn headless_practice_prints_each_spoken_line_once_and_nothing_else() {
         assert!(!log.contains(noise), "the log is quiet by default, yet has {noise:?}: {log}");
     }
 }
+
+#[test]
+fn a_join_that_cannot_reach_the_host_fails_on_one_line_without_a_backtrace() {
+    // Nothing listens on port 1; RUST_BACKTRACE as a developer's shell has it.
+    let out = Command::new(env!("CARGO_BIN_EXE_client_haptic"))
+        .args(["join", "127.0.0.1:1", "--code", "ABCD-EFGH", "--headless", "--audio", "memory"])
+        .env("RUST_BACKTRACE", "1")
+        .output()
+        .expect("client_haptic runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines.len(), 1, "one line: {err}");
+    assert!(lines[0].starts_with("error: joining 127.0.0.1:1 as Phantom: cannot reach the token endpoint"), "{err}");
+    assert_eq!(lines[0].matches("refused").count(), 1, "the cause once: {err}");
+}

@@ -3,8 +3,11 @@
 use std::path::PathBuf;
 use std::process::Command;
 
+/// The binary, with backtraces asked for (as a developer's shell may): errors still take one line.
 fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_collette"))
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_collette"));
+    cmd.env("RUST_BACKTRACE", "1");
+    cmd
 }
 
 fn temp_dir() -> PathBuf {
@@ -47,11 +50,14 @@ fn build_info_and_render_work_end_to_end() {
 
     // A foreign file and an open mesh are clear errors, not panics.
     let out = bin().arg("info").arg(&obj).output().expect("runs");
-    assert!(!out.status.success() && String::from_utf8_lossy(&out.stderr).contains("not an .ist file"));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("not an .ist file"), "{err}");
+    assert!(err.trim().lines().count() == 1 && err.starts_with("error: "), "one line, no backtrace: {err}");
     let open: String = CUBE_OBJ.lines().take(19).map(|l| format!("{l}\n")).collect();
     std::fs::write(&obj, open).expect("write obj");
     let out = bin().arg("build").arg(&obj).arg("-o").arg(&ist).output().expect("runs");
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && err.contains("edge") && !err.contains("panicked"), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "one line, no backtrace: {err}");
     std::fs::remove_dir_all(&dir).ok();
 }

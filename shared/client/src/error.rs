@@ -6,12 +6,12 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 pub enum JoinError {
     /// The token endpoint could not be reached or did not answer in time.
-    #[error("cannot reach the token endpoint at {addr}: {source}")]
+    #[error("cannot reach the token endpoint at {addr}: {cause}")]
     Unreachable {
         /// Endpoint address.
         addr: std::net::SocketAddr,
-        /// Cause.
-        source: std::io::Error,
+        /// Cause (in the message, like every variant's, so a chain printed with `{:#}` says it once).
+        cause: std::io::Error,
     },
     /// The endpoint refused (wrong code, role taken...).
     #[error("the host refused to let us join: {0}")]

@@ -18,7 +18,7 @@ pub fn request_token(
     role: Role,
     timeout: Duration,
 ) -> Result<ConnectToken, JoinError> {
-    let unreachable = |source| JoinError::Unreachable { addr: endpoint, source };
+    let unreachable = |cause| JoinError::Unreachable { addr: endpoint, cause };
     let mut stream = TcpStream::connect_timeout(&endpoint, timeout).map_err(unreachable)?;
     stream.set_read_timeout(Some(timeout)).map_err(unreachable)?;
     stream.set_write_timeout(Some(timeout)).map_err(unreachable)?;
