@@ -83,6 +83,9 @@ pub struct PhantomState {
     pub copy: Option<(ItemId, Option<ArtifactKind>)>,
     /// The copy's material class, for the contact sound only.
     copy_feel: Option<MaterialClass>,
+    /// A copy arrived this frame (of this kind, if known): said after this frame's events, so the
+    /// answer to the last verdict comes before the next copy.
+    arrived: Option<Option<ArtifactKind>>,
     exploration: Option<Exploration>,
     last_verdict: Option<(ItemId, bool)>,
     judged: Option<ItemId>,
@@ -157,8 +160,6 @@ fn receive(
     mut events: MessageWriter<HeistEvent>,
     mut state: ResMut<PhantomState>,
     mut haptics: NonSendMut<Haptics>,
-    mut speaker: NonSendMut<Speaker>,
-    mut audio: NonSendMut<AudioEngine>,
     mut bench: ResMut<BenchView>,
     items: Query<&ItemView>,
 ) {
@@ -173,8 +174,7 @@ fn receive(
         state.copy = Some((copy.item, kind));
         state.copy_feel = Some(MaterialClass::nearest(&copy.material));
         state.exploration = None;
-        audio.earcon(Earcon::CopyArrived);
-        speaker.say(status::copy_arrived(kind));
+        state.arrived = Some(kind);
     }
     // The item's replication may come a frame after the copy.
     if let Some((item, None)) = state.copy
@@ -477,6 +477,7 @@ fn announce_events(
     mut spoken_alerts: Local<HashMap<u16, GuardAlert>>,
     mut speaker: NonSendMut<Speaker>,
     mut audio: NonSendMut<AudioEngine>,
+    mut state: ResMut<PhantomState>,
 ) {
     for HeistEvent(e) in events.read() {
         // A guard's alert is said once per change.
@@ -497,6 +498,10 @@ fn announce_events(
             GameEvent::PhaseChanged(Phase::Lost(_)) => audio.earcon(Earcon::Lost),
             _ => {}
         }
+    }
+    if let Some(kind) = state.arrived.take() {
+        audio.earcon(Earcon::CopyArrived);
+        speaker.say(status::copy_arrived(kind));
     }
 }
 

@@ -69,6 +69,21 @@ fn headless_practice_prints_each_spoken_line_once_and_nothing_else() {
         1,
         "the word that is no key: {lines:#?}"
     );
+    // In the order a player needs them: the welcome first, each verdict's answer before the next copy.
+    let at = |prefix: &str| -> Vec<usize> {
+        lines.iter().enumerate().filter(|(_, l)| l.starts_with(prefix)).map(|(i, _)| i).collect()
+    };
+    let copies = at("A copy of the crown is on the bench.");
+    let answers = [at("Correct."), at("Wrong:")].concat();
+    assert!(at("Welcome").iter().all(|w| *w < copies[0]), "{lines:#?}");
+    assert_eq!(answers.len(), 3, "{lines:#?}");
+    for next in &copies[1..] {
+        assert_eq!(
+            answers.iter().filter(|a| *a < next).count(),
+            copies.iter().filter(|c| *c < next).count(),
+            "{lines:#?}"
+        );
+    }
     let last = lines.last().expect("something was said");
     assert!(last.starts_with("Practice over: ") && last.ends_with(" wrong."), "said last: {lines:#?}");
     for line in &lines {
