@@ -7,16 +7,18 @@
 //!         --heist --kind idol --real --repeat 16 10
 
 use clap::Parser;
+use client_haptic::cli::KindArg;
 use client_haptic::explore::feel;
 use client_haptic::haptics::{Haptics, HapticsSettings};
 use heist_shared::artifact::{ArtifactKind, build_mesh, copy_mesh_seed, generate_copies, target_seed};
+use heist_shared::level::Level;
 use heist_shared::protocol::{ItemId, WorkbenchCopy};
 
 #[derive(Parser)]
 struct Args {
-    /// Only this kind: crown, amphora or idol.
-    #[arg(long, value_parser = parse_kind)]
-    kind: Option<ArtifactKind>,
+    /// Only this kind.
+    #[arg(long, value_enum)]
+    kind: Option<KindArg>,
     /// Only the real one of each kind.
     #[arg(long)]
     real: bool,
@@ -32,12 +34,9 @@ struct Args {
     seeds: Vec<u64>,
 }
 
-fn parse_kind(s: &str) -> Result<ArtifactKind, String> {
-    ArtifactKind::ALL.into_iter().find(|k| k.name() == s).ok_or_else(|| format!("{s:?} is not crown, amphora or idol"))
-}
-
 fn main() -> anyhow::Result<()> {
     let args = Args::parse();
+    let museum = Level::museum();
     let mut h = Haptics::start(HapticsSettings::default())?;
     std::thread::sleep(std::time::Duration::from_millis(2500));
     println!(
@@ -46,13 +45,18 @@ fn main() -> anyhow::Result<()> {
     );
     let (mut item, mut felt, mut wrong) = (0, 0, 0);
     for &seed in &args.seeds {
-        for kind in ArtifactKind::ALL.into_iter().filter(|k| args.kind.is_none_or(|only| only == *k)) {
-            // The shipped museum's targets are one of each kind, in this order, three copies each.
-            let target = ArtifactKind::ALL.iter().position(|k| *k == kind).unwrap_or(0);
-            let copies_seed = if args.heist { target_seed(seed, target) } else { seed };
-            let (copies, real) = generate_copies(kind, copies_seed, 3);
+        for kind in
+            ArtifactKind::ALL.into_iter().filter(|k| args.kind.is_none_or(|only| ArtifactKind::from(only) == *k))
+        {
+            // A heist's copies of a kind: its target on the shipped museum, as the server sets it up.
+            let target = museum.targets.iter().position(|t| t.kind == kind).filter(|_| args.heist);
+            let (copies_seed, count) = match target {
+                Some(t) => (target_seed(seed, t), museum.targets[t].copies),
+                None => (seed, 3),
+            };
+            let (copies, real) = generate_copies(kind, copies_seed, count);
             for (c, t) in copies.iter().enumerate().filter(|(c, _)| !args.real || *c == real) {
-                let mesh = build_mesh(t, if args.heist { copy_mesh_seed(copies_seed, c) } else { seed });
+                let mesh = build_mesh(t, if target.is_some() { copy_mesh_seed(copies_seed, c) } else { seed });
                 for _ in 0..args.repeat {
                     item += 1;
                     let copy =

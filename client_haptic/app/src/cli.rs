@@ -61,6 +61,16 @@ pub enum KindArg {
     Idol,
 }
 
+impl From<KindArg> for heist_shared::artifact::ArtifactKind {
+    fn from(kind: KindArg) -> Self {
+        match kind {
+            KindArg::Crown => Self::Crown,
+            KindArg::Amphora => Self::Amphora,
+            KindArg::Idol => Self::Idol,
+        }
+    }
+}
+
 /// Arguments of `practice`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct PracticeArgs {
@@ -282,11 +292,7 @@ pub fn join(args: &JoinArgs) -> anyhow::Result<()> {
 /// Runs `practice`.
 pub fn practice(args: &PracticeArgs) -> anyhow::Result<()> {
     let settings = args.client.settings().map_err(anyhow::Error::msg)?;
-    let kind = match args.kind {
-        KindArg::Crown => heist_shared::artifact::ArtifactKind::Crown,
-        KindArg::Amphora => heist_shared::artifact::ArtifactKind::Amphora,
-        KindArg::Idol => heist_shared::artifact::ArtifactKind::Idol,
-    };
+    let kind = args.kind.into();
     let mut app = app(settings, args.client.headless, Some(crate::practice::Practice::new(kind, args.seed)))?;
     args.client.request_shot(&mut app);
     app.run();
