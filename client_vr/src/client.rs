@@ -13,7 +13,7 @@ use bevy::prelude::*;
 use glam::{Quat, Vec2};
 use heist_client::Inbox;
 use heist_shared::level::{Level, WallSet};
-use heist_shared::protocol::{GameEvent, GuardView, PhantomTool, Phase, SessionView, TICK_HZ, ViveAvatar};
+use heist_shared::protocol::{GameEvent, GuardView, PhantomTool, Phase, Role, SessionView, TICK_HZ, ViveAvatar};
 
 use crate::intent::{self, InputSource, Intent, IntentSystems, Sent};
 use crate::interp::{Snapshot, Track};
@@ -143,7 +143,9 @@ impl Plugin for ViveClientPlugin {
             )
             .add_systems(
                 RunFixedMainLoop,
-                (take_level, track_session, reconcile, snapshots, events).chain().in_set(ViveSystems::Receive),
+                (take_level, track_session, reconcile, snapshots, events, tell_the_link)
+                    .chain()
+                    .in_set(ViveSystems::Receive),
             )
             .add_systems(RunFixedMainLoop, intent::clear.in_set(IntentSystems::Clear))
             .add_systems(RunFixedMainLoop, ready_at_once.in_set(IntentSystems::Gather))
@@ -178,9 +180,12 @@ fn track_session(q: Query<&SessionView>, mut state: ResMut<ViveState>, time: Res
         let text = match session.phase {
             Phase::Lobby => "In the lobby".to_owned(),
             Phase::Heist => "The heist is on".to_owned(),
-            Phase::Won => "RESULT: won".to_owned(),
-            Phase::Lost(why) => format!("RESULT: lost ({why})"),
+            Phase::Won => "RESULT: won. Enter asks for another round".to_owned(),
+            Phase::Lost(why) => format!("RESULT: lost ({why}). Enter asks for another round"),
         };
+        if session.phase == Phase::Heist {
+            state.ended_s = 0.0;
+        }
         state.phase = session.phase;
         state.say(now, text);
     }
@@ -258,7 +263,12 @@ fn events(
                     format!("{alert:?}").to_lowercase()
                 ))
             }
-            GameEvent::Noise { .. } | GameEvent::PhaseChanged(_) => None,
+            GameEvent::Noise { .. } | GameEvent::PhaseChanged(_) | GameEvent::PickedUp(_) => None,
+            GameEvent::Joined(_)
+            | GameEvent::Left { .. }
+            | GameEvent::RematchAsked(_)
+            | GameEvent::RoundStarted(_)
+            | GameEvent::EndingSoon(_) => heist_client::notice::session_notice(&e, Role::Vive),
         };
         if let GameEvent::Noise { kind: heist_shared::protocol::NoiseKind::Glass, position, .. } = &e
             && state.body().is_some_and(|b| b.distance(*position) < heist_shared::rules::REACH * 2.0)
@@ -272,6 +282,33 @@ fn events(
     }
     for r in std::mem::take(&mut inbox.refusals) {
         state.say(now, format!("The server refused: {r:?}"));
+    }
+}
+
+/// The connection's changes on the HUD: lost after 3 s of silence, back, gone; and why the server let us go.
+fn tell_the_link(
+    link: Res<heist_client::Link>,
+    inbox: Res<Inbox>,
+    mut was: Local<heist_client::Link>,
+    mut told_disconnect: Local<bool>,
+    mut state: ResMut<ViveState>,
+    time: Res<Time>,
+) {
+    let now = time.elapsed_secs_f64();
+    if let Some(reason) = &inbox.disconnect
+        && !*told_disconnect
+    {
+        *told_disconnect = true;
+        state.say(now, heist_client::notice::disconnect_notice(reason));
+    }
+    if *link != *was {
+        let gone = *link == heist_client::Link::Gone;
+        if !(gone && inbox.disconnect.is_some())
+            && let Some(line) = heist_client::notice::link_notice(*was, *link)
+        {
+            state.say(now, line.to_owned());
+        }
+        *was = *link;
     }
 }
 
@@ -315,9 +352,10 @@ fn quit_after_end(
     state: Res<ViveState>,
     mut exit: MessageWriter<AppExit>,
     inbox: Res<Inbox>,
+    link: Res<heist_client::Link>,
 ) {
     if let Some(after) = settings.quit_after_end_s
-        && (state.ended_s > after || inbox.disconnect.is_some())
+        && (state.ended_s > after || inbox.disconnect.is_some() || *link == heist_client::Link::Gone)
     {
         exit.write(AppExit::Success);
     }

@@ -92,6 +92,15 @@ fn look(
     view.pitch = (view.pitch - motion.delta.y * SENSITIVITY).clamp(-1.4, 1.4);
 }
 
+/// What Enter means in `phase`: ready in the lobby, another round after a result, nothing mid-heist.
+pub fn enter_action(phase: Phase) -> Option<Action> {
+    match phase {
+        Phase::Lobby => Some(Action::Ready),
+        Phase::Won | Phase::Lost(_) => Some(Action::Rematch),
+        Phase::Heist => None,
+    }
+}
+
 /// The walking direction on the floor for pressed keys, facing `facing`.
 pub fn walk_direction(forward: bool, back: bool, left: bool, right: bool, facing: f32) -> Vec2 {
     let ahead = Vec2::new(facing.cos(), facing.sin());
@@ -126,8 +135,10 @@ fn keys(
     } else {
         Gait::Walk
     };
-    if keys.just_pressed(KeyCode::Enter) && state.phase == Phase::Lobby {
-        intent.actions.push(Action::Ready);
+    if keys.just_pressed(KeyCode::Enter)
+        && let Some(action) = enter_action(state.phase)
+    {
+        intent.actions.push(action);
     }
     let Some(body) = state.body() else { return };
     let aim = Aim { from: body, towards: Vec2::new(intent.facing.cos(), intent.facing.sin()) };
@@ -195,6 +206,15 @@ fn follow_body(
 mod tests {
     use super::*;
     use std::f32::consts::FRAC_PI_2;
+
+    #[test]
+    fn enter_readies_in_the_lobby_and_asks_for_another_round_after_a_result() {
+        use heist_shared::protocol::{ClientMsg, LobbyMsg, LossReason};
+        assert_eq!(enter_action(Phase::Lobby).map(Action::message), Some(ClientMsg::Lobby(LobbyMsg::Ready)));
+        assert_eq!(enter_action(Phase::Won).map(Action::message), Some(ClientMsg::Lobby(LobbyMsg::Rematch)));
+        assert_eq!(enter_action(Phase::Lost(LossReason::Caught)), Some(Action::Rematch));
+        assert_eq!(enter_action(Phase::Heist), None);
+    }
 
     #[test]
     fn wasd_moves_relative_to_where_the_player_looks() {

@@ -15,6 +15,8 @@ use heist_shared::rules;
 pub enum Action {
     /// Say ready in the lobby.
     Ready,
+    /// After a result: ask for another round.
+    Rematch,
     /// Break a display case.
     Break(CaseId),
     /// Pick an item up.
@@ -37,6 +39,7 @@ impl Action {
     pub fn message(self) -> ClientMsg {
         match self {
             Action::Ready => ClientMsg::Lobby(LobbyMsg::Ready),
+            Action::Rematch => ClientMsg::Lobby(LobbyMsg::Rematch),
             Action::Break(c) => ClientMsg::Vive(ViveMsg::Break(c)),
             Action::PickUp(i) => ClientMsg::Vive(ViveMsg::PickUp(i)),
             Action::Drop(i) => ClientMsg::Vive(ViveMsg::Drop(i)),

@@ -8,7 +8,7 @@ use std::time::Duration;
 use anyhow::Context as _;
 use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
-use heist_bots::{PhantomBotPlugin, ViveBotPlugin, ViveStyle};
+use heist_bots::{PhantomBotPlugin, Rounds, ViveBotPlugin, ViveStyle};
 use heist_client::{ClientNetPlugin, request_token};
 use heist_shared::protocol::{Phase, Role, TICK_HZ};
 use heist_transport::renetcode::ConnectToken;
@@ -54,6 +54,23 @@ pub struct Heist {
     pub phantom: App,
     /// Ticks stepped so far.
     pub ticks: u64,
+    /// Each round's end, in order.
+    pub results: Vec<RoundResult>,
+}
+
+/// How one round ended, read the tick it ended (a rematch may replace the game soon after).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RoundResult {
+    /// The round (1 for the first).
+    pub round: u32,
+    /// Its seed.
+    pub seed: u64,
+    /// Its final phase.
+    pub phase: Phase,
+    /// Game time it lasted, seconds.
+    pub elapsed_s: f32,
+    /// `RESULT: …`.
+    pub line: String,
 }
 
 impl Heist {
@@ -64,13 +81,38 @@ impl Heist {
 
     /// Joins both bots to a running `server`.
     pub fn join(server: HostedServer, style: ViveStyle) -> anyhow::Result<Self> {
+        Self::join_for_rounds(server, style, 1)
+    }
+
+    /// Both bots join and will ask for another round after each result until `rounds` were played.
+    pub fn join_for_rounds(server: HostedServer, style: ViveStyle, rounds: u32) -> anyhow::Result<Self> {
         let vive = join(&server, Role::Vive, |app| {
-            app.add_plugins(ViveBotPlugin { style });
+            app.add_plugins(ViveBotPlugin { style }).insert_resource(Rounds(rounds));
         })?;
         let phantom = join(&server, Role::Phantom, |app| {
-            app.add_plugins(PhantomBotPlugin::default());
+            app.add_plugins(PhantomBotPlugin::default()).insert_resource(Rounds(rounds));
         })?;
-        Ok(Self { server, vive, phantom, ticks: 0 })
+        Ok(Self { server, vive, phantom, ticks: 0, results: Vec::new() })
+    }
+
+    /// After a result: steps until the next round is on (true) or `max_s` of stepped time passed, or the
+    /// session closed (false).
+    pub fn await_next_round(&mut self, max_s: f32) -> bool {
+        let round = self.results.last().map_or(1, |r| r.round);
+        if self.server.game().round > round && self.server.game().is_running() {
+            return true;
+        }
+        for _ in 0..(f64::from(max_s) * TICK_HZ) as u64 {
+            self.step();
+            let g = self.server.game();
+            if g.round > round && g.is_running() {
+                return true;
+            }
+            if g.closed {
+                return false;
+            }
+        }
+        false
     }
 
     /// One tick for everyone.
@@ -112,12 +154,21 @@ impl Heist {
                     guards.join(" ")
                 );
             }
-            if !self.server.game().is_running() {
+            let g = self.server.game();
+            if !g.is_running() {
+                let phase = g.phase;
+                self.results.push(RoundResult {
+                    round: g.round,
+                    seed: g.seed,
+                    phase,
+                    elapsed_s: g.elapsed_s,
+                    line: crate::session::result_line(g).unwrap_or_default(),
+                });
                 // A few more ticks let the final messages reach the clients.
                 for _ in 0..10 {
                     self.step();
                 }
-                break;
+                return phase;
             }
         }
         self.server.game().phase
@@ -130,15 +181,24 @@ fn play_to_the_end(options: ServerOptions, style: ViveStyle) -> anyhow::Result<(
     let limit = options.game.time_limit_s.unwrap_or(options.level.time_limit_s);
     let mut heist = Heist::start(options, style)?;
     let phase = heist.run(limit + 5.0);
-    let result =
-        crate::session::result_line(heist.server.game()).unwrap_or_else(|| format!("RESULT: unfinished ({phase:?})"));
+    let result = heist.results.last().map_or_else(|| format!("RESULT: unfinished ({phase:?})"), |r| r.line.clone());
     Ok((heist, phase, result))
 }
 
-/// Runs a whole heist with bots and prints the log and the result.
-pub fn run_demo(options: ServerOptions, style: ViveStyle) -> anyhow::Result<Phase> {
-    let (heist, phase, result) = play_to_the_end(options, style)?;
-    let game = heist.server.game();
+/// Runs the demo: `rounds` heists in one session, the bots asking for another round after each result;
+/// prints each round's result line. Returns the last round's phase.
+pub fn run_demo(options: ServerOptions, style: ViveStyle, rounds: u32) -> anyhow::Result<Phase> {
+    let limit = options.game.time_limit_s.unwrap_or(options.level.time_limit_s);
+    let rounds = rounds.max(1);
+    let mut heist = Heist::join_for_rounds(build_server(options)?, style, rounds)?;
+    let mut phase = heist.run(limit + 5.0);
+    for round in 2..=rounds {
+        if !heist.await_next_round(30.0) {
+            println!("round {round} did not begin");
+            break;
+        }
+        phase = heist.run(limit + 5.0);
+    }
     for (name, app) in [("Vive", &heist.vive), ("Phantom", &heist.phantom)] {
         let inbox = app.world().resource::<heist_client::Inbox>();
         if !inbox.refusals.is_empty() {
@@ -149,7 +209,13 @@ pub fn run_demo(options: ServerOptions, style: ViveStyle) -> anyhow::Result<Phas
             );
         }
     }
-    println!("{result} after {:.1} s of game time", game.elapsed_s);
+    if heist.results.is_empty() {
+        println!("RESULT: unfinished ({phase:?})");
+    }
+    for r in &heist.results {
+        let prefix = if rounds > 1 { format!("round {}: ", r.round) } else { String::new() };
+        println!("{prefix}{} after {:.1} s of game time", r.line, r.elapsed_s);
+    }
     Ok(phase)
 }
 

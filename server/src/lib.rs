@@ -73,7 +73,7 @@ impl ServerOptions {
         let loopback: SocketAddr = "127.0.0.1:0".parse().unwrap_or_else(|_| unreachable!());
         Self {
             level: Level::museum(),
-            game: GameOptions { seed, time_limit_s: None },
+            game: GameOptions { seed, ..Default::default() },
             bind: loopback,
             token_bind: loopback,
             insecure: false,
@@ -159,12 +159,22 @@ pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
     app.insert_resource(Time::<Fixed>::from_hz(TICK_HZ))
         .add_plugins((StatesPlugin, RepliconPlugins, RepliconRenetPlugins, ProtocolPlugin))
         .insert_resource(GameState(Game::new(options.level, &options.game)))
-        .insert_resource(SessionLog { echo: options.echo_log, ..Default::default() })
+        .insert_resource(SessionLog {
+            echo: options.echo_log,
+            id: format!("{:08x}", rand::random::<u32>()),
+            round: 1,
+            ..Default::default()
+        })
         .add_plugins(SessionPlugin)
         .add_plugins(ServerNetPlugin {
             socket: std::sync::Mutex::new(Some(socket)),
             settings: NetSettings { auth, roles, abuse_limit: options.abuse_limit, advertise },
         });
+    app.world_mut().resource_mut::<SessionLog>().record(
+        0.0,
+        session::Record::SessionCreated,
+        "session created; waiting for players".into(),
+    );
     if options.clock == Clock::Stepped {
         app.finish();
         app.cleanup();

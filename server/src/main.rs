@@ -58,8 +58,11 @@ enum Command {
         #[arg(long, value_enum, default_value_t = Style::Careful)]
         vive: Style,
         /// Override the level's time limit, seconds.
-        #[arg(long)]
+        #[arg(long, value_parser = positive_seconds)]
         time_limit: Option<f32>,
+        /// Heists in the session: after each result the bots ask for another round (a new seed).
+        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100))]
+        rounds: u32,
     },
     /// Play one whole bot heist per seed (no live log) and print each result and the tally.
     Sweep {
@@ -95,6 +98,13 @@ enum Command {
         /// Accept clients without tokens, claiming any role. LAN development only.
         #[arg(long)]
         insecure: bool,
+        /// Seconds the session waits after a result for another round (and outlives its last player)
+        /// before it ends and the server exits.
+        #[arg(long, default_value_t = heist_server::game::SESSION_IDLE_S, value_parser = positive_seconds)]
+        idle_end: f32,
+        /// Override the level's time limit, seconds.
+        #[arg(long, value_parser = positive_seconds)]
+        time_limit: Option<f32>,
     },
     /// Join a hosted session as a bot.
     Join {
@@ -109,7 +119,56 @@ enum Command {
         /// How a Vive bot plays.
         #[arg(long, value_enum, default_value_t = Style::Careful)]
         vive: Style,
+        /// Heists to play: after each result but the last the bot asks for another round; after the last
+        /// it leaves.
+        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1000))]
+        rounds: u32,
     },
+}
+
+/// The bot leaves a few seconds after the last round's result, or quits when the server lets it go,
+/// saying why.
+#[allow(clippy::too_many_arguments)]
+fn leave_after_the_last_round(
+    rounds: Res<heist_bots::Rounds>,
+    inbox: Res<heist_client::Inbox>,
+    session: Query<&heist_shared::protocol::SessionView>,
+    time: Res<Time<Real>>,
+    mut over_at: Local<Option<f64>>,
+    mut leaving: ResMut<heist_client::Leaving>,
+    link: Res<heist_client::Link>,
+    mut exit: MessageWriter<AppExit>,
+) {
+    use heist_shared::protocol::Phase;
+    let now = time.elapsed_secs_f64();
+    if let Some(reason) = &inbox.disconnect {
+        println!("{}", heist_client::notice::disconnect_notice(reason));
+        exit.write(AppExit::Success);
+        return;
+    }
+    if *link == heist_client::Link::Gone {
+        println!("{}", heist_client::notice::link_notice(heist_client::Link::Up, *link).unwrap_or_default());
+        exit.write(AppExit::Success);
+        return;
+    }
+    let finished = session.single().is_ok_and(|s| matches!(s.phase, Phase::Won | Phase::Lost(_)));
+    if !finished || inbox.round.max(1) < rounds.0 {
+        *over_at = None;
+        return;
+    }
+    let at = *over_at.get_or_insert(now);
+    if now - at > 2.0 {
+        leaving.start(now);
+    }
+}
+
+/// A number of seconds for a flag: finite and above zero.
+fn positive_seconds(text: &str) -> Result<f32, String> {
+    match text.parse::<f32>() {
+        Ok(s) if s.is_finite() && s > 0.0 => Ok(s),
+        Ok(_) => Err(format!("must be a positive number of seconds, got {text}")),
+        Err(e) => Err(format!("not a number of seconds ({e})")),
+    }
 }
 
 fn load_level(path: Option<PathBuf>) -> anyhow::Result<Level> {
@@ -134,13 +193,13 @@ fn main() -> std::process::ExitCode {
 
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
-        Command::Demo { seed, level, vive, time_limit } => {
+        Command::Demo { seed, level, vive, time_limit, rounds } => {
             let mut options = ServerOptions::local_test(seed);
             options.level = load_level(level)?;
-            options.game = GameOptions { seed, time_limit_s: time_limit };
+            options.game = GameOptions { seed, time_limit_s: time_limit, ..Default::default() };
             options.echo_log = LogEcho::Stdout;
             println!("Phantom Heist demo: {} with seed {seed}, both bots over loopback UDP", options.level.name);
-            heist_server::demo::run_demo(options, vive.into())?;
+            heist_server::demo::run_demo(options, vive.into(), rounds)?;
             Ok(())
         }
         Command::Sweep { from, to, vive } => {
@@ -150,13 +209,18 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             println!("{tally}");
             Ok(())
         }
-        Command::Host { bind, advertise, seed, code_ttl, level, insecure } => {
+        Command::Host { bind, advertise, seed, code_ttl, level, insecure, idle_end, time_limit } => {
             if insecure {
                 eprintln!("WARNING: --insecure: anyone who reaches {bind} can join as any role. LAN development only!");
             }
             let options = ServerOptions {
                 level: load_level(level)?,
-                game: GameOptions { seed: seed.unwrap_or_else(rand::random), time_limit_s: None },
+                game: GameOptions {
+                    seed: seed.unwrap_or_else(rand::random),
+                    random_rounds: seed.is_none(),
+                    idle_end_s: Some(idle_end),
+                    time_limit_s: time_limit,
+                },
                 bind,
                 token_bind: bind,
                 insecure,
@@ -186,16 +250,19 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 })?;
             }
             server.app.run();
+            println!("the session is over");
             Ok(())
         }
-        Command::Join { addr, code, role, vive } => {
+        Command::Join { addr, code, role, vive, rounds } => {
             let token = heist_client::request_token(addr, &code, role, Duration::from_secs(5))
                 .with_context(|| format!("joining {addr} as {role}"))?;
             let mut app = App::new();
             app.add_plugins(
                 MinimalPlugins.set(bevy::app::ScheduleRunnerPlugin::run_loop(Duration::from_secs_f64(1.0 / 60.0))),
             )
-            .add_plugins(heist_client::ClientNetPlugin);
+            .add_plugins(heist_client::ClientNetPlugin)
+            .insert_resource(heist_bots::Rounds(rounds))
+            .add_systems(Update, leave_after_the_last_round);
             match role {
                 Role::Vive => app.add_plugins(ViveBotPlugin { style: vive.into() }),
                 Role::Phantom => app.add_plugins(PhantomBotPlugin::default()),

@@ -4,7 +4,8 @@
 use bevy::prelude::*;
 use bevy_replicon::prelude::*;
 use heist_shared::protocol::{
-    Audience, CaseId, CaseView, GameEvent, GuardView, ItemId, ItemView, PhantomTool, Phase, SessionView, ViveAvatar,
+    Audience, CaseId, CaseView, GameEvent, GuardAlert, GuardView, ItemId, ItemView, LossReason, PhantomTool, Phase,
+    Role, SessionView, VerdictOutcome, ViveAvatar,
 };
 
 use crate::game::Game;
@@ -26,7 +27,10 @@ pub enum LogEcho {
     Tracing,
 }
 
-/// Human-readable log of the session.
+/// The session's log: readable lines (kept in [`SessionLog::lines`], echoed as [`LogEcho`] says) and, when
+/// echoed to `tracing`, one structured event per line (target `session`, an `event` field naming it, the
+/// session's `id` — never its join code — its `round`, the game time and the `role` where there is one;
+/// `--log-format json` makes each a JSON object).
 #[derive(Resource, Default)]
 pub struct SessionLog {
     /// Lines so far.
@@ -35,19 +39,121 @@ pub struct SessionLog {
     pub echo: LogEcho,
     /// Also record debug lines (refusals).
     pub verbose: bool,
+    /// The session's public id (random, hex): what log collectors group by.
+    pub id: String,
+    /// The round being played (set by the session as rounds start).
+    pub round: u32,
+}
+
+/// What a log line records, for the structured log.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Record<'a> {
+    /// Anything else (refusals, warnings): `event = "note"`.
+    Note,
+    /// The session exists and waits for players.
+    SessionCreated,
+    /// A player was admitted.
+    PlayerJoined(Role),
+    /// A player closed the connection on purpose.
+    PlayerLeft(Role),
+    /// A player's connection was lost.
+    PlayerDropped(Role),
+    /// The phase changed (not to a result).
+    Phase(Phase),
+    /// The round ended.
+    Result {
+        /// Won?
+        won: bool,
+        /// Why it was lost.
+        reason: Option<LossReason>,
+        /// The round's seed (told only now).
+        seed: u64,
+    },
+    /// A case was broken.
+    CaseBroken(&'a str),
+    /// Vive picked an item up.
+    ItemPicked(u16),
+    /// A copy was placed on the workbench.
+    Delivered(u16),
+    /// Phantom judged a copy.
+    Verdict {
+        /// The copy.
+        item: u16,
+        /// Said real?
+        declared_real: bool,
+        /// What came of it.
+        outcome: VerdictOutcome,
+    },
+    /// A guard's alert changed.
+    GuardAlert {
+        /// The guard's name.
+        guard: &'a str,
+        /// The new state.
+        alert: GuardAlert,
+    },
+    /// A player asked for another round.
+    RematchAsked(Role),
+    /// A round began.
+    RoundStarted(u32),
+    /// The session closed.
+    SessionEnded,
 }
 
 impl SessionLog {
-    /// Records a line stamped with game time.
+    /// Records a plain line stamped with game time.
     pub fn line(&mut self, t: f32, text: String) {
+        self.record(t, Record::Note, text);
+    }
+
+    /// Records a line that is also a structured event.
+    pub fn record(&mut self, t: f32, record: Record<'_>, text: String) {
         match self.echo {
             LogEcho::Off => {}
             LogEcho::Stdout => println!("[{t:7.2}s] {text}"),
-            LogEcho::Tracing => {
-                info!(target: "session", game_time_s = (f64::from(t) * 100.0).round() / 100.0, "{text}")
-            }
+            LogEcho::Tracing => self.trace(t, record, &text),
         }
         self.lines.push(format!("[{t:7.2}s] {text}"));
+    }
+
+    fn trace(&self, t: f32, record: Record<'_>, text: &str) {
+        let (id, round, time) = (self.id.as_str(), self.round, (f64::from(t) * 100.0).round() / 100.0);
+        macro_rules! ev {
+            ($name:literal $(, $k:ident = $v:expr)*) => {
+                info!(target: "session", event = $name, session = id, round, game_time_s = time $(, $k = $v)*, "{text}")
+            };
+        }
+        match record {
+            Record::Note => ev!("note"),
+            Record::SessionCreated => ev!("session_created"),
+            Record::PlayerJoined(r) => ev!("player_joined", role = role_name(r)),
+            Record::PlayerLeft(r) => ev!("player_left", role = role_name(r)),
+            Record::PlayerDropped(r) => ev!("player_dropped", role = role_name(r)),
+            Record::Phase(p) => ev!("phase", phase = phase_name(p)),
+            Record::Result { won, reason, seed } => {
+                ev!(
+                    "result",
+                    won = won,
+                    reason = reason.map(|r| r.to_string()).unwrap_or_default(),
+                    seed = seed.to_string()
+                )
+            }
+            Record::CaseBroken(case) => ev!("case_broken", role = "vive", case = case),
+            Record::ItemPicked(item) => ev!("item_picked", role = "vive", item = item),
+            Record::Delivered(item) => ev!("delivered", role = "vive", item = item),
+            Record::Verdict { item, declared_real, outcome } => ev!(
+                "verdict",
+                role = "phantom",
+                item = item,
+                declared_real = declared_real,
+                outcome = format!("{outcome:?}").to_lowercase()
+            ),
+            Record::GuardAlert { guard, alert } => {
+                ev!("guard_alert", guard = guard, alert = format!("{alert:?}").to_lowercase())
+            }
+            Record::RematchAsked(r) => ev!("rematch_asked", role = role_name(r)),
+            Record::RoundStarted(n) => ev!("round_started", new_round = n),
+            Record::SessionEnded => ev!("session_ended"),
+        }
     }
 
     /// Records a line only in verbose mode.
@@ -59,34 +165,71 @@ impl SessionLog {
 
     /// Describes a game event.
     pub fn event(&mut self, t: f32, game: &Game, event: &GameEvent) {
-        let text = match event {
+        let (record, text) = match event {
             GameEvent::PhaseChanged(p @ (Phase::Won | Phase::Lost(_))) => {
                 // Only now may the seed be told: it decides which copies are real.
-                format!("phase: {p:?} (seed {0}; `--seed {0}` replays this session)", game.seed)
+                let reason = if let Phase::Lost(r) = p { Some(*r) } else { None };
+                (
+                    Record::Result { won: *p == Phase::Won, reason, seed: game.seed },
+                    format!("phase: {p:?} (seed {0}; `--seed {0}` replays this round)", game.seed),
+                )
             }
-            GameEvent::PhaseChanged(p) => format!("phase: {p:?}"),
+            GameEvent::PhaseChanged(p) => (Record::Phase(*p), format!("phase: {p:?}")),
             GameEvent::GuardAlert { guard, alert, position } => {
                 let name = game.guards.get(usize::from(guard.0)).map_or("?", |g| g.name.as_str());
-                format!("guard {name}: {alert:?} at ({:.1}, {:.1})", position.x, position.y)
+                let text = format!("guard {name}: {alert:?} at ({:.1}, {:.1})", position.x, position.y);
+                (Record::GuardAlert { guard: name, alert: *alert }, text)
             }
             GameEvent::Noise { kind, position, .. } => {
                 if matches!(kind, heist_shared::protocol::NoiseKind::Footsteps) {
                     return; // too frequent to be worth a line
                 }
-                format!("noise: {kind:?} at ({:.1}, {:.1})", position.x, position.y)
+                (Record::Note, format!("noise: {kind:?} at ({:.1}, {:.1})", position.x, position.y))
             }
             GameEvent::CaseBroken(c) => {
-                format!("case {} broken", game.level.cases.get(usize::from(c.0)).map_or("?", |c| c.id.as_str()))
+                let id = game.level.cases.get(usize::from(c.0)).map_or("?", |c| c.id.as_str());
+                (Record::CaseBroken(id), format!("case {id} broken"))
             }
-            GameEvent::Delivered(i) => format!("copy #{} delivered to the workbench", i.0),
+            GameEvent::PickedUp(i) => (Record::ItemPicked(i.0), format!("Vive picks up item #{}", i.0)),
+            GameEvent::Delivered(i) => (Record::Delivered(i.0), format!("copy #{} delivered to the workbench", i.0)),
             GameEvent::Verdict { item, declared_real, outcome } => {
                 let said = if *declared_real { "real" } else { "fake" };
-                format!("Phantom declares copy #{} {said}: {outcome:?}", item.0)
+                (
+                    Record::Verdict { item: item.0, declared_real: *declared_real, outcome: *outcome },
+                    format!("Phantom declares copy #{} {said}: {outcome:?}", item.0),
+                )
             }
-            GameEvent::Alarm(level) => format!("alarm level {level}"),
-            GameEvent::Warning(w) => format!("Phantom warns Vive: {w:?}"),
+            GameEvent::Alarm(level) => (Record::Note, format!("alarm level {level}")),
+            GameEvent::Warning(w) => (Record::Note, format!("Phantom warns Vive: {w:?}")),
+            GameEvent::Joined(role) => (Record::PlayerJoined(*role), format!("{role} joined")),
+            GameEvent::Left { role, dropped: false } => (Record::PlayerLeft(*role), format!("{role} left")),
+            GameEvent::Left { role, dropped: true } => {
+                (Record::PlayerDropped(*role), format!("{role} dropped (connection lost)"))
+            }
+            GameEvent::RematchAsked(role) => (Record::RematchAsked(*role), format!("{role} asks for another round")),
+            GameEvent::RoundStarted(n) => {
+                self.round = *n;
+                (Record::RoundStarted(*n), format!("round {n} begins"))
+            }
+            GameEvent::EndingSoon(s) => (Record::Note, format!("the session ends in {s} s unless a round begins")),
         };
-        self.line(t, text);
+        self.record(t, record, text);
+    }
+}
+
+fn role_name(role: Role) -> &'static str {
+    match role {
+        Role::Vive => "vive",
+        Role::Phantom => "phantom",
+    }
+}
+
+fn phase_name(phase: Phase) -> &'static str {
+    match phase {
+        Phase::Lobby => "lobby",
+        Phase::Heist => "heist",
+        Phase::Won => "won",
+        Phase::Lost(_) => "lost",
     }
 }
 
@@ -233,4 +376,108 @@ fn case_view(g: &Game, i: usize) -> CaseView {
 fn item_view(g: &Game, i: usize) -> ItemView {
     let item = &g.items[i];
     ItemView { id: ItemId(i as u16), kind: item.kind.clone(), place: item.place }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::io::Write;
+    use std::sync::{Arc, Mutex};
+
+    use heist_shared::level::Level;
+    use heist_shared::protocol::{CaseId, GuardId, ItemId};
+
+    use super::*;
+    use crate::game::GameOptions;
+
+    /// Collects what the subscriber writes.
+    #[derive(Clone, Default)]
+    struct Captured(Arc<Mutex<Vec<u8>>>);
+
+    impl Write for Captured {
+        fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+            self.0.lock().map_err(|_| std::io::Error::other("poisoned"))?.extend_from_slice(buf);
+            Ok(buf.len())
+        }
+        fn flush(&mut self) -> std::io::Result<()> {
+            Ok(())
+        }
+    }
+
+    /// The session's events as `--log-format json` writes them, parsed back.
+    fn json_lines(write: impl FnOnce()) -> Vec<serde_json::Value> {
+        let captured = Captured::default();
+        let sink = captured.clone();
+        let subscriber = tracing_subscriber::fmt()
+            .json()
+            .flatten_event(true)
+            .with_writer(move || sink.clone())
+            .with_max_level(bevy::log::tracing::Level::INFO)
+            .finish();
+        bevy::log::tracing::subscriber::with_default(subscriber, write);
+        let bytes = captured.0.lock().map(|b| b.clone()).unwrap_or_default();
+        String::from_utf8_lossy(&bytes)
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("not JSON ({e}): {l}")))
+            .collect()
+    }
+
+    #[test]
+    fn every_session_event_is_one_json_object_naming_the_event_session_and_role() {
+        let game = Game::new(Level::museum(), &GameOptions { seed: 77, ..Default::default() });
+        let mut log = SessionLog { echo: LogEcho::Tracing, id: "0badc0de".into(), round: 1, ..Default::default() };
+        let lines = json_lines(|| {
+            log.record(0.0, Record::SessionCreated, "session created".into());
+            for event in [
+                GameEvent::Joined(Role::Phantom),
+                GameEvent::Left { role: Role::Vive, dropped: true },
+                GameEvent::Left { role: Role::Vive, dropped: false },
+                GameEvent::PhaseChanged(Phase::Heist),
+                GameEvent::CaseBroken(CaseId(0)),
+                GameEvent::PickedUp(ItemId(3)),
+                GameEvent::Delivered(ItemId(3)),
+                GameEvent::Verdict { item: ItemId(3), declared_real: true, outcome: VerdictOutcome::Secured },
+                GameEvent::GuardAlert { guard: GuardId(0), alert: GuardAlert::Chasing, position: Default::default() },
+                GameEvent::PhaseChanged(Phase::Lost(LossReason::Caught)),
+                GameEvent::RematchAsked(Role::Vive),
+                GameEvent::RoundStarted(2),
+            ] {
+                log.event(12.5, &game, &event);
+            }
+        });
+        let names: Vec<&str> = lines.iter().map(|l| l["event"].as_str().unwrap_or("?")).collect();
+        assert_eq!(
+            names,
+            [
+                "session_created",
+                "player_joined",
+                "player_dropped",
+                "player_left",
+                "phase",
+                "case_broken",
+                "item_picked",
+                "delivered",
+                "verdict",
+                "guard_alert",
+                "result",
+                "rematch_asked",
+                "round_started"
+            ]
+        );
+        for line in &lines {
+            assert_eq!(line["session"], "0badc0de", "{line}");
+            assert_eq!(line["target"], "session");
+            assert!(line["message"].is_string());
+            assert!(!line.to_string().contains(&game.seed.to_string()) || line["event"] == "result", "{line}");
+        }
+        assert_eq!(lines[1]["role"], "phantom");
+        assert_eq!(lines[2]["role"], "vive");
+        assert_eq!(lines[4]["phase"], "heist");
+        assert_eq!(lines[5]["case"], game.level.cases[0].id.as_str());
+        assert_eq!((lines[8]["outcome"].as_str(), lines[8]["role"].as_str()), (Some("secured"), Some("phantom")));
+        assert_eq!(lines[9]["alert"], "chasing");
+        assert_eq!((lines[10]["won"].as_bool(), lines[10]["reason"].as_str()), (Some(false), Some("caught")));
+        assert_eq!(lines[10]["seed"], "77", "the seed is told once the round is over (a string: it is 64 bits)");
+        assert_eq!(lines[10]["game_time_s"], 12.5);
+        assert_eq!(lines[12]["new_round"], 2);
+    }
 }

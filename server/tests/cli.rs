@@ -63,3 +63,93 @@ fn a_sweep_tallies_every_seed() {
     assert!(!bad.status.success());
     assert!(String::from_utf8_lossy(&bad.stderr).contains("--from 5 is after --to 2"));
 }
+
+/// Reads `child`'s stdout line by line on a thread, so the test can wait for a line with a deadline.
+fn lines_of(stream: impl std::io::Read + Send + 'static) -> std::sync::mpsc::Receiver<String> {
+    use std::io::BufRead as _;
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        for line in std::io::BufReader::new(stream).lines().map_while(Result::ok) {
+            if tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    rx
+}
+
+/// Waits for `child` to exit, killing it after `limit`.
+fn wait_for(child: &mut std::process::Child, limit: std::time::Duration) -> Option<std::process::ExitStatus> {
+    let deadline = std::time::Instant::now() + limit;
+    while std::time::Instant::now() < deadline {
+        if let Ok(Some(status)) = child.try_wait() {
+            return Some(status);
+        }
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    let _ = child.kill();
+    None
+}
+
+#[test]
+fn a_hosted_session_plays_two_rounds_for_two_bot_processes_logs_them_as_json_and_ends() {
+    use std::process::Stdio;
+    use std::time::{Duration, Instant};
+    let bin = env!("CARGO_BIN_EXE_heist-server");
+    // A free loopback port for UDP and TCP alike.
+    let port = std::net::UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
+    let addr = format!("127.0.0.1:{port}");
+    let mut host = Command::new(bin)
+        .args(["--log-format", "json", "host", "--bind", &addr, "--time-limit", "4", "--idle-end", "30"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let out = lines_of(host.stdout.take().unwrap());
+    let log = lines_of(host.stderr.take().unwrap());
+    let deadline = Instant::now() + Duration::from_secs(20);
+    let code = loop {
+        let line =
+            out.recv_timeout(deadline.saturating_duration_since(Instant::now())).expect("the host prints its code");
+        if let Some(rest) = line.strip_prefix("join code: ") {
+            break rest.split_whitespace().next().unwrap().to_owned();
+        }
+    };
+    let bot = |role: &str| {
+        Command::new(bin)
+            .args(["join", &addr, "--code", &code, "--role", role, "--vive", "idle", "--rounds", "2"])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    let mut bots = [bot("vive"), bot("phantom")];
+    // Two rounds of 4 s, then both bots leave and the empty session ends: the host exits by itself.
+    let status = wait_for(&mut host, Duration::from_secs(60));
+    for b in &mut bots {
+        let _ = wait_for(b, Duration::from_secs(5));
+    }
+    assert!(status.is_some_and(|s| s.success()), "the host exits 0 once the session is over: {status:?}");
+    let printed: Vec<String> = out.try_iter().collect();
+    assert_eq!(printed.last().map(String::as_str), Some("the session is over"), "{printed:?}");
+
+    let events: Vec<serde_json::Value> = log
+        .try_iter()
+        .filter_map(|l| serde_json::from_str::<serde_json::Value>(&l).ok())
+        .filter(|v| v["target"] == "session")
+        .collect();
+    let names: Vec<&str> = events.iter().filter_map(|e| e["event"].as_str()).collect();
+    let count = |n: &str| names.iter().filter(|&&x| x == n).count();
+    assert_eq!(count("session_created"), 1, "{names:?}");
+    assert_eq!(count("player_joined"), 2, "{names:?}");
+    assert_eq!(count("result"), 2, "two rounds were played: {names:?}");
+    assert_eq!(count("round_started"), 1, "{names:?}");
+    assert_eq!(count("player_left"), 2, "both bots left on purpose after the last round: {names:?}");
+    assert_eq!(count("session_ended"), 1, "{names:?}");
+    let id = events[0]["session"].as_str().unwrap();
+    assert!(events.iter().all(|e| e["session"] == id), "one session id throughout");
+    assert!(!events.iter().any(|e| e.to_string().contains(&code)), "the join code is never logged");
+    let results: Vec<_> = events.iter().filter(|e| e["event"] == "result").collect();
+    assert!(results.iter().all(|r| r["reason"] == "time" && r["won"] == false), "{results:?}");
+    assert_ne!(results[0]["seed"], results[1]["seed"], "each round has its own seed");
+}

@@ -209,7 +209,7 @@ pub fn app(
     if practising {
         app.add_systems(Update, quit_when_practice_is_over);
     } else {
-        app.add_systems(Update, quit_when_over);
+        app.add_systems(Update, (quit_when_over, tell_the_link));
     }
     Ok(app)
 }
@@ -253,23 +253,68 @@ fn quit_when_practice_is_over(
     }
 }
 
-/// Quits a few seconds after the heist ends (so the result is heard) or when the server goes away.
+/// After a result a player stays for another round (Enter) or leaves (Q); the bot leaves a few seconds
+/// after the result is heard. When the server lets us go, why is said and the client quits.
+#[allow(clippy::too_many_arguments)]
 fn quit_when_over(
     q: Query<&SessionView>,
     inbox: Res<heist_client::Inbox>,
     time: Res<Time<Real>>,
     mut over_at: Local<Option<f32>>,
+    mut gone_at: Local<Option<f32>>,
     state: Res<PhantomState>,
+    settings: Res<crate::PhantomSettings>,
+    mut leaving: ResMut<heist_client::Leaving>,
+    mut speaker: NonSendMut<crate::speech::Speaker>,
     mut exit: MessageWriter<AppExit>,
 ) {
-    let over =
-        q.iter().next().is_some_and(|s| matches!(s.phase, Phase::Won | Phase::Lost(_))) || inbox.disconnect.is_some();
     let now = time.elapsed_secs();
-    if over && over_at.is_none() {
+    let over = q.iter().next().is_some_and(|s| matches!(s.phase, Phase::Won | Phase::Lost(_)));
+    if !over {
+        *over_at = None;
+    } else if over_at.is_none() {
         *over_at = Some(now);
-        log::info!("the session is over after {} verdicts", state.verdicts.len());
+        log::info!("the round is over after {} verdicts", state.verdicts.len());
     }
-    if over_at.is_some_and(|t| now - t > 4.0) {
+    if settings.bot && over_at.is_some_and(|t| now - t > 4.0) {
+        leaving.start(time.elapsed_secs_f64());
+    }
+    if let Some(reason) = &inbox.disconnect
+        && gone_at.is_none()
+    {
+        *gone_at = Some(now);
+        speaker.say(heist_client::notice::disconnect_notice(reason));
+    }
+    if gone_at.is_some_and(|t| now - t > 3.0) {
+        exit.write(AppExit::Success);
+    }
+}
+
+/// Says when the server goes silent (3 s without a packet), comes back, or is gone; quits 3 s after it is
+/// gone (unless the server said why it let us go: [`quit_when_over`] says that).
+fn tell_the_link(
+    link: Res<heist_client::Link>,
+    inbox: Res<heist_client::Inbox>,
+    time: Res<Time<Real>>,
+    mut was: Local<heist_client::Link>,
+    mut gone_at: Local<Option<f32>>,
+    mut speaker: NonSendMut<crate::speech::Speaker>,
+    mut exit: MessageWriter<AppExit>,
+) {
+    let now = time.elapsed_secs();
+    if *link != *was {
+        let gone = *link == heist_client::Link::Gone;
+        if !(gone && inbox.disconnect.is_some())
+            && let Some(line) = heist_client::notice::link_notice(*was, *link)
+        {
+            speaker.say(line);
+            if gone {
+                *gone_at = Some(now);
+            }
+        }
+        *was = *link;
+    }
+    if gone_at.is_some_and(|t| now - t > 3.0) {
         exit.write(AppExit::Success);
     }
 }

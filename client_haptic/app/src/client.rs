@@ -16,7 +16,7 @@ use heist_client::Inbox;
 use heist_shared::artifact::{ArtifactKind, MaterialClass};
 use heist_shared::protocol::{
     ClientMsg, GameEvent, GuardAlert, GuardView, ItemId, ItemKind, ItemView, LobbyMsg, NoiseKind, PhantomMsg, Phase,
-    SessionView, VerdictOutcome, ViveAvatar, WarningKind,
+    Role, SessionView, VerdictOutcome, ViveAvatar, WarningKind,
 };
 
 use crate::audio::synth::{ContactParams, Earcon};
@@ -102,6 +102,11 @@ pub struct PhantomState {
 }
 
 impl PhantomState {
+    /// Forgets the last round (a rematch began); the greeting and the menu stay.
+    fn new_round(&mut self) {
+        *self = Self { greeted: self.greeted, ready_sent: true, menu: self.menu, ..Self::default() };
+    }
+
     /// True while the haptic side is busy with a copy in real time (a tree building or the bot
     /// exploring): a test stepping the clock by hand should keep to wall-clock time meanwhile.
     pub fn busy(&self) -> bool {
@@ -278,6 +283,8 @@ fn keys(
     mut speaker: NonSendMut<Speaker>,
     mut haptics: NonSendMut<Haptics>,
     mut out: MessageWriter<ClientMsg>,
+    mut leaving: Option<ResMut<heist_client::Leaving>>,
+    mut exit: MessageWriter<AppExit>,
 ) {
     let Some(keys) = keys else { return };
     let Some(s) = session(&q) else { return };
@@ -307,6 +314,20 @@ fn keys(
                 MenuItem::Briefing => speaker.say("The briefing comes when the heist begins."),
                 MenuItem::Status => speaker.say(status_line(&state)),
                 MenuItem::Help => speaker.say(status::HELP),
+            }
+        }
+    }
+    if matches!(s.phase, Phase::Won | Phase::Lost(_)) && keys.just_pressed(KeyCode::Enter) {
+        out.write(ClientMsg::Lobby(LobbyMsg::Rematch));
+    }
+    if keys.just_pressed(KeyCode::KeyQ) {
+        match leaving.as_mut() {
+            Some(leaving) => {
+                speaker.say("Leaving the session.");
+                leaving.start(time.elapsed_secs_f64());
+            }
+            None => {
+                exit.write(AppExit::Success);
             }
         }
     }
@@ -402,6 +423,13 @@ fn after_verdict(
     mut out: MessageWriter<ClientMsg>,
 ) {
     for HeistEvent(e) in events.read() {
+        if let GameEvent::RoundStarted(_) = e {
+            // A new round: the last round's copy, briefing and verdicts mean nothing now.
+            state.new_round();
+            haptics.clear();
+            bench.copy = None;
+            continue;
+        }
         if let GameEvent::Verdict { item, declared_real, outcome } = e {
             if *outcome != VerdictOutcome::Wrong {
                 if state.copy.is_some_and(|c| c.0 == *item) {
@@ -478,7 +506,9 @@ fn announce_events(
     mut speaker: NonSendMut<Speaker>,
     mut audio: NonSendMut<AudioEngine>,
     mut state: ResMut<PhantomState>,
+    settings: Res<PhantomSettings>,
 ) {
+    let bot = settings.bot;
     for HeistEvent(e) in events.read() {
         // A guard's alert is said once per change.
         if let GameEvent::GuardAlert { guard, alert, .. } = e
@@ -487,8 +517,12 @@ fn announce_events(
             continue;
         }
         let name = |id: u16| guards.iter().find(|g| g.id.0 == id).map(|g| g.name.clone());
-        if let Some(text) = status::announce(e, name) {
+        let text = status::announce(e, name).or_else(|| heist_client::notice::session_notice(e, Role::Phantom));
+        if let Some(text) = text {
             speaker.say(text);
+        }
+        if matches!(e, GameEvent::PhaseChanged(Phase::Won | Phase::Lost(_))) && !bot {
+            speaker.say("Enter asks for another round; Q leaves.");
         }
         match e {
             GameEvent::Verdict { outcome: VerdictOutcome::Wrong, .. } => audio.earcon(Earcon::Wrong),

@@ -39,7 +39,8 @@ impl MenuItem {
 
 /// The keys, spoken.
 pub const HELP: &str = "Keys: Y, the copy is real. N, it is fake. S, status. B, briefing. R, repeat the last message. \
-H, tell Vive to hide. G, tell Vive to go. C, tell Vive to come back. Arrow keys, page up and page down move your hand; \
+H, tell Vive to hide. G, tell Vive to go. C, tell Vive to come back. After a heist, Enter asks for another round. \
+Q leaves the session. Arrow keys, page up and page down move your hand; \
 or use your device and its buttons: first button real, second button fake.";
 
 /// "two minutes and five seconds".

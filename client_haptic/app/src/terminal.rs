@@ -24,15 +24,16 @@ pub fn key_for(line: &str) -> Option<KeyCode> {
         "h" | "hide" => KeyCode::KeyH,
         "g" | "go" => KeyCode::KeyG,
         "c" | "come back" => KeyCode::KeyC,
+        "q" | "quit" | "leave" => KeyCode::KeyQ,
         "up" => KeyCode::ArrowUp,
         "down" => KeyCode::ArrowDown,
-        "" | "enter" | "ready" => KeyCode::Enter,
+        "" | "enter" | "ready" | "again" | "another round" => KeyCode::Enter,
         _ => return None,
     })
 }
 
 /// What is said when a typed line is no key.
-const HELP: &str = "Type y, n, s, b, r, h, g, c, up, down, or just Enter.";
+const HELP: &str = "Type y, n, s, b, r, h, g, c, q, up, down, or just Enter.";
 
 #[derive(Resource)]
 struct Lines(Mutex<Receiver<String>>);

@@ -65,7 +65,7 @@ fn headless_practice_prints_each_spoken_line_once_and_nothing_else() {
     assert_eq!(count("You can feel it now."), 3, "{lines:#?}");
     assert_eq!(count("You say: "), 3, "{lines:#?}");
     assert_eq!(
-        count("Type y, n, s, b, r, h, g, c, up, down, or just Enter."),
+        count("Type y, n, s, b, r, h, g, c, q, up, down, or just Enter."),
         1,
         "the word that is no key: {lines:#?}"
     );
@@ -109,4 +109,112 @@ fn a_join_that_cannot_reach_the_host_fails_on_one_line_without_a_backtrace() {
     assert_eq!(lines.len(), 1, "one line: {err}");
     assert!(lines[0].starts_with("error: joining 127.0.0.1:1 as Phantom: cannot reach the token endpoint"), "{err}");
     assert_eq!(lines[0].matches("refused").count(), 1, "the cause once: {err}");
+}
+
+/// A host for the next test, on its own thread: a loopback server (4 s heists) and, once Phantom is in, a
+/// Vive bot that asks for another round after the first. Stepped at about 60 Hz of wall-clock time until
+/// `stop` is set; sends the join code, then the server's log at the end.
+fn host_with_a_vive_bot(
+    stop: std::sync::Arc<std::sync::atomic::AtomicBool>,
+) -> (std::net::SocketAddr, String, std::thread::JoinHandle<Vec<String>>) {
+    use heist_server::{ServerOptions, build_server};
+    use heist_shared::protocol::Role;
+    let (tx, rx) = mpsc::channel();
+    let host = std::thread::spawn(move || {
+        let mut options = ServerOptions::local_test(12);
+        options.game.time_limit_s = Some(4.0);
+        let mut server = build_server(options).expect("server starts");
+        let tokens = server.tokens.as_ref().expect("secure");
+        tx.send((tokens.addr, tokens.codes.current().code.clone())).expect("the test waits");
+        let mut vive: Option<bevy::app::App> = None;
+        let deadline = Instant::now() + Duration::from_secs(120);
+        while !stop.load(std::sync::atomic::Ordering::Relaxed) && Instant::now() < deadline {
+            server.app.update();
+            if vive.is_none() && server.game().is_present(Role::Phantom) {
+                let app = heist_server::demo::join(&server, Role::Vive, |app| {
+                    app.add_plugins(heist_bots::ViveBotPlugin { style: heist_bots::ViveStyle::Idle })
+                        .insert_resource(heist_bots::Rounds(2));
+                })
+                .expect("the Vive bot joins");
+                vive = Some(app);
+            }
+            if let Some(v) = vive.as_mut() {
+                v.update();
+            }
+            std::thread::sleep(Duration::from_millis(16));
+        }
+        server.log().to_vec()
+    });
+    let (addr, code) = rx.recv_timeout(Duration::from_secs(30)).expect("the host starts");
+    (addr, code, host)
+}
+
+#[test]
+fn a_blind_player_hears_the_partner_plays_a_rematch_and_leaves_by_typed_lines() {
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let (addr, code, host) = host_with_a_vive_bot(stop.clone());
+    let mut child = Command::new(env!("CARGO_BIN_EXE_client_haptic"))
+        .args(["join", &addr.to_string(), "--code", &code, "--headless", "--audio", "memory"])
+        .env_remove("RUST_LOG")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("client_haptic runs");
+    let mut stdin = child.stdin.take().expect("stdin");
+    let stdout = child.stdout.take().expect("stdout");
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+            if tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    // Ready when the partner is in; after the first result, Enter for another round; after the second, q.
+    let mut lines: Vec<String> = Vec::new();
+    let mut results = 0;
+    let deadline = Instant::now() + Duration::from_secs(90);
+    loop {
+        match rx.recv_timeout(Duration::from_millis(200)) {
+            Ok(line) => {
+                if line == "Vive joined." {
+                    writeln!(stdin).expect("types Enter: ready");
+                }
+                if line.starts_with("Enter asks for another round") {
+                    results += 1;
+                    writeln!(stdin, "{}", if results == 1 { "again" } else { "q" }).expect("types");
+                }
+                lines.push(line);
+            }
+            Err(RecvTimeoutError::Timeout) => {}
+            Err(RecvTimeoutError::Disconnected) => break,
+        }
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            stop.store(true, std::sync::atomic::Ordering::Relaxed);
+            panic!("the two rounds did not end within 90 s; Phantom heard {lines:#?}");
+        }
+    }
+    let status = child.wait().expect("waits");
+    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+    let log = host.join().expect("the host thread");
+    assert!(status.success(), "client_haptic exited with {status}");
+    println!("Phantom heard:\n{}", lines.join("\n"));
+    let at = |text: &str| {
+        lines.iter().position(|l| l.starts_with(text)).unwrap_or_else(|| panic!("{text:?} was never said: {lines:#?}"))
+    };
+    let order = [
+        at("Vive joined."),
+        at("The heist has begun."),
+        at("Time is up. The heist is lost."),
+        at("Round 2 begins"),
+        at("Leaving the session."),
+    ];
+    assert!(order.windows(2).all(|w| w[0] < w[1]), "said out of order: {lines:#?}");
+    assert!(lines.iter().any(|l| l == "Vive asks for another round." || l.starts_with("You asked for another round")));
+    assert_eq!(lines.iter().filter(|l| l.starts_with("The heist has begun.")).count(), 2, "{lines:#?}");
+    assert_eq!(lines.iter().filter(|l| l.starts_with("Time is up.")).count(), 2, "{lines:#?}");
+    assert!(log.iter().any(|l| l.ends_with("round 2 begins")), "{log:#?}");
+    assert!(log.iter().any(|l| l.ends_with("Phantom left")), "a clean leave, not a drop: {log:#?}");
 }

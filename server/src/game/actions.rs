@@ -103,6 +103,7 @@ impl Game {
         }
         self.items[usize::from(id.0)].place = ItemPlace::Carried;
         self.vive.carrying.push(id);
+        self.event(GameEvent::PickedUp(id));
         Ok(())
     }
 

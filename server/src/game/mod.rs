@@ -24,13 +24,35 @@ use rand_chacha::ChaCha8Rng;
 /// Seconds a player may be gone during a heist before it is lost as abandoned.
 pub const ABANDON_GRACE_S: f32 = 20.0;
 
+/// Seconds a session waits after a result for another round before it ends (unless
+/// [`GameOptions::idle_end_s`] says otherwise); also how long it outlives its last player.
+pub const SESSION_IDLE_S: f32 = 300.0;
+/// Seconds before an idle session ends at which both players are warned.
+pub const ENDING_WARNING_S: f32 = 60.0;
+
 /// Options that change a session without editing the level.
 #[derive(Clone, Debug, Default)]
 pub struct GameOptions {
-    /// Seed for copy traits, case assignment and guard decisions.
+    /// Seed for copy traits, case assignment and guard decisions (of the first round; each later round's
+    /// seed follows from it by [`next_round_seed`]).
     pub seed: u64,
     /// Replaces the level's time limit (seconds).
     pub time_limit_s: Option<f32>,
+    /// Replaces [`SESSION_IDLE_S`].
+    pub idle_end_s: Option<f32>,
+    /// Draw each later round's seed from the operating system instead of [`next_round_seed`]: what a
+    /// hosted session with a random first seed needs, since the host reads the log, where a round's seed
+    /// appears when it ends, and a derived seed would tell him the next round's real copies.
+    pub random_rounds: bool,
+}
+
+/// The seed of the round after one played on `seed` (SplitMix64), when rounds are reproducible (a given
+/// `--seed`, tests, the demo).
+pub fn next_round_seed(seed: u64) -> u64 {
+    let mut z = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
 }
 
 /// Who receives an outgoing message.
@@ -159,9 +181,18 @@ pub struct Game {
     pub present: (bool, bool),
     /// Where Phantom's tool was last reported (workbench frame), for Vive's client to draw.
     pub tool: PhantomTool,
-    /// The seed the session was made from (secret while it runs: it decides which copy is real).
+    /// The seed this round was made from (secret while it runs: it decides which copy is real).
     pub seed: u64,
+    /// The round being played: 1 for the first heist of the session, one more for each rematch.
+    pub round: u32,
+    /// Set once the session is over for good (idle after a result, or empty): the server closes it.
+    pub closed: bool,
+    options: GameOptions,
     ready: (bool, bool),
+    rematch: (bool, bool),
+    idle_s: f32,
+    warned_ending: bool,
+    joined_once: bool,
     absent_s: f32,
     noises: Vec<(Vec2, f32)>,
     outgoing: Vec<Outgoing>,
@@ -189,20 +220,33 @@ impl Game {
         setup::new_game(level, options)
     }
 
-    /// A player connected.
+    /// A player connected; the other is told.
     pub fn join(&mut self, role: Role) {
         set(&mut self.present, role, true);
+        self.joined_once = true;
+        self.event(GameEvent::Joined(role));
     }
 
-    /// A player disconnected.
-    pub fn leave(&mut self, role: Role) {
+    /// A player disconnected (`dropped`: the connection was lost rather than closed); the other is told.
+    pub fn leave(&mut self, role: Role, dropped: bool) {
         set(&mut self.present, role, false);
         set(&mut self.ready, role, false);
+        set(&mut self.rematch, role, false);
+        self.event(GameEvent::Left { role, dropped });
     }
 
-    /// True while the session has not ended.
+    /// True while the round has not ended.
     pub fn is_running(&self) -> bool {
         matches!(self.phase, Phase::Lobby | Phase::Heist)
+    }
+
+    /// Seconds the session has been idle (after a result, or with nobody in it after someone was).
+    pub fn idle_s(&self) -> f32 {
+        self.idle_s
+    }
+
+    fn idle_limit_s(&self) -> f32 {
+        self.options.idle_end_s.unwrap_or(SESSION_IDLE_S)
     }
 
     /// Applies one message from a player; a refusal changes nothing.
@@ -214,6 +258,16 @@ impl Game {
                 self.start_if_ready();
                 Ok(())
             }
+            ClientMsg::Lobby(LobbyMsg::Rematch) => {
+                if !get(self.rematch, role) {
+                    set(&mut self.rematch, role, true);
+                    self.event(GameEvent::RematchAsked(role));
+                }
+                self.start_round_if_agreed();
+                Ok(())
+            }
+            // The network layer closes the connection; `leave` follows from it.
+            ClientMsg::Lobby(LobbyMsg::Leave) => Ok(()),
             ClientMsg::Vive(m) => self.apply_vive(m),
             ClientMsg::Phantom(m) => self.apply_phantom(m),
             ClientMsg::Malformed(_) => unreachable!("verify refuses malformed messages"),
@@ -228,15 +282,65 @@ impl Game {
         }
     }
 
+    /// After a result, once both players are there and have asked: a new round on the next seed, same
+    /// level, roles and options. Vive's input numbering carries on, so his client's next move counts.
+    fn start_round_if_agreed(&mut self) {
+        if self.is_running() || self.closed || self.present != (true, true) || self.rematch != (true, true) {
+            return;
+        }
+        let mut options = self.options.clone();
+        options.seed = if self.options.random_rounds { rand::random() } else { next_round_seed(self.seed) };
+        let mut next = setup::new_game(self.level.clone(), &options);
+        next.options = self.options.clone();
+        next.round = self.round + 1;
+        next.present = self.present;
+        next.joined_once = true;
+        next.ready = (true, true);
+        next.vive.last_input_seq = self.vive.last_input_seq;
+        next.outgoing = std::mem::take(&mut self.outgoing);
+        *self = next;
+        self.event(GameEvent::RoundStarted(self.round));
+        self.start_if_ready();
+    }
+
     /// Advances the session by `dt` seconds.
     pub fn step(&mut self, dt: f32) {
-        if self.phase == Phase::Lobby {
-            self.start_if_ready();
+        match self.phase {
+            Phase::Lobby => {
+                self.start_if_ready();
+                // A lobby waits for its players; once someone came and everyone left, it idles.
+                let deserted = self.present == (false, false) && self.joined_once;
+                self.idle(dt, deserted);
+            }
+            Phase::Heist => self.step_heist(dt),
+            Phase::Won | Phase::Lost(_) => {
+                if self.present == (false, false) {
+                    self.closed = true;
+                }
+                self.idle(dt, true);
+            }
+        }
+    }
+
+    /// Counts idle time while `idle`, warns once a minute before the end, and closes the session at the limit.
+    fn idle(&mut self, dt: f32, idle: bool) {
+        if !idle || self.closed {
+            self.idle_s = 0.0;
+            self.warned_ending = false;
             return;
         }
-        if self.phase != Phase::Heist {
-            return;
+        self.idle_s += dt;
+        let limit = self.idle_limit_s();
+        if !self.warned_ending && limit > ENDING_WARNING_S && self.idle_s >= limit - ENDING_WARNING_S {
+            self.warned_ending = true;
+            self.event(GameEvent::EndingSoon(ENDING_WARNING_S as u32));
         }
+        if self.idle_s >= limit {
+            self.closed = true;
+        }
+    }
+
+    fn step_heist(&mut self, dt: f32) {
         self.elapsed_s += dt;
         self.time_left_s = (self.time_left_s - dt).max(0.0);
         self.move_vive(dt);

@@ -87,6 +87,13 @@ pub(super) fn new_game(level: Level, options: &GameOptions) -> Game {
         rng,
         level,
         seed: options.seed,
+        round: 1,
+        closed: false,
+        options: options.clone(),
+        rematch: (false, false),
+        idle_s: 0.0,
+        warned_ending: false,
+        joined_once: false,
         tool: Default::default(),
     }
 }

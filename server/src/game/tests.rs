@@ -10,7 +10,7 @@ use heist_shared::protocol::{
 use super::*;
 
 fn started(seed: u64) -> Game {
-    let mut g = Game::new(Level::museum(), &GameOptions { seed, time_limit_s: None });
+    let mut g = Game::new(Level::museum(), &GameOptions { seed, ..Default::default() });
     g.join(Role::Vive);
     g.join(Role::Phantom);
     g.apply(Role::Vive, &ClientMsg::Lobby(LobbyMsg::Ready)).unwrap();
@@ -144,7 +144,7 @@ fn three_wrong_verdicts_lock_the_museum_down() {
 
 #[test]
 fn the_timer_ends_the_heist() {
-    let mut g = Game::new(Level::museum(), &GameOptions { seed: 0, time_limit_s: Some(2.0) });
+    let mut g = Game::new(Level::museum(), &GameOptions { seed: 0, time_limit_s: Some(2.0), ..Default::default() });
     g.join(Role::Vive);
     g.join(Role::Phantom);
     g.apply(Role::Vive, &ClientMsg::Lobby(LobbyMsg::Ready)).unwrap();
@@ -344,4 +344,190 @@ fn a_warning_reaches_vive_and_phantom_hears_it_went_out() {
         matches!(sent[..], [Outgoing::All(ServerMsg::Event(GameEvent::Warning(WarningKind::Hide)))]),
         "one message, to both players: {sent:?}"
     );
+}
+
+/// A heist started with a short clock and run out on time (Vive waits at the exit).
+fn lost_on_time(seed: u64, idle_end_s: Option<f32>) -> Game {
+    let options = GameOptions { seed, time_limit_s: Some(1.0), idle_end_s, ..Default::default() };
+    let mut g = Game::new(Level::museum(), &options);
+    g.join(Role::Vive);
+    g.join(Role::Phantom);
+    g.apply(Role::Vive, &ClientMsg::Lobby(LobbyMsg::Ready)).unwrap();
+    g.apply(Role::Phantom, &ClientMsg::Lobby(LobbyMsg::Ready)).unwrap();
+    g.vive.position = g.level.exit;
+    for _ in 0..90 {
+        g.step(TICK_S);
+    }
+    assert_eq!(g.phase, Phase::Lost(LossReason::Time));
+    g
+}
+
+fn events(g: &mut Game) -> Vec<GameEvent> {
+    g.drain_outgoing()
+        .filter_map(|o| match o {
+            Outgoing::All(ServerMsg::Event(e)) => Some(e),
+            _ => None,
+        })
+        .collect()
+}
+
+#[test]
+fn both_players_hear_who_joins_and_who_leaves_and_how() {
+    let mut g = Game::new(Level::museum(), &GameOptions::default());
+    g.join(Role::Vive);
+    g.join(Role::Phantom);
+    g.leave(Role::Vive, true);
+    g.leave(Role::Phantom, false);
+    assert_eq!(
+        events(&mut g),
+        vec![
+            GameEvent::Joined(Role::Vive),
+            GameEvent::Joined(Role::Phantom),
+            GameEvent::Left { role: Role::Vive, dropped: true },
+            GameEvent::Left { role: Role::Phantom, dropped: false },
+        ]
+    );
+}
+
+#[test]
+fn a_rematch_starts_a_new_round_on_a_new_seed_once_both_ask() {
+    let mut g = lost_on_time(5, None);
+    let first_seed = g.seed;
+    g.vive.last_input_seq = 777;
+    events(&mut g);
+    let rematch = ClientMsg::Lobby(LobbyMsg::Rematch);
+    g.apply(Role::Vive, &rematch).unwrap();
+    g.apply(Role::Vive, &rematch).unwrap(); // asking twice is asking once
+    assert!(!g.is_running(), "one player's wish is not enough");
+    g.apply(Role::Phantom, &rematch).unwrap();
+    assert_eq!(g.phase, Phase::Heist, "both asked: the next round is on");
+    assert_eq!(g.round, 2);
+    assert_eq!(g.seed, next_round_seed(first_seed));
+    assert_ne!(g.seed, first_seed);
+    assert_eq!(g.present, (true, true), "same players");
+    assert_eq!(g.vive.last_input_seq, 777, "Vive's move numbers carry on");
+    assert_eq!(g.vive.position, g.level.vive_spawn);
+    assert!(g.time_left_s > 0.5 && g.time_left_s <= 1.0, "the options carry over: {}", g.time_left_s);
+    let out: Vec<Outgoing> = g.drain_outgoing().collect();
+    let said: Vec<&GameEvent> = out
+        .iter()
+        .filter_map(|o| match o {
+            Outgoing::All(ServerMsg::Event(e)) => Some(e),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(
+        said,
+        vec![
+            &GameEvent::RematchAsked(Role::Vive),
+            &GameEvent::RematchAsked(Role::Phantom),
+            &GameEvent::RoundStarted(2),
+            &GameEvent::PhaseChanged(Phase::Heist)
+        ]
+    );
+    assert!(
+        out.iter().any(|o| matches!(o, Outgoing::To(Role::Phantom, ServerMsg::Briefings(b)) if b.len() == 3)),
+        "Phantom is briefed on the new round's copies"
+    );
+    // The new round's copies differ from the first round's: which is real follows the new seed.
+    let again = Game::new(Level::museum(), &GameOptions { seed: first_seed, ..Default::default() });
+    let briefing = |g: &Game| g.targets.iter().map(|t| t.briefing.text.clone()).collect::<Vec<_>>();
+    assert_ne!(briefing(&g), briefing(&again));
+}
+
+#[test]
+fn a_hosted_session_with_a_secret_seed_draws_each_next_round_afresh() {
+    // The host reads round 1's seed in his log when it ends: round 2's must not follow from it.
+    let mut seeds = Vec::new();
+    for _ in 0..2 {
+        let options = GameOptions { seed: 5, time_limit_s: Some(1.0), random_rounds: true, ..Default::default() };
+        let mut g = Game::new(Level::museum(), &options);
+        g.join(Role::Vive);
+        g.join(Role::Phantom);
+        g.apply(Role::Vive, &ClientMsg::Lobby(LobbyMsg::Ready)).unwrap();
+        g.apply(Role::Phantom, &ClientMsg::Lobby(LobbyMsg::Ready)).unwrap();
+        for _ in 0..90 {
+            g.step(TICK_S);
+        }
+        g.apply(Role::Vive, &ClientMsg::Lobby(LobbyMsg::Rematch)).unwrap();
+        g.apply(Role::Phantom, &ClientMsg::Lobby(LobbyMsg::Rematch)).unwrap();
+        assert_eq!(g.round, 2);
+        assert_ne!(g.seed, next_round_seed(5));
+        seeds.push(g.seed);
+    }
+    assert_ne!(seeds[0], seeds[1], "two sessions from the same first seed part ways");
+}
+
+#[test]
+fn a_rematch_waits_for_a_partner_who_left_and_forgets_his_wish() {
+    let mut g = lost_on_time(6, None);
+    let rematch = ClientMsg::Lobby(LobbyMsg::Rematch);
+    g.apply(Role::Phantom, &rematch).unwrap();
+    g.leave(Role::Phantom, false);
+    g.apply(Role::Vive, &rematch).unwrap();
+    assert!(!g.is_running(), "Phantom is gone");
+    g.join(Role::Phantom);
+    g.step(TICK_S);
+    assert!(!g.is_running(), "a returning player has not asked again yet");
+    g.apply(Role::Phantom, &rematch).unwrap();
+    assert_eq!((g.phase, g.round), (Phase::Heist, 2));
+}
+
+#[test]
+fn another_round_cannot_be_asked_mid_heist() {
+    let mut g = started(8);
+    let asked = g.apply(Role::Vive, &ClientMsg::Lobby(LobbyMsg::Rematch));
+    assert_eq!(asked, Err(Refusal::WrongPhase(Phase::Heist)));
+}
+
+#[test]
+fn a_session_nobody_continues_warns_a_minute_before_it_closes() {
+    let mut g = lost_on_time(9, Some(90.0));
+    events(&mut g);
+    let mut warned_at = None;
+    let mut t = 0.0;
+    while !g.closed && t < 200.0 {
+        g.step(0.5);
+        t += 0.5;
+        if warned_at.is_none() && events(&mut g).contains(&GameEvent::EndingSoon(60)) {
+            warned_at = Some(t);
+        }
+    }
+    assert_eq!(warned_at, Some(30.0), "warned 60 s before the 90 s limit");
+    assert!(g.closed && (89.0..=91.0).contains(&t), "closed after {t} s");
+}
+
+#[test]
+fn a_rematch_resets_the_idle_clock_and_an_empty_finished_session_closes_at_once() {
+    let mut g = lost_on_time(10, Some(90.0));
+    for _ in 0..100 {
+        g.step(0.5);
+    }
+    let rematch = ClientMsg::Lobby(LobbyMsg::Rematch);
+    g.apply(Role::Vive, &rematch).unwrap();
+    g.apply(Role::Phantom, &rematch).unwrap();
+    assert_eq!(g.idle_s(), 0.0);
+    assert!(!g.closed);
+    let mut g = lost_on_time(11, None);
+    g.leave(Role::Vive, false);
+    g.step(TICK_S);
+    assert!(!g.closed, "Phantom is still there");
+    g.leave(Role::Phantom, true);
+    g.step(TICK_S);
+    assert!(g.closed, "nobody is left after the result");
+}
+
+#[test]
+fn a_lobby_waits_for_its_players_but_not_forever_once_they_all_went() {
+    let mut g = Game::new(Level::museum(), &GameOptions { idle_end_s: Some(10.0), ..Default::default() });
+    for _ in 0..100 {
+        g.step(0.5);
+    }
+    assert!(!g.closed, "nobody came yet: the host waits");
+    g.join(Role::Vive);
+    g.leave(Role::Vive, false);
+    for _ in 0..21 {
+        g.step(0.5);
+    }
+    assert!(g.closed);
 }

@@ -19,6 +19,8 @@ pub struct Player {
     pub strikes: f32,
     /// Set once the client is being disconnected for abuse.
     pub expelled: bool,
+    /// Set once the player said it is leaving (a clean quit, not a lost connection).
+    pub leaving: bool,
     /// How much of each message kind it may still send.
     pub limits: MessageLimits,
     /// Where it connects from (for the log).
@@ -105,12 +107,12 @@ pub(super) fn admit(
     *roles.slot(role) = Some(client);
     settings.roles.set(role, true);
     let limits = MessageLimits::new(time.elapsed_secs_f64());
-    commands
-        .entity(client)
-        .insert((Player { role, strikes: 0.0, expelled: false, limits, peer: peer_addr }, ClientRole(role)));
+    commands.entity(client).insert((
+        Player { role, strikes: 0.0, expelled: false, leaving: false, limits, peer: peer_addr },
+        ClientRole(role),
+    ));
     game.0.join(role);
     info!("{role} joined from {peer}");
-    log.line(game.0.elapsed_s, format!("{role} joined"));
     messages.write(ToClients {
         targets: SendTargets::Single(ClientId::Client(client)),
         message: ServerMsg::Welcome { role, level: Box::new(game.0.level.clone()) },
@@ -123,13 +125,11 @@ pub(super) fn forget(
     settings: Res<NetSettings>,
     mut roles: ResMut<Roles>,
     mut game: ResMut<GameState>,
-    mut log: ResMut<SessionLog>,
 ) {
     let Ok(player) = players.get(remove.entity) else { return };
     if roles.get(player.role) == Some(remove.entity) {
         *roles.slot(player.role) = None;
         settings.roles.set(player.role, false);
-        game.0.leave(player.role);
-        log.line(game.0.elapsed_s, format!("{} left", player.role));
+        game.0.leave(player.role, !player.leaving);
     }
 }

@@ -2,13 +2,13 @@
 //! [`Refusal::RateLimited`] and counts against the sender like any refusal, so a flood ends in a
 //! disconnection; nothing it asked for happens.
 
-use heist_shared::protocol::{ClientMsg, LobbyMsg, PhantomMsg, Refusal, ViveMsg};
+use heist_shared::protocol::{ClientMsg, PhantomMsg, Refusal, ViveMsg};
 use heist_transport::limit::{Bucket, Rate};
 
 /// The kinds of client message, each with its own rate (in [`MsgKind::ALL`]'s order).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MsgKind {
-    /// `Ready`.
+    /// The lobby's messages: `Ready`, `Rematch`, `Leave`.
     Ready,
     /// Vive's `Move`: one per tick.
     Move,
@@ -30,7 +30,7 @@ impl MsgKind {
     /// The kind of `msg`; `None` for a malformed one (refused anyway).
     pub fn of(msg: &ClientMsg) -> Option<Self> {
         Some(match msg {
-            ClientMsg::Lobby(LobbyMsg::Ready) => MsgKind::Ready,
+            ClientMsg::Lobby(_) => MsgKind::Ready,
             ClientMsg::Vive(ViveMsg::Move { .. }) => MsgKind::Move,
             ClientMsg::Vive(_) => MsgKind::Action,
             ClientMsg::Phantom(PhantomMsg::Verdict { .. }) => MsgKind::Verdict,

@@ -93,7 +93,7 @@ impl Plugin for ServerNetPlugin {
             .configure_sets(PreUpdate, NetSystems::Receive.after(ServerSystems::Receive))
             .configure_sets(PostUpdate, NetSystems::Send.before(ServerSystems::Send))
             .add_systems(PreUpdate, receive::apply_client_messages.in_set(NetSystems::Receive))
-            .add_systems(PostUpdate, send::send_outgoing.in_set(NetSystems::Send));
+            .add_systems(PostUpdate, (send::send_outgoing, close_session).chain().in_set(NetSystems::Send));
         transport::add_systems(app);
     }
 }
@@ -130,6 +130,52 @@ fn start_transport(
             commands.insert_resource(transport);
         }
         Err(e) => error!("cannot start the game transport on {addr}: {e}"),
+    }
+}
+
+/// Seconds between telling the players a session is over and the process exiting (so the message goes).
+const CLOSE_LINGER_S: f64 = 1.0;
+
+/// Once the game is closed (idle after a result, or deserted): tells each player why, lets them go, and a
+/// second later ends the app (`host` then exits 0).
+#[allow(clippy::too_many_arguments)]
+fn close_session(
+    game: Res<crate::session::GameState>,
+    roles: Res<Roles>,
+    mut log: ResMut<crate::session::SessionLog>,
+    mut messages: MessageWriter<ToClients<heist_shared::protocol::ServerMsg>>,
+    mut disconnects: MessageWriter<DisconnectRequest>,
+    mut exit: MessageWriter<AppExit>,
+    time: Res<Time<Real>>,
+    mut closed_at: Local<Option<f64>>,
+) {
+    if !game.0.closed {
+        return;
+    }
+    let now = time.elapsed_secs_f64();
+    match *closed_at {
+        None => {
+            *closed_at = Some(now);
+            let why = if game.0.present == (false, false) {
+                "nobody is left in it"
+            } else {
+                "nobody asked for another round"
+            };
+            info!("the session is over: {why}");
+            log.record(game.0.elapsed_s, crate::session::Record::SessionEnded, format!("session ended: {why}"));
+            for client in [roles.vive, roles.phantom].into_iter().flatten() {
+                admission::refuse_and_disconnect(
+                    client,
+                    heist_shared::protocol::DisconnectReason::SessionEnded,
+                    &mut messages,
+                    &mut disconnects,
+                );
+            }
+        }
+        Some(at) if now - at >= CLOSE_LINGER_S => {
+            exit.write(AppExit::Success);
+        }
+        Some(_) => {}
     }
 }
 

@@ -2,7 +2,7 @@
 
 use bevy::prelude::*;
 use bevy_replicon::prelude::*;
-use heist_shared::protocol::{ClientMsg, DisconnectReason, ServerMsg};
+use heist_shared::protocol::{ClientMsg, DisconnectReason, LobbyMsg, ServerMsg};
 
 use super::NetSettings;
 use super::admission::{Player, refuse_and_disconnect};
@@ -34,7 +34,12 @@ pub fn apply_client_messages(
             continue; // being disconnected: nothing more it says counts
         }
         let now = time.elapsed_secs_f64();
-        if let Err(refusal) = player.limits.check(message, now).and_then(|()| game.0.apply(player.role, message)) {
+        let applied = player.limits.check(message, now).and_then(|()| game.0.apply(player.role, message));
+        if applied.is_ok() && *message == ClientMsg::Lobby(LobbyMsg::Leave) {
+            player.leaving = true;
+            disconnects.write(DisconnectRequest { client });
+        }
+        if let Err(refusal) = applied {
             player.strikes += 1.0;
             let peer = player.peer.map_or_else(|| "?".to_owned(), |p| p.to_string());
             info!("refused a {} message from {peer}: {refusal:?}", player.role);

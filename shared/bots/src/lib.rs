@@ -7,7 +7,9 @@
 
 mod forecast;
 mod phantom;
+mod rounds;
 mod vive;
 
 pub use phantom::{PhantomBotPlugin, PhantomBrain};
+pub use rounds::Rounds;
 pub use vive::{Seen, Sight, Turn, ViveBotPlugin, ViveBrain, ViveStyle};

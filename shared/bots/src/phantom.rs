@@ -11,6 +11,7 @@ use heist_shared::protocol::{
 /// The Phantom bot's memory.
 #[derive(Resource, Default, Debug)]
 pub struct PhantomBrain {
+    round: u32,
     ready_sent: bool,
     pending: Option<(WorkbenchCopy, f32)>,
     last_verdict: Option<(ItemId, bool)>,
@@ -35,7 +36,9 @@ struct ThinkTime(f32);
 
 impl Plugin for PhantomBotPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<PhantomBrain>().insert_resource(ThinkTime(self.think_s)).add_systems(Update, play);
+        app.init_resource::<PhantomBrain>()
+            .insert_resource(ThinkTime(self.think_s))
+            .add_systems(Update, (play, crate::rounds::ask_for_another_round));
     }
 }
 
@@ -56,6 +59,11 @@ fn play(
     mut out: MessageWriter<ClientMsg>,
 ) {
     let Ok(session) = session.single() else { return };
+    let round = crate::rounds::current_round(&inbox);
+    if brain.round != round {
+        // A new round: nothing of the last one's copies counts (the first round is ready already).
+        *brain = PhantomBrain { round, ready_sent: brain.round != 0, ..Default::default() };
+    }
     if session.phase == Phase::Lobby && !brain.ready_sent && inbox.role.is_some() {
         out.write(ClientMsg::Lobby(LobbyMsg::Ready));
         brain.ready_sent = true;

@@ -38,6 +38,7 @@ const BREAK_PATIENCE_S: f32 = 12.0;
 #[derive(Resource, Default)]
 pub struct ViveBrain {
     style: ViveStyle,
+    round: u32,
     ready_sent: bool,
     seq: u32,
     map: Option<(NavGraph, WallSet, Vec2)>,
@@ -66,7 +67,8 @@ pub struct ViveBotPlugin {
 
 impl Plugin for ViveBotPlugin {
     fn build(&self, app: &mut App) {
-        app.insert_resource(ViveBrain::new(self.style)).add_systems(Update, play);
+        app.insert_resource(ViveBrain::new(self.style))
+            .add_systems(Update, (play, crate::rounds::ask_for_another_round));
     }
 }
 
@@ -219,7 +221,19 @@ impl Seen<'_, '_> {
     }
 }
 
-fn play(mut brain: ResMut<ViveBrain>, time: Res<Time>, seen: Seen, mut out: MessageWriter<ClientMsg>) {
+fn play(
+    mut brain: ResMut<ViveBrain>,
+    time: Res<Time>,
+    seen: Seen,
+    inbox: Res<heist_client::Inbox>,
+    mut out: MessageWriter<ClientMsg>,
+) {
+    let round = crate::rounds::current_round(&inbox);
+    if brain.round != round {
+        // A new round: plans of the last one go; the move numbers carry on, as the server's do.
+        let first = brain.round == 0;
+        *brain = ViveBrain { round, seq: brain.seq, ready_sent: !first, ..ViveBrain::new(brain.style) };
+    }
     let Some(sight) = seen.avatar().and_then(|me| seen.sight(me)) else { return };
     let turn = brain.think(&sight, time.delta_secs());
     if turn.ready {

@@ -7,6 +7,7 @@
 #![warn(missing_docs)]
 
 mod error;
+pub mod notice;
 mod token;
 pub mod transport;
 
@@ -43,6 +44,9 @@ pub struct Inbox {
     pub refusals: Vec<Refusal>,
     /// Why the server disconnected us, if it said so.
     pub disconnect: Option<DisconnectReason>,
+    /// The round being played (0 before the first `RoundStarted`, which a session's first round does not
+    /// send: read 0 as round 1). A new round clears the briefings and the workbench.
+    pub round: u32,
     /// Count of each kind of message received, for tests: (welcome, briefings, workbench, events).
     pub received: MessageCounts,
 }
@@ -78,8 +82,11 @@ impl Plugin for ClientNetPlugin {
         app.add_plugins((RepliconPlugins, bevy_replicon_renet::RepliconRenetPlugins))
             .add_plugins(heist_shared::protocol::ProtocolPlugin)
             .init_resource::<Inbox>()
+            .init_resource::<Leaving>()
+            .init_resource::<Link>()
             .configure_sets(PreUpdate, ClientNetSystems::Receive.after(ClientSystems::Receive))
-            .add_systems(PreUpdate, fill_inbox.in_set(ClientNetSystems::Receive));
+            .add_systems(PreUpdate, (fill_inbox, watch_link).in_set(ClientNetSystems::Receive))
+            .add_systems(Update, leave);
         transport::add_systems(app);
     }
 }
@@ -103,10 +110,87 @@ fn fill_inbox(mut messages: MessageReader<ServerMsg>, mut inbox: ResMut<Inbox>) 
                 inbox.received.workbench += 1;
             }
             ServerMsg::Event(e) => {
+                if let GameEvent::RoundStarted(n) = e {
+                    inbox.round = n;
+                    inbox.briefings.clear();
+                    inbox.workbench = None;
+                }
                 inbox.events.push(e);
                 inbox.received.events += 1;
             }
         }
+    }
+}
+
+/// Seconds of silence from the server after which the connection counts as lost (netcode sends a
+/// keep-alive several times a second when there is nothing else to send).
+pub const SILENCE_LOST_S: f64 = 3.0;
+
+/// The connection to the server, as the player should hear of it.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Link {
+    /// Nothing heard from the server yet.
+    #[default]
+    Connecting,
+    /// The server was heard within [`SILENCE_LOST_S`].
+    Up,
+    /// Silent for [`SILENCE_LOST_S`] or more: the connection may come back until netcode gives up.
+    Silent,
+    /// The transport stopped: the server let us go, or went silent until netcode's timeout (15 s).
+    Gone,
+}
+
+/// Updates [`Link`] from the transport (only on a change, so `is_changed` means a new state).
+fn watch_link(transport: Option<Res<transport::ClientTransport>>, time: Res<Time<Real>>, mut link: ResMut<Link>) {
+    let Some(transport) = transport else { return };
+    let state = if transport.stopped.is_some() {
+        Link::Gone
+    } else {
+        match transport.heard_at {
+            None => Link::Connecting,
+            Some(at) if (time.elapsed() - at).as_secs_f64() >= SILENCE_LOST_S => Link::Silent,
+            Some(_) => Link::Up,
+        }
+    };
+    if *link != state {
+        *link = state;
+    }
+}
+
+/// Leaving on purpose: set [`Leaving::since`] (or call [`Leaving::start`]) and the client says `Leave` to
+/// the server (so the partner hears "left", not "dropped"), waits for the server to close the connection
+/// (at most [`LEAVE_WAIT_S`]) and exits the app.
+#[derive(Resource, Default, Debug)]
+pub struct Leaving {
+    /// When the player asked to leave (app time, seconds); `None` while staying.
+    pub since: Option<f64>,
+    sent: bool,
+}
+
+/// Seconds a leaving client waits for the server to let it go before exiting anyway.
+pub const LEAVE_WAIT_S: f64 = 1.0;
+
+impl Leaving {
+    /// Starts leaving now (`now`: the app's real time, seconds).
+    pub fn start(&mut self, now: f64) {
+        self.since.get_or_insert(now);
+    }
+}
+
+fn leave(
+    mut leaving: ResMut<Leaving>,
+    inbox: Res<Inbox>,
+    time: Res<Time<Real>>,
+    mut out: MessageWriter<heist_shared::protocol::ClientMsg>,
+    mut exit: MessageWriter<AppExit>,
+) {
+    let Some(since) = leaving.since else { return };
+    if !leaving.sent {
+        leaving.sent = true;
+        out.write(heist_shared::protocol::ClientMsg::Lobby(heist_shared::protocol::LobbyMsg::Leave));
+    }
+    if inbox.disconnect.is_some() || time.elapsed_secs_f64() - since > LEAVE_WAIT_S {
+        exit.write(AppExit::Success);
     }
 }
 

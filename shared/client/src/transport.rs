@@ -21,13 +21,15 @@ pub struct ClientTransport {
     buffer: Box<[u8; socket::BUFFER_BYTES]>,
     /// Why the transport stopped, once it has.
     pub stopped: Option<String>,
+    /// When the server was last heard (a datagram from it that passed the checks), app real time.
+    pub heard_at: Option<std::time::Duration>,
 }
 
 impl ClientTransport {
     /// Serves `socket` (made non-blocking) for `intake`.
     pub fn new(socket: UdpSocket, intake: ClientIntake) -> std::io::Result<Self> {
         socket.set_nonblocking(true)?;
-        Ok(Self { socket, intake, buffer: Box::new([0; socket::BUFFER_BYTES]), stopped: None })
+        Ok(Self { socket, intake, buffer: Box::new([0; socket::BUFFER_BYTES]), stopped: None, heard_at: None })
     }
 
     /// Why netcode gave up, if it did.
@@ -78,15 +80,17 @@ fn stop(stopped: &mut Option<String>, error: TransportError) {
 }
 
 fn receive(mut transport: ResMut<ClientTransport>, mut renet: ResMut<RenetClient>, time: Res<Time<Real>>) {
-    let ClientTransport { socket, intake, buffer, stopped } = &mut *transport;
+    let ClientTransport { socket, intake, buffer, stopped, heard_at } = &mut *transport;
     let mut send = send_to(socket);
     if let Err(e) = intake.begin_update(&mut renet, &mut send) {
         stop(stopped, e);
         return;
     }
+    let now = time.elapsed();
     let drained = socket::drain(socket, buffer, MAX_DATAGRAMS_PER_FRAME, |from, datagram| {
-        if let Err(r) = intake.receive(from, datagram, &mut renet) {
-            debug!("refused a datagram from {from}: {r}");
+        match intake.receive(from, datagram, &mut renet) {
+            Ok(()) => *heard_at = Some(now),
+            Err(r) => debug!("refused a datagram from {from}: {r}"),
         }
     });
     if let Err(e) = drained {

@@ -29,6 +29,12 @@ pub enum ClientMsg {
 pub enum LobbyMsg {
     /// The player is ready; the heist starts once both players are present and ready.
     Ready,
+    /// After a result: the player wants another round (new seed, same roles, same join code); it starts
+    /// as soon as both players have asked.
+    Rematch,
+    /// The player is leaving on purpose (the partner hears "left", not "dropped"); the server then closes
+    /// the connection.
+    Leave,
 }
 
 /// Vive's movement gait.

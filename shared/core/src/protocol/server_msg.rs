@@ -106,6 +106,23 @@ pub enum GameEvent {
     Alarm(u8),
     /// Phantom warns Vive.
     Warning(WarningKind),
+    /// A player came into the session (the first time or again).
+    Joined(Role),
+    /// A player went away: `dropped` when the connection was lost rather than closed by the player.
+    Left {
+        /// Who.
+        role: Role,
+        /// Lost connection (true) or closed by the player (false).
+        dropped: bool,
+    },
+    /// After a result, a player asked for another round.
+    RematchAsked(Role),
+    /// A new round began (the first round is 1): forget the last round's copies and briefings.
+    RoundStarted(u32),
+    /// The session ends in this many seconds unless someone asks for another round.
+    EndingSoon(u32),
+    /// Vive picked an item up.
+    PickedUp(ItemId),
 }
 
 /// Why an input was refused. Sent as data; the session goes on.
@@ -152,4 +169,6 @@ pub enum DisconnectReason {
     BadToken,
     /// Too many refused or malformed messages.
     Abuse,
+    /// The session is over: nobody asked for another round in time, or nobody was left in it.
+    SessionEnded,
 }

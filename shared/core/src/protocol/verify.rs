@@ -1,6 +1,6 @@
 //! The single check of which messages each role may send in which phase.
 
-use super::client_msg::{ClientMsg, PhantomMsg};
+use super::client_msg::{ClientMsg, LobbyMsg, PhantomMsg};
 use super::ids::Role;
 use super::replicated::Phase;
 use super::server_msg::Refusal;
@@ -11,7 +11,9 @@ pub fn verify(role: Role, phase: Phase, msg: &ClientMsg) -> Result<(), Refusal> 
     use super::client_msg::ViveMsg as V;
     match msg {
         ClientMsg::Malformed(reason) => Err(Refusal::Malformed(reason.clone())),
-        ClientMsg::Lobby(_) => Ok(()),
+        ClientMsg::Lobby(LobbyMsg::Ready | LobbyMsg::Leave) => Ok(()),
+        ClientMsg::Lobby(LobbyMsg::Rematch) if matches!(phase, Phase::Won | Phase::Lost(_)) => Ok(()),
+        ClientMsg::Lobby(LobbyMsg::Rematch) => Err(Refusal::WrongPhase(phase)),
         ClientMsg::Vive(_) if role != Role::Vive => Err(Refusal::WrongRole),
         ClientMsg::Phantom(_) if role != Role::Phantom => Err(Refusal::WrongRole),
         ClientMsg::Phantom(PhantomMsg::Warn(_) | PhantomMsg::ToolPose { .. }) if phase == Phase::Lobby => {
@@ -49,7 +51,7 @@ fn check_phantom_numbers(msg: &ClientMsg) -> Result<(), Refusal> {
 mod tests {
     use glam::Vec2;
 
-    use super::super::{ItemId, LobbyMsg, ViveMsg};
+    use super::super::{ItemId, ViveMsg};
     use super::*;
 
     fn mv(direction: Vec2) -> ClientMsg {
@@ -78,5 +80,15 @@ mod tests {
         assert_eq!(verify(Role::Vive, Phase::Lobby, &mv(Vec2::X)), Err(Refusal::WrongPhase(Phase::Lobby)));
         assert_eq!(verify(Role::Vive, Phase::Lobby, &ClientMsg::Lobby(LobbyMsg::Ready)), Ok(()));
         assert!(verify(Role::Vive, Phase::Won, &mv(Vec2::X)).is_err());
+    }
+
+    #[test]
+    fn another_round_can_be_asked_only_after_a_result() {
+        let rematch = ClientMsg::Lobby(LobbyMsg::Rematch);
+        assert_eq!(verify(Role::Vive, Phase::Heist, &rematch), Err(Refusal::WrongPhase(Phase::Heist)));
+        assert_eq!(verify(Role::Phantom, Phase::Lobby, &rematch), Err(Refusal::WrongPhase(Phase::Lobby)));
+        assert_eq!(verify(Role::Phantom, Phase::Won, &rematch), Ok(()));
+        let lost = Phase::Lost(super::super::LossReason::Time);
+        assert_eq!(verify(Role::Vive, lost, &rematch), Ok(()));
     }
 }

@@ -1,0 +1,133 @@
+//! A session over its life, over loopback UDP with secure tokens: rounds and rematches, who is told what
+//! when a player comes, leaves or drops, and the end of a session nobody continues.
+
+use heist_bots::ViveStyle;
+use heist_server::ServerOptions;
+use heist_server::build_server;
+use heist_server::game::next_round_seed;
+use heist_shared::protocol::{ClientMsg, DisconnectReason, GameEvent, LobbyMsg, LossReason, Phase, Role};
+use heist_tests::{HZ, Heist, Session};
+
+/// Both plain clients joined and ready; the heist runs on a `time_limit_s` clock.
+fn started(seed: u64, time_limit_s: f32, idle_end_s: Option<f32>) -> (Session, usize, usize) {
+    let mut options = ServerOptions::local_test(seed);
+    options.game.time_limit_s = Some(time_limit_s);
+    options.game.idle_end_s = idle_end_s;
+    let mut s = Session::with_options(options);
+    let vive = s.join(Role::Vive, |_| {});
+    let phantom = s.join(Role::Phantom, |_| {});
+    assert!(s.step_until(5 * HZ, |s| s.server.game().present == (true, true)), "both are admitted");
+    s.send(vive, ClientMsg::Lobby(LobbyMsg::Ready));
+    s.send(phantom, ClientMsg::Lobby(LobbyMsg::Ready));
+    assert!(s.step_until(5 * HZ, |s| s.server.game().phase == Phase::Heist), "the heist starts");
+    (s, vive, phantom)
+}
+
+fn events_of(s: &Session, client: usize) -> &[GameEvent] {
+    &s.inbox(client).events
+}
+
+#[test]
+fn a_rematch_asked_by_both_plays_a_second_heist_on_a_new_seed_with_the_same_players() {
+    // Careful bots on a short clock: they break cases and judge copies in both rounds.
+    let mut options = ServerOptions::local_test(10);
+    options.game.time_limit_s = Some(150.0);
+    let mut heist = Heist::join_for_rounds(build_server(options).expect("server starts"), ViveStyle::Careful, 2)
+        .expect("the bots join");
+    let first = heist.run(160.0);
+    assert!(matches!(first, Phase::Won | Phase::Lost(_)), "round 1 ended: {first:?}");
+    let first_seed = heist.results[0].seed;
+    assert_eq!(first_seed, 10);
+    assert!(heist.await_next_round(10.0), "both bots asked and round 2 began");
+    let game = heist.server.game();
+    assert_eq!((game.round, game.seed), (2, next_round_seed(first_seed)));
+    assert_eq!(game.present, (true, true));
+    let second = heist.run(160.0);
+    assert!(matches!(second, Phase::Won | Phase::Lost(_)), "round 2 ended: {second:?}");
+
+    let log = heist.server.log().to_vec();
+    let begins = log.iter().position(|l| l.contains("round 2 begins")).expect("round 2 is logged");
+    let round_two = &log[begins..];
+    let all = log.join("\n");
+    assert!(round_two.iter().any(|l| l.contains("broken")), "Vive played round 2 too:\n{all}");
+    assert!(round_two.iter().any(|l| l.contains("Phantom declares")), "Phantom judged in round 2:\n{all}");
+    assert!(log.iter().filter(|l| l.contains("asks for another round")).count() == 2, "{all}");
+    assert_eq!(log.iter().filter(|l| l.contains("phase: Won") || l.contains("phase: Lost")).count(), 2);
+    // Phantom was briefed twice, each time on that round's copies; Vive heard the round begin.
+    let phantom = heist.phantom.world().resource::<heist_client::Inbox>();
+    assert_eq!((phantom.received.briefings, phantom.round), (2, 2));
+    let vive = heist.vive.world().resource::<heist_client::Inbox>();
+    assert!(vive.refusals.is_empty(), "Vive's moves of round 2 were all accepted: {:?}", vive.refusals);
+}
+
+#[test]
+fn a_rematch_needs_both_and_a_partner_hears_the_request() {
+    let (mut s, vive, phantom) = started(4, 1.0, None);
+    assert!(s.step_until(3 * HZ, |s| !s.server.game().is_running()));
+    assert_eq!(s.server.game().phase, Phase::Lost(LossReason::Time));
+    s.send(vive, ClientMsg::Lobby(LobbyMsg::Rematch));
+    s.step_until(HZ, |_| false);
+    assert!(!s.server.game().is_running(), "one wish is not enough");
+    assert!(events_of(&s, phantom).contains(&GameEvent::RematchAsked(Role::Vive)), "Phantom hears Vive ask");
+    s.send(phantom, ClientMsg::Lobby(LobbyMsg::Rematch));
+    assert!(s.step_until(2 * HZ, |s| s.server.game().phase == Phase::Heist), "round 2 begins");
+    assert!(s.step_until(HZ, |s| s.inbox(vive).round == 2 && s.inbox(phantom).received.briefings == 2));
+    assert!(events_of(&s, vive).contains(&GameEvent::RoundStarted(2)));
+    assert_eq!(s.client_phase(vive), Some(Phase::Heist));
+}
+
+#[test]
+fn a_player_who_leaves_is_heard_as_left_and_one_who_vanishes_as_dropped() {
+    let (mut s, vive, phantom) = started(5, 600.0, None);
+    assert!(events_of(&s, vive).contains(&GameEvent::Joined(Role::Phantom)), "Vive heard Phantom join");
+    s.send(phantom, ClientMsg::Lobby(LobbyMsg::Leave));
+    let left = GameEvent::Left { role: Role::Phantom, dropped: false };
+    assert!(s.step_until(3 * HZ, |s| events_of(s, vive).contains(&left)), "Vive hears Phantom left");
+    assert!(!s.server.game().is_present(Role::Phantom));
+
+    // A new Phantom comes, then its process dies without a word: the server notices it dropped.
+    let again = s.join(Role::Phantom, |_| {});
+    assert!(s.step_until(5 * HZ, |s| s.server.game().is_present(Role::Phantom)), "the seat was free");
+    drop(s.clients.remove(again));
+    let dropped = GameEvent::Left { role: Role::Phantom, dropped: true };
+    assert!(s.step_until(20 * HZ, |s| events_of(s, vive).contains(&dropped)), "Vive hears the drop");
+    assert_eq!(s.server.game().phase, Phase::Heist, "within the grace period the heist goes on");
+}
+
+#[test]
+fn a_session_nobody_continues_ends_and_both_players_are_told() {
+    let (mut s, vive, phantom) = started(6, 1.0, Some(5.0));
+    assert!(s.step_until(3 * HZ, |s| !s.server.game().is_running()));
+    let told = |s: &Session, c: usize| s.inbox(c).disconnect == Some(DisconnectReason::SessionEnded);
+    assert!(s.step_until(8 * HZ, |s| told(s, vive) && told(s, phantom)), "both were told the session ended");
+    assert!(s.server.game().closed);
+    assert!(s.server.log().iter().any(|l| l.contains("session ended: nobody asked for another round")));
+}
+
+#[test]
+fn a_client_notices_within_seconds_that_the_server_went_silent_and_when_it_is_back() {
+    use heist_client::{Link, SILENCE_LOST_S};
+    use std::time::{Duration, Instant};
+    let (mut s, vive, phantom) = started(7, 600.0, None);
+    let link = |s: &Session, c: usize| *s.clients[c].world().resource::<Link>();
+    assert_eq!((link(&s, vive), link(&s, phantom)), (Link::Up, Link::Up));
+    // The server stalls (its process hangs, or the network drops everything): only the clients run.
+    let stalled = Instant::now();
+    let mut lost_after = None;
+    while stalled.elapsed() < Duration::from_secs(8) {
+        for c in &mut s.clients {
+            c.update();
+        }
+        if link(&s, vive) == Link::Silent && link(&s, phantom) == Link::Silent {
+            lost_after = Some(stalled.elapsed());
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(16));
+    }
+    let lost_after = lost_after.expect("both clients noticed the silence");
+    // Not before the threshold (counted from the server's last packet, which may predate the stall by a
+    // frame or two); well before netcode's 15 s timeout (the margin is for a loaded machine).
+    assert!(lost_after.as_secs_f64() >= SILENCE_LOST_S - 0.5, "{lost_after:?}");
+    assert!(lost_after < Duration::from_secs(6), "{lost_after:?}");
+    assert!(s.step_until(3 * HZ, |s| link(s, vive) == Link::Up && link(s, phantom) == Link::Up), "back");
+}
