@@ -502,7 +502,7 @@ fn touch_bot(
 fn announce_events(
     mut events: MessageReader<HeistEvent>,
     guards: Query<&GuardView>,
-    mut spoken_alerts: Local<HashMap<u16, GuardAlert>>,
+    mut spoken_alerts: Local<AlertMemory>,
     mut speaker: NonSendMut<Speaker>,
     mut audio: NonSendMut<AudioEngine>,
     mut state: ResMut<PhantomState>,
@@ -510,10 +510,7 @@ fn announce_events(
 ) {
     let bot = settings.bot;
     for HeistEvent(e) in events.read() {
-        // A guard's alert is said once per change.
-        if let GameEvent::GuardAlert { guard, alert, .. } = e
-            && spoken_alerts.insert(guard.0, *alert) == Some(*alert)
-        {
+        if !spoken_alerts.is_news(e) {
             continue;
         }
         let name = |id: u16| guards.iter().find(|g| g.id.0 == id).map(|g| g.name.clone());
@@ -536,6 +533,24 @@ fn announce_events(
     if let Some(kind) = state.arrived.take() {
         audio.earcon(Earcon::CopyArrived);
         speaker.say(status::copy_arrived(kind));
+    }
+}
+
+/// Each guard's alert is said once per change, and a new round starts every guard afresh.
+#[derive(Default)]
+struct AlertMemory(HashMap<u16, GuardAlert>);
+
+impl AlertMemory {
+    /// False for a guard's alert already said; true for everything else.
+    fn is_news(&mut self, event: &GameEvent) -> bool {
+        match event {
+            GameEvent::RoundStarted(_) => {
+                self.0.clear();
+                true
+            }
+            GameEvent::GuardAlert { guard, alert, .. } => self.0.insert(guard.0, *alert) != Some(*alert),
+            _ => true,
+        }
     }
 }
 
@@ -676,6 +691,18 @@ mod tests {
                 ..Default::default()
             })
             .collect()
+    }
+
+    #[test]
+    fn a_guards_alert_is_said_once_per_change_and_afresh_in_a_new_round() {
+        use heist_shared::protocol::GuardId;
+        let alert = |a| GameEvent::GuardAlert { guard: GuardId(1), alert: a, position: Vec2::ZERO };
+        let mut memory = AlertMemory::default();
+        assert!(memory.is_news(&alert(GuardAlert::Suspicious)));
+        assert!(!memory.is_news(&alert(GuardAlert::Suspicious)), "said once");
+        assert!(memory.is_news(&alert(GuardAlert::Chasing)));
+        assert!(memory.is_news(&GameEvent::RoundStarted(2)));
+        assert!(memory.is_news(&alert(GuardAlert::Chasing)), "a new round: the same alert is news again");
     }
 
     #[test]
