@@ -180,8 +180,8 @@ fn track_session(q: Query<&SessionView>, mut state: ResMut<ViveState>, time: Res
         let text = match session.phase {
             Phase::Lobby => "In the lobby".to_owned(),
             Phase::Heist => "The heist is on".to_owned(),
-            Phase::Won => "RESULT: won. Enter asks for another round".to_owned(),
-            Phase::Lost(why) => format!("RESULT: lost ({why}). Enter asks for another round"),
+            Phase::Won => "RESULT: won. Enter (or a trigger) asks for another round".to_owned(),
+            Phase::Lost(why) => format!("RESULT: lost ({why}). Enter (or a trigger) asks for another round"),
         };
         if session.phase == Phase::Heist {
             state.ended_s = 0.0;

@@ -14,7 +14,8 @@
 //! - the main hand's stick: snap turn (30°);
 //! - walking in the room moves the body too (the head pulls it); walls hold the view back;
 //! - crouching in the room crouches (standing mode); seated mode lifts the view to standing height;
-//! - holding both grips with empty hands for 1.5 s recentres.
+//! - holding both grips with empty hands for 1.5 s recentres;
+//! - after a result, a trigger pull asks for another round (as Enter does on the desktop).
 //!
 //! Controllers pulse on a grab and on breaking glass ([`Pulse`]).
 
@@ -33,7 +34,7 @@ use bevy_mod_openxr::session::OxrSession;
 use bevy_mod_openxr::{openxr_session_available, openxr_session_running};
 use bevy_mod_xr::session::{XrPreDestroySession, XrSessionCreated, XrTrackingRoot};
 use glam::{Vec2, Vec3};
-use heist_shared::protocol::{CaseView, Gait, ItemPlace, ItemView};
+use heist_shared::protocol::{CaseView, Gait, ItemPlace, ItemView, Phase};
 use heist_shared::rules;
 use openxr::{Action, ActionSet, Haptic, Path, Posef, Vector2f};
 
@@ -474,6 +475,9 @@ fn read_hands(
             let bench = state.level.as_ref().map(|l| l.workbench);
             let at_bench = bench.is_some_and(|b| b.distance(space::floor(hand_pos[hand])) < rules::REACH);
             intent.actions.push(if at_bench { Do::Place(item) } else { Do::Drop(item) });
+        }
+        if trigger && !hs.triggered[hand] && matches!(state.phase, Phase::Won | Phase::Lost(_)) {
+            intent.actions.push(Do::Rematch);
         }
         if trigger
             && !hs.triggered[hand]
