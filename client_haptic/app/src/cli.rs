@@ -44,6 +44,8 @@ pub enum AudioChoice {
 pub enum Command {
     /// Join a session as Phantom.
     Join(JoinArgs),
+    /// Host a session (the server runs in this client) and join it as Phantom; the join code is spoken.
+    Host(crate::host::HostArgs),
     /// Practise at the workbench offline: the copies of one artifact, one after another.
     Practice(PracticeArgs),
     /// List the device presets and the HID devices found.
@@ -220,6 +222,8 @@ pub fn app(
 fn quiet_log() -> bevy::log::LogPlugin {
     bevy::log::LogPlugin {
         level: bevy::log::Level::WARN,
+        // netcode logs an error each time the server closes the connection, which the client says itself.
+        filter: format!("{},renetcode=off", bevy::log::DEFAULT_FILTER),
         fmt_layer: |_| {
             use std::io::IsTerminal as _;
             let layer = bevy::log::tracing_subscriber::fmt::Layer::default()
@@ -292,19 +296,22 @@ fn quit_when_over(
 
 /// Says when the server goes silent (3 s without a packet), comes back, or is gone; quits 3 s after it is
 /// gone (unless the server said why it let us go: [`quit_when_over`] says that).
+#[allow(clippy::too_many_arguments)]
 fn tell_the_link(
     link: Res<heist_client::Link>,
     inbox: Res<heist_client::Inbox>,
     time: Res<Time<Real>>,
     mut was: Local<heist_client::Link>,
     mut gone_at: Local<Option<f32>>,
+    leaving: Res<heist_client::Leaving>,
     mut speaker: NonSendMut<crate::speech::Speaker>,
     mut exit: MessageWriter<AppExit>,
 ) {
     let now = time.elapsed_secs();
     if *link != *was {
         let gone = *link == heist_client::Link::Gone;
-        if !(gone && inbox.disconnect.is_some())
+        // Gone because we left, or because the server said why: nothing more to say.
+        if !(gone && (inbox.disconnect.is_some() || leaving.since.is_some()))
             && let Some(line) = heist_client::notice::link_notice(*was, *link)
         {
             speaker.say(line);

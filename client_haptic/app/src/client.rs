@@ -72,6 +72,11 @@ pub struct VerdictRecord {
     pub findings: Option<Findings>,
 }
 
+/// When this client hosts: the lines that give the partner the address and the join code, said after the
+/// welcome.
+#[derive(Resource, Clone, Debug)]
+pub struct HostedCode(pub Vec<String>);
+
 /// The Phantom client's memory.
 #[derive(Resource, Default, Debug)]
 pub struct PhantomState {
@@ -244,6 +249,7 @@ fn lobby(
     inbox: Res<Inbox>,
     q: Query<&SessionView>,
     settings: Res<PhantomSettings>,
+    hosted: Option<Res<HostedCode>>,
     mut speaker: NonSendMut<Speaker>,
     mut out: MessageWriter<ClientMsg>,
 ) {
@@ -257,6 +263,10 @@ fn lobby(
             "Welcome to Phantom Heist. You are Phantom, at the workbench. Up and down read the menu; Enter chooses.",
         );
         speaker.say(MenuItem::ALL[0].label());
+        // Last, so R repeats the spelled code.
+        for line in hosted.iter().flat_map(|h| h.0.iter()) {
+            speaker.say(line.clone());
+        }
     }
     if settings.bot && s.phase == Phase::Lobby && !state.ready_sent {
         out.write(ClientMsg::Lobby(LobbyMsg::Ready));

@@ -13,6 +13,7 @@ pub mod device;
 pub mod error;
 pub mod explore;
 pub mod haptics;
+pub mod host;
 pub mod practice;
 #[cfg(feature = "spectator")]
 pub mod spectator;

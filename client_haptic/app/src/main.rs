@@ -18,6 +18,7 @@ fn main() -> std::process::ExitCode {
 fn run() -> anyhow::Result<()> {
     match Cli::parse().command {
         Command::Join(args) => join(&args),
+        Command::Host(args) => client_haptic::host::host(&args),
         Command::Practice(args) => practice(&args),
         Command::Devices => devices(),
     }

@@ -218,3 +218,70 @@ fn a_blind_player_hears_the_partner_plays_a_rematch_and_leaves_by_typed_lines() 
     assert!(log.iter().any(|l| l.ends_with("round 2 begins")), "{log:#?}");
     assert!(log.iter().any(|l| l.ends_with("Phantom left")), "a clean leave, not a drop: {log:#?}");
 }
+
+#[test]
+fn a_blind_player_hosts_alone_hears_the_code_spelled_and_a_partner_joins_with_it() {
+    use heist_shared::protocol::{Role, TICK_HZ};
+    let port = std::net::UdpSocket::bind("127.0.0.1:0").expect("a free port").local_addr().expect("addr").port();
+    let bind = format!("127.0.0.1:{port}");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_client_haptic"))
+        .args(["host", "--bind", &bind, "--headless", "--audio", "memory"])
+        .env_remove("RUST_LOG")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("client_haptic runs");
+    let mut stdin = child.stdin.take().expect("stdin");
+    let stdout = child.stdout.take().expect("stdout");
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+            if tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    let mut lines: Vec<String> = Vec::new();
+    let mut vive: Option<bevy::app::App> = None;
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let mut done = false;
+    while !done {
+        assert!(Instant::now() < deadline, "no partner joined within 60 s; Phantom heard {lines:#?}");
+        while let Ok(line) = rx.try_recv() {
+            // The code as a sighted or screen-reader user reads it off the line, and a partner joins with it.
+            if let Some(code) = line.split("with the code ").nth(1).map(|c| c.trim_end_matches('.').to_owned()) {
+                let token =
+                    heist_client::request_token(bind.parse().expect("addr"), &code, Role::Vive, Duration::from_secs(5))
+                        .expect("the spoken code admits the partner");
+                let mut app = heist_server::demo::stepped_client_app();
+                app.add_plugins(heist_bots::ViveBotPlugin { style: heist_bots::ViveStyle::Idle });
+                app.finish();
+                app.cleanup();
+                heist_client::connect(&mut app, token).expect("connects");
+                vive = Some(app);
+            }
+            if line == "Vive joined." {
+                writeln!(stdin, "q").expect("types q: leave");
+            }
+            if line == "Leaving the session." {
+                done = true;
+            }
+            lines.push(line);
+        }
+        if let Some(v) = vive.as_mut() {
+            v.update();
+        }
+        std::thread::sleep(Duration::from_secs_f64(1.0 / TICK_HZ));
+    }
+    let status = child.wait().expect("waits");
+    assert!(status.success(), "client_haptic exited with {status}: {lines:#?}");
+    let hosted = lines.iter().find(|l| l.starts_with("You host the heist.")).expect("the host line");
+    let code = hosted.split("with the code ").nth(1).expect("a code").trim_end_matches('.');
+    let spelled = format!("The code, spelled: {}. R repeats it.", client_haptic::host::spell(code));
+    let at = |l: &str| lines.iter().position(|x| x == l);
+    let welcome = lines.iter().position(|l| l.starts_with("Welcome")).expect("welcomed");
+    assert!(at(&spelled).is_some_and(|s| s > welcome), "the spelled code comes last, for R: {lines:#?}");
+    assert!(hosted.contains(&bind), "the address to join is said: {hosted}");
+    assert!(!lines.iter().any(|l| l.contains("server is gone")), "leaving on purpose is no lost server: {lines:#?}");
+}

@@ -1,0 +1,111 @@
+//! `client_haptic host`: a blind player hosts alone. The server runs in this process (on its own thread,
+//! in real time), the client joins it as Phantom, and the join code to give the partner is said twice:
+//! as written, and spelled slowly character by character in the NATO alphabet (R repeats it).
+
+use std::net::SocketAddr;
+use std::time::Duration;
+
+use anyhow::Context as _;
+use heist_server::{Clock, DEFAULT_CODE_TTL, ServerOptions, build_server};
+use heist_shared::level::Level;
+use heist_shared::protocol::Role;
+
+use crate::cli::ClientArgs;
+
+/// Arguments of `host`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct HostArgs {
+    /// Where the server listens (UDP game, TCP join endpoint); 0.0.0.0 for players on other machines.
+    #[arg(long, default_value = "127.0.0.1:5757")]
+    pub bind: SocketAddr,
+    /// The address the partner reaches (behind a NAT or relay).
+    #[arg(long)]
+    pub advertise: Option<SocketAddr>,
+    /// Seed of the first round (default: random, so nobody knows which copies are real).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Device, window, audio and bot settings, as for `join`.
+    #[command(flatten)]
+    pub client: ClientArgs,
+}
+
+/// The NATO word (or the digit's name) for each character of a join code; the dash is a pause.
+pub fn spell(code: &str) -> String {
+    const NATO: [&str; 26] = [
+        "alfa", "bravo", "charlie", "delta", "echo", "foxtrot", "golf", "hotel", "india", "juliett", "kilo", "lima",
+        "mike", "november", "oscar", "papa", "quebec", "romeo", "sierra", "tango", "uniform", "victor", "whiskey",
+        "x-ray", "yankee", "zulu",
+    ];
+    const DIGITS: [&str; 10] = ["zero", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine"];
+    let words: Vec<&str> = code
+        .chars()
+        .filter_map(|c| match c.to_ascii_uppercase() {
+            c @ 'A'..='Z' => Some(NATO[usize::from(c as u8 - b'A')]),
+            c @ '0'..='9' => Some(DIGITS[usize::from(c as u8 - b'0')]),
+            '-' => Some("then"),
+            _ => None,
+        })
+        .collect();
+    words.join(", ")
+}
+
+/// Runs `host`: starts the server, joins it as Phantom, says the code, plays until the session ends.
+pub fn host(args: &HostArgs) -> anyhow::Result<()> {
+    let settings = args.client.settings().map_err(anyhow::Error::msg)?;
+    let options = ServerOptions {
+        level: Level::museum(),
+        game: heist_server::game::GameOptions {
+            seed: args.seed.unwrap_or_else(rand::random),
+            random_rounds: args.seed.is_none(),
+            ..Default::default()
+        },
+        bind: args.bind,
+        token_bind: args.bind,
+        insecure: false,
+        clock: Clock::RealTime,
+        echo_log: heist_server::session::LogEcho::Tracing,
+        abuse_limit: 50,
+        advertise: args.advertise,
+        code_ttl: DEFAULT_CODE_TTL,
+        token_limits: Default::default(),
+    };
+    let (tx, rx) = std::sync::mpsc::channel();
+    // The server's app is built and run on its own thread (a Bevy app stays on the thread that made it).
+    std::thread::Builder::new().name("server".into()).spawn(move || match build_server(options) {
+        Ok(mut server) => {
+            let code = server.join_code().map(|c| c.code);
+            let _ = tx.send(Ok((server.advertised, server.tokens.as_ref().map(|t| t.addr), code)));
+            server.app.run();
+        }
+        Err(e) => {
+            let _ = tx.send(Err(e));
+        }
+    })?;
+    let (advertised, endpoint, code) =
+        rx.recv_timeout(Duration::from_secs(10)).context("the server did not start within 10 s")??;
+    let (endpoint, code) = endpoint.zip(code).context("the server runs without a join endpoint")?;
+    let token = heist_client::request_token(endpoint, &code, Role::Phantom, Duration::from_secs(5))
+        .with_context(|| format!("joining the session hosted on {endpoint}"))?;
+    let mut app = crate::cli::app(settings, args.client.headless, None)?;
+    args.client.request_shot(&mut app);
+    app.finish();
+    app.cleanup();
+    app.insert_resource(crate::client::HostedCode(vec![
+        format!("You host the heist. Your partner joins at {advertised} with the code {code}."),
+        format!("The code, spelled: {}. R repeats it.", spell(&code)),
+    ]));
+    heist_client::connect(&mut app, token)?;
+    app.run();
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_code_is_spelled_in_the_nato_alphabet_with_digits_by_name() {
+        assert_eq!(spell("K7QX-2M4P"), "kilo, seven, quebec, x-ray, then, two, mike, four, papa");
+        assert_eq!(spell("ab"), "alfa, bravo");
+    }
+}
