@@ -152,7 +152,7 @@ fn leave_after_the_last_round(
         return;
     }
     let finished = session.single().is_ok_and(|s| matches!(s.phase, Phase::Won | Phase::Lost(_)));
-    if !finished || inbox.round.max(1) < rounds.0 {
+    if !finished || inbox.current_round() < rounds.0 {
         *over_at = None;
         return;
     }

@@ -59,7 +59,7 @@ fn play(
     mut out: MessageWriter<ClientMsg>,
 ) {
     let Ok(session) = session.single() else { return };
-    let round = crate::rounds::current_round(&inbox);
+    let round = inbox.current_round();
     if brain.round != round {
         // A new round: nothing of the last one's copies counts (the first round is ready already).
         *brain = PhantomBrain { round, ready_sent: brain.round != 0, ..Default::default() };

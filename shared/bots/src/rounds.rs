@@ -9,11 +9,6 @@ use heist_shared::protocol::{ClientMsg, LobbyMsg, Phase, SessionView};
 #[derive(Resource, Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Rounds(pub u32);
 
-/// The round the client is in (the first sends no `RoundStarted`).
-pub(crate) fn current_round(inbox: &Inbox) -> u32 {
-    inbox.round.max(1)
-}
-
 /// Asks once per result while rounds remain.
 pub(crate) fn ask_for_another_round(
     rounds: Option<Res<Rounds>>,
@@ -24,7 +19,7 @@ pub(crate) fn ask_for_another_round(
 ) {
     let Some(rounds) = rounds else { return };
     let Ok(session) = session.single() else { return };
-    let round = current_round(&inbox);
+    let round = inbox.current_round();
     if matches!(session.phase, Phase::Won | Phase::Lost(_)) && round < rounds.0 && *asked_after < round {
         *asked_after = round;
         out.write(ClientMsg::Lobby(LobbyMsg::Rematch));

@@ -228,7 +228,7 @@ fn play(
     inbox: Res<heist_client::Inbox>,
     mut out: MessageWriter<ClientMsg>,
 ) {
-    let round = crate::rounds::current_round(&inbox);
+    let round = inbox.current_round();
     if brain.round != round {
         // A new round: plans of the last one go; the move numbers carry on, as the server's do.
         let first = brain.round == 0;

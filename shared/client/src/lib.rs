@@ -44,11 +44,18 @@ pub struct Inbox {
     pub refusals: Vec<Refusal>,
     /// Why the server disconnected us, if it said so.
     pub disconnect: Option<DisconnectReason>,
-    /// The round being played (0 before the first `RoundStarted`, which a session's first round does not
-    /// send: read 0 as round 1). A new round clears the briefings and the workbench.
+    /// The last `RoundStarted` (0 before one: a session's first round sends none; [`Inbox::current_round`]
+    /// reads it). A new round clears the briefings and the workbench.
     pub round: u32,
     /// Count of each kind of message received, for tests: (welcome, briefings, workbench, events).
     pub received: MessageCounts,
+}
+
+impl Inbox {
+    /// The round being played: 1 until a `RoundStarted` says otherwise.
+    pub fn current_round(&self) -> u32 {
+        self.round.max(1)
+    }
 }
 
 /// How many server messages of each kind arrived.
