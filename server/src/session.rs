@@ -125,9 +125,9 @@ impl SessionLog {
         match record {
             Record::Note => ev!("note"),
             Record::SessionCreated => ev!("session_created"),
-            Record::PlayerJoined(r) => ev!("player_joined", role = role_name(r)),
-            Record::PlayerLeft(r) => ev!("player_left", role = role_name(r)),
-            Record::PlayerDropped(r) => ev!("player_dropped", role = role_name(r)),
+            Record::PlayerJoined(r) => ev!("player_joined", role = r.name()),
+            Record::PlayerLeft(r) => ev!("player_left", role = r.name()),
+            Record::PlayerDropped(r) => ev!("player_dropped", role = r.name()),
             Record::Phase(p) => ev!("phase", phase = phase_name(p)),
             Record::Result { won, reason, seed } => {
                 ev!(
@@ -137,12 +137,12 @@ impl SessionLog {
                     seed = seed.to_string()
                 )
             }
-            Record::CaseBroken(case) => ev!("case_broken", role = "vive", case = case),
-            Record::ItemPicked(item) => ev!("item_picked", role = "vive", item = item),
-            Record::Delivered(item) => ev!("delivered", role = "vive", item = item),
+            Record::CaseBroken(case) => ev!("case_broken", role = Role::Vive.name(), case = case),
+            Record::ItemPicked(item) => ev!("item_picked", role = Role::Vive.name(), item = item),
+            Record::Delivered(item) => ev!("delivered", role = Role::Vive.name(), item = item),
             Record::Verdict { item, declared_real, outcome } => ev!(
                 "verdict",
-                role = "phantom",
+                role = Role::Phantom.name(),
                 item = item,
                 declared_real = declared_real,
                 outcome = format!("{outcome:?}").to_lowercase()
@@ -150,7 +150,7 @@ impl SessionLog {
             Record::GuardAlert { guard, alert } => {
                 ev!("guard_alert", guard = guard, alert = format!("{alert:?}").to_lowercase())
             }
-            Record::RematchAsked(r) => ev!("rematch_asked", role = role_name(r)),
+            Record::RematchAsked(r) => ev!("rematch_asked", role = r.name()),
             Record::RoundStarted(n) => ev!("round_started", new_round = n),
             Record::SessionEnded => ev!("session_ended"),
         }
@@ -214,13 +214,6 @@ impl SessionLog {
             GameEvent::EndingSoon(s) => (Record::Note, format!("the session ends in {s} s unless a round begins")),
         };
         self.record(t, record, text);
-    }
-}
-
-fn role_name(role: Role) -> &'static str {
-    match role {
-        Role::Vive => "vive",
-        Role::Phantom => "phantom",
     }
 }
 

@@ -28,6 +28,14 @@ impl Role {
             _ => None,
         }
     }
+
+    /// The role's name as typed on a command line and written in structured logs: `vive`, `phantom`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Role::Vive => "vive",
+            Role::Phantom => "phantom",
+        }
+    }
 }
 
 impl std::fmt::Display for Role {
