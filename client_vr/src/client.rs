@@ -289,6 +289,7 @@ fn events(
 fn tell_the_link(
     link: Res<heist_client::Link>,
     inbox: Res<Inbox>,
+    leaving: Res<heist_client::Leaving>,
     mut was: Local<heist_client::Link>,
     mut told_disconnect: Local<bool>,
     mut state: ResMut<ViveState>,
@@ -302,10 +303,7 @@ fn tell_the_link(
         state.say(now, heist_client::notice::disconnect_notice(reason));
     }
     if *link != *was {
-        let gone = *link == heist_client::Link::Gone;
-        if !(gone && inbox.disconnect.is_some())
-            && let Some(line) = heist_client::notice::link_notice(*was, *link)
-        {
+        if let Some(line) = heist_client::notice::link_change_notice(*was, *link, &inbox, &leaving) {
             state.say(now, line.to_owned());
         }
         *was = *link;

@@ -211,7 +211,7 @@ pub fn app(
     if practising {
         app.add_systems(Update, quit_when_practice_is_over);
     } else {
-        app.add_systems(Update, (quit_when_over, tell_the_link));
+        app.add_systems(Update, (leave_after_a_result, tell_the_link));
     }
     Ok(app)
 }
@@ -258,19 +258,14 @@ fn quit_when_practice_is_over(
 }
 
 /// After a result a player stays for another round (Enter) or leaves (Q); the bot leaves a few seconds
-/// after the result is heard. When the server lets us go, why is said and the client quits.
-#[allow(clippy::too_many_arguments)]
-fn quit_when_over(
+/// after the result is heard.
+fn leave_after_a_result(
     q: Query<&SessionView>,
-    inbox: Res<heist_client::Inbox>,
     time: Res<Time<Real>>,
     mut over_at: Local<Option<f32>>,
-    mut gone_at: Local<Option<f32>>,
     state: Res<PhantomState>,
     settings: Res<crate::PhantomSettings>,
     mut leaving: ResMut<heist_client::Leaving>,
-    mut speaker: NonSendMut<crate::speech::Speaker>,
-    mut exit: MessageWriter<AppExit>,
 ) {
     let now = time.elapsed_secs();
     let over = q.iter().next().is_some_and(|s| matches!(s.phase, Phase::Won | Phase::Lost(_)));
@@ -283,45 +278,38 @@ fn quit_when_over(
     if settings.bot && over_at.is_some_and(|t| now - t > 4.0) {
         leaving.start(time.elapsed_secs_f64());
     }
-    if let Some(reason) = &inbox.disconnect
-        && gone_at.is_none()
-    {
-        *gone_at = Some(now);
-        speaker.say(heist_client::notice::disconnect_notice(reason));
-    }
-    if gone_at.is_some_and(|t| now - t > 3.0) {
-        exit.write(AppExit::Success);
-    }
 }
 
-/// Says when the server goes silent (3 s without a packet), comes back, or is gone; quits 3 s after it is
-/// gone (unless the server said why it let us go: [`quit_when_over`] says that).
+/// Says why the server let us go, or that it went silent (3 s without a packet), came back or is gone;
+/// quits 3 s after the connection ended, so the last line is heard.
 #[allow(clippy::too_many_arguments)]
 fn tell_the_link(
     link: Res<heist_client::Link>,
     inbox: Res<heist_client::Inbox>,
     time: Res<Time<Real>>,
     mut was: Local<heist_client::Link>,
-    mut gone_at: Local<Option<f32>>,
+    mut ended_at: Local<Option<f32>>,
     leaving: Res<heist_client::Leaving>,
     mut speaker: NonSendMut<crate::speech::Speaker>,
     mut exit: MessageWriter<AppExit>,
 ) {
     let now = time.elapsed_secs();
+    if let Some(reason) = &inbox.disconnect
+        && ended_at.is_none()
+    {
+        *ended_at = Some(now);
+        speaker.say(heist_client::notice::disconnect_notice(reason));
+    }
     if *link != *was {
-        let gone = *link == heist_client::Link::Gone;
-        // Gone because we left, or because the server said why: nothing more to say.
-        if !(gone && (inbox.disconnect.is_some() || leaving.since.is_some()))
-            && let Some(line) = heist_client::notice::link_notice(*was, *link)
-        {
+        if let Some(line) = heist_client::notice::link_change_notice(*was, *link, &inbox, &leaving) {
             speaker.say(line);
-            if gone {
-                *gone_at = Some(now);
-            }
+        }
+        if *link == heist_client::Link::Gone {
+            ended_at.get_or_insert(now);
         }
         *was = *link;
     }
-    if gone_at.is_some_and(|t| now - t > 3.0) {
+    if ended_at.is_some_and(|t| now - t > 3.0) {
         exit.write(AppExit::Success);
     }
 }

@@ -33,6 +33,18 @@ pub fn link_notice(was: crate::Link, now: crate::Link) -> Option<&'static str> {
     }
 }
 
+/// The line for the link's change from `was` to `now`, unless it ended for a reason the player already
+/// has: the server said why ([`disconnect_notice`]) or the player is leaving.
+pub fn link_change_notice(
+    was: crate::Link,
+    now: crate::Link,
+    inbox: &crate::Inbox,
+    leaving: &crate::Leaving,
+) -> Option<&'static str> {
+    let explained = inbox.disconnect.is_some() || leaving.since.is_some();
+    if now == crate::Link::Gone && explained { None } else { link_notice(was, now) }
+}
+
 /// Why the server let us go, as a line for the player.
 pub fn disconnect_notice(reason: &DisconnectReason) -> String {
     match reason {
@@ -64,6 +76,19 @@ mod tests {
         assert_eq!(link_notice(Link::Silent, Link::Up), Some("The connection is back."));
         assert!(link_notice(Link::Silent, Link::Gone).is_some_and(|l| l.contains("gone")));
         assert_eq!(link_notice(Link::Connecting, Link::Up), None, "connecting is no news");
+    }
+
+    #[test]
+    fn a_lost_server_is_not_announced_when_the_end_was_already_explained() {
+        use crate::{Inbox, Leaving, Link};
+        let (mut inbox, mut leaving) = (Inbox::default(), Leaving::default());
+        assert!(link_change_notice(Link::Up, Link::Gone, &inbox, &leaving).is_some_and(|l| l.contains("gone")));
+        leaving.start(1.0);
+        assert_eq!(link_change_notice(Link::Up, Link::Gone, &inbox, &leaving), None, "we left");
+        let leaving = Leaving::default();
+        inbox.disconnect = Some(DisconnectReason::SessionEnded);
+        assert_eq!(link_change_notice(Link::Up, Link::Gone, &inbox, &leaving), None, "the server said why");
+        assert!(link_change_notice(Link::Up, Link::Silent, &inbox, &leaving).is_some(), "only the end is muted");
     }
 
     #[test]
