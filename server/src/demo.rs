@@ -99,13 +99,14 @@ impl Heist {
     /// session closed (false).
     pub fn await_next_round(&mut self, max_s: f32) -> bool {
         let round = self.results.last().map_or(1, |r| r.round);
-        if self.server.game().round > round && self.server.game().is_running() {
+        let begun = |g: &crate::game::Game| g.round > round && g.is_running();
+        if begun(self.server.game()) {
             return true;
         }
         for _ in 0..(f64::from(max_s) * TICK_HZ) as u64 {
             self.step();
             let g = self.server.game();
-            if g.round > round && g.is_running() {
+            if begun(g) {
                 return true;
             }
             if g.closed {
