@@ -3,23 +3,24 @@
 //! `RUST_LOG` asks for more. Played as a screen-reader user would: answering by typed lines.
 
 use std::io::{BufRead, BufReader, Read, Write};
-use std::process::{Command, Stdio};
+use std::process::{Child, ChildStdin, Command, Stdio};
 use std::sync::mpsc::{self, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
-#[test]
-fn headless_practice_prints_each_spoken_line_once_and_nothing_else() {
+/// The client as a screen-reader user runs it: `args` then `--headless --audio memory`, `RUST_LOG` unset;
+/// its stdin to type into and its stdout read line by line on a thread (stderr stays piped for the caller).
+fn headless(args: &[&str]) -> (Child, ChildStdin, mpsc::Receiver<String>) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_client_haptic"))
-        .args(["practice", "--kind", "crown", "--seed", "3", "--headless", "--audio", "memory"])
+        .args(args)
+        .args(["--headless", "--audio", "memory"])
         .env_remove("RUST_LOG")
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .expect("client_haptic runs");
-    let mut stdin = child.stdin.take().expect("stdin");
+    let stdin = child.stdin.take().expect("stdin");
     let stdout = child.stdout.take().expect("stdout");
-    let mut stderr = child.stderr.take().expect("stderr");
     let (tx, rx) = mpsc::channel();
     std::thread::spawn(move || {
         for line in BufReader::new(stdout).lines().map_while(Result::ok) {
@@ -28,6 +29,13 @@ fn headless_practice_prints_each_spoken_line_once_and_nothing_else() {
             }
         }
     });
+    (child, stdin, rx)
+}
+
+#[test]
+fn headless_practice_prints_each_spoken_line_once_and_nothing_else() {
+    let (mut child, mut stdin, rx) = headless(&["practice", "--kind", "crown", "--seed", "3"]);
+    let mut stderr = child.stderr.take().expect("stderr");
     let log = std::thread::spawn(move || {
         let mut s = String::new();
         let _ = stderr.read_to_string(&mut s);
@@ -153,24 +161,7 @@ fn host_with_a_vive_bot(
 fn a_blind_player_hears_the_partner_plays_a_rematch_and_leaves_by_typed_lines() {
     let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
     let (addr, code, host) = host_with_a_vive_bot(stop.clone());
-    let mut child = Command::new(env!("CARGO_BIN_EXE_client_haptic"))
-        .args(["join", &addr.to_string(), "--code", &code, "--headless", "--audio", "memory"])
-        .env_remove("RUST_LOG")
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("client_haptic runs");
-    let mut stdin = child.stdin.take().expect("stdin");
-    let stdout = child.stdout.take().expect("stdout");
-    let (tx, rx) = mpsc::channel();
-    std::thread::spawn(move || {
-        for line in BufReader::new(stdout).lines().map_while(Result::ok) {
-            if tx.send(line).is_err() {
-                break;
-            }
-        }
-    });
+    let (mut child, mut stdin, rx) = headless(&["join", &addr.to_string(), "--code", &code]);
     // Ready when the partner is in; after the first result, Enter for another round; after the second, q.
     let mut lines: Vec<String> = Vec::new();
     let mut results = 0;
@@ -224,24 +215,7 @@ fn a_blind_player_hosts_alone_hears_the_code_spelled_and_a_partner_joins_with_it
     use heist_shared::protocol::{Role, TICK_HZ};
     let port = std::net::UdpSocket::bind("127.0.0.1:0").expect("a free port").local_addr().expect("addr").port();
     let bind = format!("127.0.0.1:{port}");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_client_haptic"))
-        .args(["host", "--bind", &bind, "--headless", "--audio", "memory"])
-        .env_remove("RUST_LOG")
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("client_haptic runs");
-    let mut stdin = child.stdin.take().expect("stdin");
-    let stdout = child.stdout.take().expect("stdout");
-    let (tx, rx) = mpsc::channel();
-    std::thread::spawn(move || {
-        for line in BufReader::new(stdout).lines().map_while(Result::ok) {
-            if tx.send(line).is_err() {
-                break;
-            }
-        }
-    });
+    let (mut child, mut stdin, rx) = headless(&["host", "--bind", &bind]);
     let mut lines: Vec<String> = Vec::new();
     let mut vive: Option<bevy::app::App> = None;
     let deadline = Instant::now() + Duration::from_secs(60);
