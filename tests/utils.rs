@@ -142,3 +142,31 @@ impl UdpAttacker {
 pub fn token_for(server: &HostedServer, role: Role) -> ConnectToken {
     heist_server::demo::token(server, role).expect("a token")
 }
+
+/// A seat cache of its own for one test client (a fresh directory under the system's temp dir).
+pub fn seat_cache(name: &str) -> heist_client::SeatCache {
+    let dir = std::env::temp_dir().join(format!("heist-seats-{}-{name}-{}", std::process::id(), rand::random::<u32>()));
+    heist_client::SeatCache::new(dir)
+}
+
+/// Joins `server` as `role` like a player's client does: with the seat ticket kept in `cache` when there
+/// is one (taking the seat back), else with the join code; the client keeps its seat in `cache`. Returns
+/// the app and whether it took a seat back.
+pub fn join_with_seat(
+    server: &HostedServer,
+    role: Role,
+    cache: &heist_client::SeatCache,
+    setup: impl FnOnce(&mut App),
+) -> Result<(App, bool), heist_client::JoinError> {
+    let tokens = server.tokens.as_ref().expect("a token endpoint");
+    let code = tokens.codes.current().code;
+    let timeout = std::time::Duration::from_secs(5);
+    let joining = heist_client::join_or_resume(tokens.addr, &code, role, Some(cache), timeout)?;
+    let mut app = heist_server::demo::stepped_client_app();
+    setup(&mut app);
+    app.finish();
+    app.cleanup();
+    heist_client::connect(&mut app, joining.token)?;
+    heist_client::hold_seat(&mut app, Some(cache.clone()), tokens.addr, role);
+    Ok((app, joining.resuming))
+}

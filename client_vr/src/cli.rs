@@ -288,12 +288,15 @@ pub fn join(args: &JoinArgs) -> anyhow::Result<()> {
     let (mode, line) = decide_mode(args, crate::xr::probe_from_env);
     // Logging is not up before the app exists: this line goes to stderr directly, once.
     eprintln!("client_vr: {line}");
-    let token = heist_client::request_token(args.addr, &args.code, Role::Vive, Duration::from_secs(5))
-        .with_context(|| format!("joining {} as Vive", args.addr))?;
+    let cache = heist_client::SeatCache::in_default_dir();
+    let joining =
+        heist_client::join_or_resume(args.addr, &args.code, Role::Vive, cache.as_ref(), Duration::from_secs(5))
+            .with_context(|| format!("joining {} as Vive", args.addr))?;
     let mut app = app(args, &mode)?;
     app.finish();
     app.cleanup();
-    heist_client::connect(&mut app, token)?;
+    heist_client::connect(&mut app, joining.token)?;
+    heist_client::hold_seat(&mut app, cache, args.addr, Role::Vive);
     app.run();
     Ok(())
 }

@@ -266,6 +266,8 @@ fn events(
             GameEvent::Noise { .. } | GameEvent::PhaseChanged(_) | GameEvent::PickedUp(_) => None,
             GameEvent::Joined(_)
             | GameEvent::Left { .. }
+            | GameEvent::Resumed(_)
+            | GameEvent::GaveUp(_)
             | GameEvent::RematchAsked(_)
             | GameEvent::RoundStarted(_)
             | GameEvent::EndingSoon(_) => heist_client::notice::session_notice(&e, Role::Vive),
@@ -285,12 +287,16 @@ fn events(
     }
 }
 
-/// The connection's changes on the HUD: lost after 3 s of silence, back, gone; and why the server let us go.
+/// The connection's changes on the HUD: lost after 3 s of silence, back, gone, trying to get back in or
+/// giving up; and why the server let us go.
+#[allow(clippy::too_many_arguments)]
 fn tell_the_link(
     link: Res<heist_client::Link>,
     inbox: Res<Inbox>,
     leaving: Res<heist_client::Leaving>,
+    reconnect: Res<heist_client::Reconnect>,
     mut was: Local<heist_client::Link>,
+    mut was_reconnect: Local<heist_client::Reconnect>,
     mut told_disconnect: Local<bool>,
     mut state: ResMut<ViveState>,
     time: Res<Time>,
@@ -303,10 +309,16 @@ fn tell_the_link(
         state.say(now, heist_client::notice::disconnect_notice(reason));
     }
     if *link != *was {
-        if let Some(line) = heist_client::notice::link_change_notice(*was, *link, &inbox, &leaving) {
+        if let Some(line) = heist_client::notice::link_change_notice(*was, *link, &inbox, &leaving, &reconnect) {
             state.say(now, line.to_owned());
         }
         *was = *link;
+    }
+    if *reconnect != *was_reconnect {
+        if let Some(line) = heist_client::notice::reconnect_notice(&was_reconnect, &reconnect) {
+            state.say(now, line);
+        }
+        *was_reconnect = reconnect.clone();
     }
 }
 
@@ -351,9 +363,10 @@ fn quit_after_end(
     mut exit: MessageWriter<AppExit>,
     inbox: Res<Inbox>,
     link: Res<heist_client::Link>,
+    reconnect: Res<heist_client::Reconnect>,
 ) {
     if let Some(after) = settings.quit_after_end_s
-        && (state.ended_s > after || inbox.disconnect.is_some() || *link == heist_client::Link::Gone)
+        && (state.ended_s > after || heist_client::connection_over(*link, &inbox, &reconnect))
     {
         exit.write(AppExit::Success);
     }

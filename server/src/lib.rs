@@ -23,7 +23,7 @@ use heist_shared::level::Level;
 use heist_shared::protocol::{ProtocolPlugin, TICK_HZ};
 
 use game::{Game, GameOptions};
-use net::tokens::{CodeBook, JoinCode, RoleTable, TokenConfig, TokenLimits, TokenService};
+use net::tokens::{CodeBook, JoinCode, TokenConfig, TokenLimits, TokenService};
 use net::{Auth, NetSettings, ServerNetPlugin};
 use session::{GameState, LogEcho, SessionLog, SessionPlugin};
 
@@ -125,7 +125,7 @@ pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
         a => a,
     };
     let advertised = advertise.unwrap_or(addr);
-    let roles = RoleTable::default();
+    let seats = net::seats::Seats::default();
     let (auth, tokens) = if options.insecure {
         (Auth::Insecure, None)
     } else {
@@ -138,7 +138,7 @@ pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
                 private_key,
                 server_addr: advertised,
                 session,
-                roles: roles.clone(),
+                seats: seats.clone(),
                 limits: options.token_limits,
             },
         )
@@ -168,7 +168,7 @@ pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
         .add_plugins(SessionPlugin)
         .add_plugins(ServerNetPlugin {
             socket: std::sync::Mutex::new(Some(socket)),
-            settings: NetSettings { auth, roles, abuse_limit: options.abuse_limit, advertise },
+            settings: NetSettings { auth, seats, abuse_limit: options.abuse_limit, advertise },
         });
     app.world_mut().resource_mut::<SessionLog>().record(
         0.0,

@@ -106,7 +106,8 @@ enum Command {
         #[arg(long, value_parser = positive_seconds)]
         time_limit: Option<f32>,
     },
-    /// Join a hosted session as a bot.
+    /// Join a hosted session as a bot (restarted within a minute of losing its connection, it takes its
+    /// seat back through the seat cache, `$XDG_CACHE_HOME/phantom-heist/seats`).
     Join {
         /// The host's game address.
         addr: SocketAddr,
@@ -126,8 +127,8 @@ enum Command {
     },
 }
 
-/// The bot leaves a few seconds after the last round's result, or quits when the server lets it go,
-/// saying why.
+/// The bot leaves a few seconds after the last round's result, or quits when the server lets it go or
+/// it could not get back in after a lost connection, saying why.
 #[allow(clippy::too_many_arguments)]
 fn leave_after_the_last_round(
     rounds: Res<heist_bots::Rounds>,
@@ -137,8 +138,11 @@ fn leave_after_the_last_round(
     mut over_at: Local<Option<f64>>,
     mut leaving: ResMut<heist_client::Leaving>,
     link: Res<heist_client::Link>,
+    reconnect: Res<heist_client::Reconnect>,
+    mut was_reconnect: Local<heist_client::Reconnect>,
     mut exit: MessageWriter<AppExit>,
 ) {
+    use heist_client::{Link, Reconnect};
     use heist_shared::protocol::Phase;
     let now = time.elapsed_secs_f64();
     if let Some(reason) = &inbox.disconnect {
@@ -146,8 +150,16 @@ fn leave_after_the_last_round(
         exit.write(AppExit::Success);
         return;
     }
-    if *link == heist_client::Link::Gone {
-        println!("{}", heist_client::notice::link_notice(heist_client::Link::Up, *link).unwrap_or_default());
+    if *reconnect != *was_reconnect {
+        if let Some(line) = heist_client::notice::reconnect_notice(&was_reconnect, &reconnect) {
+            println!("{line}");
+        }
+        *was_reconnect = reconnect.clone();
+    }
+    if heist_client::connection_over(*link, &inbox, &reconnect) {
+        if !matches!(*reconnect, Reconnect::GaveUp(_)) {
+            println!("{}", heist_client::notice::link_notice(Link::Up, *link).unwrap_or_default());
+        }
         exit.write(AppExit::Success);
         return;
     }
@@ -254,7 +266,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             Ok(())
         }
         Command::Join { addr, code, role, vive, rounds } => {
-            let token = heist_client::request_token(addr, &code, role, Duration::from_secs(5))
+            let cache = heist_client::SeatCache::in_default_dir();
+            let joining = heist_client::join_or_resume(addr, &code, role, cache.as_ref(), Duration::from_secs(5))
                 .with_context(|| format!("joining {addr} as {role}"))?;
             let mut app = App::new();
             app.add_plugins(
@@ -269,8 +282,13 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             };
             app.finish();
             app.cleanup();
-            heist_client::connect(&mut app, token)?;
-            println!("joined {addr} as {role}");
+            heist_client::connect(&mut app, joining.token)?;
+            heist_client::hold_seat(&mut app, cache, addr, role);
+            if joining.resuming {
+                println!("took the {role} seat back at {addr}");
+            } else {
+                println!("joined {addr} as {role}");
+            }
             app.run();
             Ok(())
         }

@@ -56,8 +56,12 @@ pub enum Record<'a> {
     PlayerJoined(Role),
     /// A player closed the connection on purpose.
     PlayerLeft(Role),
-    /// A player's connection was lost.
+    /// A player's connection was lost (their seat is kept for them).
     PlayerDropped(Role),
+    /// A dropped player took their seat back.
+    PlayerResumed(Role),
+    /// A dropped player's seat was given up after the hold time.
+    PlayerGaveUp(Role),
     /// The phase changed (not to a result).
     Phase(Phase),
     /// The round ended.
@@ -128,6 +132,8 @@ impl SessionLog {
             Record::PlayerJoined(r) => ev!("player_joined", role = r.name()),
             Record::PlayerLeft(r) => ev!("player_left", role = r.name()),
             Record::PlayerDropped(r) => ev!("player_dropped", role = r.name()),
+            Record::PlayerResumed(r) => ev!("player_resumed", role = r.name()),
+            Record::PlayerGaveUp(r) => ev!("player_gave_up", role = r.name()),
             Record::Phase(p) => ev!("phase", phase = phase_name(p)),
             Record::Result { won, reason, seed } => {
                 ev!(
@@ -204,7 +210,11 @@ impl SessionLog {
             GameEvent::Joined(role) => (Record::PlayerJoined(*role), format!("{role} joined")),
             GameEvent::Left { role, dropped: false } => (Record::PlayerLeft(*role), format!("{role} left")),
             GameEvent::Left { role, dropped: true } => {
-                (Record::PlayerDropped(*role), format!("{role} dropped (connection lost)"))
+                (Record::PlayerDropped(*role), format!("{role} dropped (connection lost): the seat is kept for them"))
+            }
+            GameEvent::Resumed(role) => (Record::PlayerResumed(*role), format!("{role} is back (seat taken back)")),
+            GameEvent::GaveUp(role) => {
+                (Record::PlayerGaveUp(*role), format!("{role} did not come back: the seat is given up"))
             }
             GameEvent::RematchAsked(role) => (Record::RematchAsked(*role), format!("{role} asks for another round")),
             GameEvent::RoundStarted(n) => {
@@ -416,7 +426,8 @@ mod tests {
 
     #[test]
     fn every_session_event_is_one_json_object_naming_the_event_session_and_role() {
-        let game = Game::new(Level::museum(), &GameOptions { seed: 77, ..Default::default() });
+        // A seed of many digits: a short one can turn up inside a timestamp.
+        let game = Game::new(Level::museum(), &GameOptions { seed: 8_675_309_421_337, ..Default::default() });
         let mut log = SessionLog { echo: LogEcho::Tracing, id: "0badc0de".into(), round: 1, ..Default::default() };
         let lines = json_lines(|| {
             log.record(0.0, Record::SessionCreated, "session created".into());
@@ -433,6 +444,8 @@ mod tests {
                 GameEvent::PhaseChanged(Phase::Lost(LossReason::Caught)),
                 GameEvent::RematchAsked(Role::Vive),
                 GameEvent::RoundStarted(2),
+                GameEvent::Resumed(Role::Phantom),
+                GameEvent::GaveUp(Role::Vive),
             ] {
                 log.event(12.5, &game, &event);
             }
@@ -453,7 +466,9 @@ mod tests {
                 "guard_alert",
                 "result",
                 "rematch_asked",
-                "round_started"
+                "round_started",
+                "player_resumed",
+                "player_gave_up"
             ]
         );
         for line in &lines {
@@ -468,8 +483,12 @@ mod tests {
         assert_eq!(lines[5]["case"], game.level.cases[0].id.as_str());
         assert_eq!((lines[8]["outcome"].as_str(), lines[8]["role"].as_str()), (Some("secured"), Some("phantom")));
         assert_eq!(lines[9]["alert"], "chasing");
+        assert_eq!((lines[13]["role"].as_str(), lines[14]["role"].as_str()), (Some("phantom"), Some("vive")));
         assert_eq!((lines[10]["won"].as_bool(), lines[10]["reason"].as_str()), (Some(false), Some("caught")));
-        assert_eq!(lines[10]["seed"], "77", "the seed is told once the round is over (a string: it is 64 bits)");
+        assert_eq!(
+            lines[10]["seed"], "8675309421337",
+            "the seed is told once the round is over (a string: it is 64 bits)"
+        );
         assert_eq!(lines[10]["game_time_s"], 12.5);
         assert_eq!(lines[12]["new_round"], 2);
     }

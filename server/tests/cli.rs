@@ -115,9 +115,11 @@ fn a_hosted_session_plays_two_rounds_for_two_bot_processes_logs_them_as_json_and
             break rest.split_whitespace().next().unwrap().to_owned();
         }
     };
+    let cache = std::env::temp_dir().join(format!("heist-cli-seats-{}-rounds", std::process::id()));
     let bot = |role: &str| {
         Command::new(bin)
             .args(["join", &addr, "--code", &code, "--role", role, "--vive", "idle", "--rounds", "2"])
+            .env("XDG_CACHE_HOME", &cache)
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
             .spawn()
@@ -152,4 +154,82 @@ fn a_hosted_session_plays_two_rounds_for_two_bot_processes_logs_them_as_json_and
     let results: Vec<_> = events.iter().filter(|e| e["event"] == "result").collect();
     assert!(results.iter().all(|r| r["reason"] == "time" && r["won"] == false), "{results:?}");
     assert_ne!(results[0]["seed"], results[1]["seed"], "each round has its own seed");
+    let _ = std::fs::remove_dir_all(cache);
+}
+
+#[test]
+fn a_bot_process_killed_mid_heist_and_started_again_takes_its_seat_back() {
+    use std::process::Stdio;
+    use std::time::{Duration, Instant};
+    let bin = env!("CARGO_BIN_EXE_heist-server");
+    let port = std::net::UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
+    let addr = format!("127.0.0.1:{port}");
+    let mut host = Command::new(bin)
+        .args(["--log-format", "json", "host", "--bind", &addr, "--time-limit", "120", "--idle-end", "5"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let out = lines_of(host.stdout.take().unwrap());
+    let log = lines_of(host.stderr.take().unwrap());
+    let deadline = Instant::now() + Duration::from_secs(20);
+    let code = loop {
+        let line =
+            out.recv_timeout(deadline.saturating_duration_since(Instant::now())).expect("the host prints its code");
+        if let Some(rest) = line.strip_prefix("join code: ") {
+            break rest.split_whitespace().next().unwrap().to_owned();
+        }
+    };
+    // Each bot has its own seat cache, as two players on two machines would.
+    let cache = |role: &str| std::env::temp_dir().join(format!("heist-cli-seats-{}-{role}", std::process::id()));
+    let bot = |role: &str| {
+        let mut child = Command::new(bin)
+            .args(["join", &addr, "--code", &code, "--role", role, "--vive", "idle"])
+            .env("XDG_CACHE_HOME", cache(role))
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        let lines = lines_of(child.stdout.take().unwrap());
+        (child, lines)
+    };
+    let first_line = |lines: &std::sync::mpsc::Receiver<String>| lines.recv_timeout(Duration::from_secs(20)).ok();
+    let (mut vive, vive_out) = bot("vive");
+    let (mut phantom, phantom_out) = bot("phantom");
+    assert_eq!(first_line(&vive_out), Some(format!("joined {addr} as Vive")));
+    assert_eq!(first_line(&phantom_out), Some(format!("joined {addr} as Phantom")));
+    let seat_file = cache("vive").join("phantom-heist").join("seats").join(format!("127_0_0_1-{port}-vive.seat"));
+    let stored = Instant::now();
+    while !seat_file.exists() && stored.elapsed() < Duration::from_secs(10) {
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    assert!(seat_file.exists(), "the bot kept its seat ticket in {}", seat_file.display());
+
+    // The Vive bot is killed (no goodbye) and started again: it takes its seat back with the cached ticket.
+    vive.kill().unwrap();
+    let _ = vive.wait();
+    let (mut again, again_out) = bot("vive");
+    assert_eq!(first_line(&again_out), Some(format!("took the Vive seat back at {addr}")));
+    let resumed = Instant::now();
+    let mut events = Vec::new();
+    while !events.iter().any(|e: &serde_json::Value| e["event"] == "player_resumed")
+        && resumed.elapsed() < Duration::from_secs(10)
+    {
+        if let Ok(line) = log.recv_timeout(Duration::from_millis(200))
+            && let Ok(v) = serde_json::from_str::<serde_json::Value>(&line)
+            && v["target"] == "session"
+        {
+            events.push(v);
+        }
+    }
+    let back = events.iter().find(|e| e["event"] == "player_resumed").expect("the host logs the resume");
+    assert_eq!(back["role"], "vive");
+    assert!(!events.iter().any(|e| e["event"] == "player_joined" && e["role"] == "vive" && e["game_time_s"] != 0.0));
+    for child in [&mut again, &mut phantom, &mut host] {
+        let _ = child.kill();
+        let _ = child.wait();
+    }
+    for role in ["vive", "phantom"] {
+        let _ = std::fs::remove_dir_all(cache(role));
+    }
 }

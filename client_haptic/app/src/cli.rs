@@ -281,13 +281,16 @@ fn leave_after_a_result(
 }
 
 /// Says why the server let us go, or that it went silent (3 s without a packet), came back or is gone;
-/// quits 3 s after the connection ended, so the last line is heard.
+/// that the client tries to get back in or gave up; quits 3 s after the connection ended for good, so the
+/// last line is heard.
 #[allow(clippy::too_many_arguments)]
 fn tell_the_link(
     link: Res<heist_client::Link>,
     inbox: Res<heist_client::Inbox>,
+    reconnect: Res<heist_client::Reconnect>,
     time: Res<Time<Real>>,
     mut was: Local<heist_client::Link>,
+    mut was_reconnect: Local<heist_client::Reconnect>,
     mut ended_at: Local<Option<f32>>,
     leaving: Res<heist_client::Leaving>,
     mut speaker: NonSendMut<crate::speech::Speaker>,
@@ -301,13 +304,19 @@ fn tell_the_link(
         speaker.say(heist_client::notice::disconnect_notice(reason));
     }
     if *link != *was {
-        if let Some(line) = heist_client::notice::link_change_notice(*was, *link, &inbox, &leaving) {
+        if let Some(line) = heist_client::notice::link_change_notice(*was, *link, &inbox, &leaving, &reconnect) {
             speaker.say(line);
         }
-        if *link == heist_client::Link::Gone {
-            ended_at.get_or_insert(now);
-        }
         *was = *link;
+    }
+    if *reconnect != *was_reconnect {
+        if let Some(line) = heist_client::notice::reconnect_notice(&was_reconnect, &reconnect) {
+            speaker.say(line);
+        }
+        *was_reconnect = reconnect.clone();
+    }
+    if heist_client::connection_over(*link, &inbox, &reconnect) {
+        ended_at.get_or_insert(now);
     }
     if ended_at.is_some_and(|t| now - t > 3.0) {
         exit.write(AppExit::Success);
@@ -318,13 +327,16 @@ fn tell_the_link(
 pub fn join(args: &JoinArgs) -> anyhow::Result<()> {
     use anyhow::Context as _;
     let settings = args.client.settings().map_err(anyhow::Error::msg)?;
-    let token = heist_client::request_token(args.addr, &args.code, Role::Phantom, Duration::from_secs(5))
-        .with_context(|| format!("joining {} as Phantom", args.addr))?;
+    let cache = heist_client::SeatCache::in_default_dir();
+    let joining =
+        heist_client::join_or_resume(args.addr, &args.code, Role::Phantom, cache.as_ref(), Duration::from_secs(5))
+            .with_context(|| format!("joining {} as Phantom", args.addr))?;
     let mut app = app(settings, args.client.headless, None)?;
     args.client.request_shot(&mut app);
     app.finish();
     app.cleanup();
-    heist_client::connect(&mut app, token)?;
+    heist_client::connect(&mut app, joining.token)?;
+    heist_client::hold_seat(&mut app, cache, args.addr, Role::Phantom);
     app.run();
     Ok(())
 }

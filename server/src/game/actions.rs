@@ -143,23 +143,27 @@ impl Game {
             return Err(Refusal::NotCarried);
         }
         let item = self.item(id)?;
-        let Some(truth) = item.truth.as_ref() else {
-            return Err(Refusal::NotACopy);
-        };
-        if !matches!(item.kind, ItemKind::Copy { .. }) {
+        if item.truth.is_none() || !matches!(item.kind, ItemKind::Copy { .. }) {
             return Err(Refusal::NotACopy);
         }
         if self.workbench.is_some() {
             return Err(Refusal::WorkbenchBusy);
         }
         self.in_reach(self.level.workbench)?;
-        let copy = WorkbenchCopy { item: id, mesh: truth.mesh.clone(), material: truth.material };
         self.take_from_hands(id)?;
         self.items[usize::from(id.0)].place = ItemPlace::Workbench;
         self.workbench = Some(id);
         self.event(GameEvent::Delivered(id));
-        self.outgoing.push(Outgoing::To(Role::Phantom, ServerMsg::Workbench(copy)));
+        if let Some(copy) = self.workbench_copy(id) {
+            self.outgoing.push(Outgoing::To(Role::Phantom, ServerMsg::Workbench(copy)));
+        }
         Ok(())
+    }
+
+    /// What Phantom is sent of the copy `id` on the workbench: its true geometry and material.
+    pub(super) fn workbench_copy(&self, id: ItemId) -> Option<WorkbenchCopy> {
+        let truth = self.items.get(usize::from(id.0))?.truth.as_ref()?;
+        Some(WorkbenchCopy { item: id, mesh: truth.mesh.clone(), material: truth.material })
     }
 
     fn verdict(&mut self, id: ItemId, declared_real: bool) -> Result<(), Refusal> {

@@ -15,13 +15,15 @@ use glam::Vec2;
 use heist_shared::artifact::{ArtifactKind, Briefing};
 use heist_shared::level::{Level, NavGraph, WallSet};
 use heist_shared::protocol::{
-    CaseId, ClientMsg, GameEvent, ItemId, ItemKind, ItemPlace, LobbyMsg, LossReason, NoiseKind, PhantomTool, Phase,
-    Refusal, Role, ServerMsg, Stance, verify,
+    CaseId, ClientMsg, GameEvent, ItemId, ItemKind, ItemPlace, LobbyMsg, LossReason, NoiseKind, PhantomMsg,
+    PhantomTool, Phase, Refusal, Role, ServerMsg, Stance, ViveMsg, verify,
 };
 use heist_shared::rules;
 use rand_chacha::ChaCha8Rng;
 
-/// Seconds a player may be gone during a heist before it is lost as abandoned.
+/// Seconds a running heist waits, paused, for someone to take the seat of a player who left on purpose
+/// (with the join code) before it is lost as abandoned. A dropped player's seat is kept for them longer,
+/// [`rules::SEAT_HOLD_S`].
 pub const ABANDON_GRACE_S: f32 = 20.0;
 
 /// Seconds a session waits after a result for another round before it ends (unless
@@ -190,6 +192,8 @@ pub struct Game {
     options: GameOptions,
     ready: (bool, bool),
     rematch: (bool, bool),
+    /// Seconds each dropped player's seat has been kept for them (Vive, Phantom); `None`: not kept.
+    kept: [Option<f32>; 2],
     idle_s: f32,
     warned_ending: bool,
     joined_once: bool,
@@ -220,19 +224,75 @@ impl Game {
         setup::new_game(level, options)
     }
 
-    /// A player connected; the other is told.
+    /// A player connected with the join code; the other is told, and the newcomer gets what its view
+    /// of a running heist needs ([`Game::catch_up`]).
     pub fn join(&mut self, role: Role) {
-        set(&mut self.present, role, true);
-        self.joined_once = true;
+        self.arrive(role);
         self.event(GameEvent::Joined(role));
+        self.catch_up(role);
+    }
+
+    /// A dropped player took their kept seat back (the network checked the seat ticket); the other is
+    /// told, and the one back gets what their view needs ([`Game::catch_up`]).
+    pub fn resume(&mut self, role: Role) {
+        self.arrive(role);
+        self.event(GameEvent::Resumed(role));
+        self.catch_up(role);
+    }
+
+    fn arrive(&mut self, role: Role) {
+        set(&mut self.present, role, true);
+        self.kept[slot(role)] = None;
+        self.joined_once = true;
+    }
+
+    /// What a player's view needs that no replicated state carries, sent to them alone: for Phantom in
+    /// a running heist, the briefings and the copy on the bench; for Vive, a fresh move numbering (his
+    /// new connection numbers from 1, so the last move applied is forgotten, and with it any queued).
+    fn catch_up(&mut self, role: Role) {
+        match role {
+            Role::Vive => {
+                self.vive.inputs.clear();
+                self.vive.last_input_seq = 0;
+                self.vive.move_credit = 0;
+            }
+            Role::Phantom if self.phase == Phase::Heist => {
+                let briefings = self.targets.iter().map(|t| t.briefing.clone()).collect();
+                self.outgoing.push(Outgoing::To(Role::Phantom, ServerMsg::Briefings(briefings)));
+                if let Some(copy) = self.workbench.and_then(|id| self.workbench_copy(id)) {
+                    self.outgoing.push(Outgoing::To(Role::Phantom, ServerMsg::Workbench(copy)));
+                }
+            }
+            Role::Phantom => {}
+        }
     }
 
     /// A player disconnected (`dropped`: the connection was lost rather than closed); the other is told.
+    /// A dropped player's seat is kept for them for [`rules::SEAT_HOLD_S`].
     pub fn leave(&mut self, role: Role, dropped: bool) {
         set(&mut self.present, role, false);
         set(&mut self.ready, role, false);
         set(&mut self.rematch, role, false);
+        if dropped && !self.closed {
+            self.kept[slot(role)] = Some(0.0);
+        }
         self.event(GameEvent::Left { role, dropped });
+    }
+
+    /// True while `role`'s seat is kept for the player who dropped from it.
+    pub fn is_seat_kept(&self, role: Role) -> bool {
+        self.kept[slot(role)].is_some()
+    }
+
+    /// Seconds `role`'s kept seat stays kept at most (0 when it is not kept).
+    pub fn seat_kept_for_s(&self, role: Role) -> f32 {
+        self.kept[slot(role)].map_or(0.0, |t| (rules::SEAT_HOLD_S - t).max(0.0))
+    }
+
+    /// True while a running heist stands still for a missing player: the timer, the guards and every
+    /// action wait (Vive's moves are acknowledged and dropped, so his client stands him where he is).
+    pub fn is_paused(&self) -> bool {
+        self.phase == Phase::Heist && self.present != (true, true)
     }
 
     /// True while the round has not ended.
@@ -252,6 +312,19 @@ impl Game {
     /// Applies one message from a player; a refusal changes nothing.
     pub fn apply(&mut self, role: Role, msg: &ClientMsg) -> Result<(), Refusal> {
         verify(role, self.phase, msg)?;
+        if self.is_paused() {
+            match msg {
+                ClientMsg::Vive(ViveMsg::Move { seq, .. }) => {
+                    if *seq > self.vive.last_input_seq {
+                        self.vive.inputs.clear();
+                        self.vive.last_input_seq = *seq;
+                    }
+                    return Ok(());
+                }
+                ClientMsg::Vive(_) | ClientMsg::Phantom(PhantomMsg::Verdict { .. }) => return Err(Refusal::Paused),
+                _ => {}
+            }
+        }
         match msg {
             ClientMsg::Lobby(LobbyMsg::Ready) => {
                 set(&mut self.ready, role, true);
@@ -305,6 +378,7 @@ impl Game {
 
     /// Advances the session by `dt` seconds.
     pub fn step(&mut self, dt: f32) {
+        self.keep_seats(dt);
         match self.phase {
             Phase::Lobby => {
                 self.start_if_ready();
@@ -314,10 +388,26 @@ impl Game {
             }
             Phase::Heist => self.step_heist(dt),
             Phase::Won | Phase::Lost(_) => {
-                if self.present == (false, false) {
+                if self.present == (false, false) && self.kept == [None, None] {
                     self.closed = true;
                 }
                 self.idle(dt, true);
+            }
+        }
+    }
+
+    /// Counts the time kept seats have waited; one that waited [`rules::SEAT_HOLD_S`] is given up (and a
+    /// running heist is lost, abandoned).
+    fn keep_seats(&mut self, dt: f32) {
+        for role in [Role::Vive, Role::Phantom] {
+            let Some(waited) = self.kept[slot(role)].as_mut() else { continue };
+            *waited += dt;
+            if *waited >= rules::SEAT_HOLD_S {
+                self.kept[slot(role)] = None;
+                self.event(GameEvent::GaveUp(role));
+                if self.phase == Phase::Heist {
+                    self.set_phase(Phase::Lost(LossReason::Abandoned));
+                }
             }
         }
     }
@@ -341,22 +431,22 @@ impl Game {
     }
 
     fn step_heist(&mut self, dt: f32) {
+        if self.is_paused() {
+            // A kept seat waits for its player (`keep_seats`); a seat left on purpose waits for anyone.
+            if self.kept == [None, None] {
+                self.absent_s += dt;
+                if self.absent_s >= ABANDON_GRACE_S {
+                    self.set_phase(Phase::Lost(LossReason::Abandoned));
+                }
+            }
+            return;
+        }
+        self.absent_s = 0.0;
         self.elapsed_s += dt;
         self.time_left_s = (self.time_left_s - dt).max(0.0);
         self.move_vive(dt);
         self.step_guards(dt);
         self.noises.clear();
-        if self.phase != Phase::Heist {
-            return;
-        }
-        if self.present != (true, true) {
-            self.absent_s += dt;
-            if self.absent_s >= ABANDON_GRACE_S {
-                self.set_phase(Phase::Lost(LossReason::Abandoned));
-            }
-        } else {
-            self.absent_s = 0.0;
-        }
         if self.time_left_s <= 0.0 && self.phase == Phase::Heist {
             self.set_phase(Phase::Lost(LossReason::Time));
         }

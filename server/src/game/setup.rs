@@ -91,6 +91,7 @@ pub(super) fn new_game(level: Level, options: &GameOptions) -> Game {
         closed: false,
         options: options.clone(),
         rematch: (false, false),
+        kept: [None, None],
         idle_s: 0.0,
         warned_ending: false,
         joined_once: false,

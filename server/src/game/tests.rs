@@ -512,9 +512,17 @@ fn a_rematch_resets_the_idle_clock_and_an_empty_finished_session_closes_at_once(
     g.leave(Role::Vive, false);
     g.step(TICK_S);
     assert!(!g.closed, "Phantom is still there");
-    g.leave(Role::Phantom, true);
+    g.leave(Role::Phantom, false);
     g.step(TICK_S);
     assert!(g.closed, "nobody is left after the result");
+    // A dropped player's seat is kept: the finished session waits for them, then closes.
+    let mut g = lost_on_time(12, None);
+    g.leave(Role::Vive, false);
+    g.leave(Role::Phantom, true);
+    g.step(TICK_S);
+    assert!(!g.closed, "Phantom's seat is kept for a rematch");
+    step_for(&mut g, rules::SEAT_HOLD_S);
+    assert!(g.closed, "Phantom did not come back");
 }
 
 #[test]
@@ -530,4 +538,105 @@ fn a_lobby_waits_for_its_players_but_not_forever_once_they_all_went() {
         g.step(0.5);
     }
     assert!(g.closed);
+}
+
+fn step_for(g: &mut Game, seconds: f32) {
+    for _ in 0..(seconds / TICK_S).ceil() as u32 {
+        g.step(TICK_S);
+    }
+}
+
+fn sent_to(g: &mut Game, role: Role) -> Vec<ServerMsg> {
+    g.drain_outgoing()
+        .filter_map(|o| match o {
+            Outgoing::To(r, msg) if r == role => Some(msg),
+            _ => None,
+        })
+        .collect()
+}
+
+#[test]
+fn a_dropped_player_pauses_the_heist_and_the_timer_and_guards_stand_still() {
+    let mut g = started(21);
+    step_for(&mut g, 1.0);
+    let (left, elapsed) = (g.time_left_s, g.elapsed_s);
+    let guards: Vec<Vec2> = g.guards.iter().map(|gd| gd.position).collect();
+    g.leave(Role::Phantom, true);
+    assert!(g.is_paused() && g.is_seat_kept(Role::Phantom));
+    step_for(&mut g, 30.0);
+    assert_eq!((g.time_left_s, g.elapsed_s), (left, elapsed), "the heist clock stood still");
+    assert_eq!(g.guards.iter().map(|gd| gd.position).collect::<Vec<_>>(), guards, "no guard moved");
+    assert_eq!(g.phase, Phase::Heist);
+    assert!((g.seat_kept_for_s(Role::Phantom) - 30.0).abs() < 0.1);
+    // Vive's moves are acknowledged and dropped: he stands; his actions wait.
+    let at = g.vive.position;
+    vive(&mut g, walk(1, Vec2::X)).unwrap();
+    step_for(&mut g, 0.5);
+    assert_eq!((g.vive.position, g.vive.last_input_seq), (at, 1));
+    assert_eq!(vive(&mut g, ViveMsg::Break(CaseId(0))), Err(Refusal::Paused));
+    g.resume(Role::Phantom);
+    assert!(!g.is_paused() && !g.is_seat_kept(Role::Phantom));
+    assert!(events(&mut g).contains(&GameEvent::Resumed(Role::Phantom)));
+    step_for(&mut g, 1.0);
+    assert!(g.time_left_s < left, "the clock runs again");
+}
+
+#[test]
+fn a_seat_not_taken_back_within_the_hold_loses_the_heist_as_abandoned() {
+    let mut g = started(22);
+    g.leave(Role::Vive, true);
+    step_for(&mut g, rules::SEAT_HOLD_S - 1.0);
+    assert_eq!(g.phase, Phase::Heist, "still kept");
+    step_for(&mut g, 1.5);
+    assert_eq!(g.phase, Phase::Lost(LossReason::Abandoned));
+    assert!(!g.is_seat_kept(Role::Vive));
+    let heard = events(&mut g);
+    let gave_up = heard.iter().position(|e| *e == GameEvent::GaveUp(Role::Vive)).expect("the partner is told");
+    let lost = heard.iter().position(|e| *e == GameEvent::PhaseChanged(Phase::Lost(LossReason::Abandoned)));
+    assert!(lost > Some(gave_up), "gave up, then lost: {heard:?}");
+}
+
+#[test]
+fn a_seat_left_on_purpose_is_not_kept_and_the_heist_waits_less_for_a_newcomer() {
+    let mut g = started(23);
+    g.leave(Role::Phantom, false);
+    assert!(!g.is_seat_kept(Role::Phantom) && g.is_paused());
+    step_for(&mut g, ABANDON_GRACE_S + 0.5);
+    assert_eq!(g.phase, Phase::Lost(LossReason::Abandoned));
+}
+
+#[test]
+fn a_phantom_back_in_a_running_heist_gets_the_briefings_and_the_copy_on_the_bench() {
+    let mut g = started(24);
+    let item = grab_copy(&mut g, 0);
+    deliver(&mut g, item);
+    g.leave(Role::Phantom, true);
+    g.drain_outgoing().for_each(drop);
+    g.resume(Role::Phantom);
+    let got = sent_to(&mut g, Role::Phantom);
+    let caught_up = matches!(&got[..], [ServerMsg::Briefings(b), ServerMsg::Workbench(c)]
+        if b.len() == g.targets.len() && c.item == item);
+    assert!(caught_up, "{got:?}");
+    assert!(verdict(&mut g, item, true).is_ok(), "and can judge it");
+    // In the lobby there is nothing to catch up on.
+    let mut lobby = Game::new(Level::museum(), &GameOptions::default());
+    lobby.join(Role::Phantom);
+    assert!(sent_to(&mut lobby, Role::Phantom).is_empty());
+}
+
+#[test]
+fn a_vive_back_numbers_his_moves_afresh_and_they_count() {
+    let mut g = started(25);
+    for seq in 1..=200 {
+        vive(&mut g, walk(seq, Vec2::ZERO)).unwrap();
+        g.step(TICK_S);
+    }
+    assert_eq!(g.vive.last_input_seq, 200);
+    g.leave(Role::Vive, true);
+    g.resume(Role::Vive);
+    assert_eq!(g.vive.last_input_seq, 0, "the new connection's numbering starts over");
+    let at = g.vive.position;
+    vive(&mut g, walk(1, Vec2::X)).unwrap();
+    g.step(TICK_S);
+    assert!(g.vive.position.x > at.x, "move 1 of the new connection moved him");
 }

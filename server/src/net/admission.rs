@@ -1,11 +1,15 @@
-//! Admitting a client: read role and session from its token, refuse thieves of a taken role.
+//! Admitting a client: read role, session and seat ticket from its token, refuse thieves of a taken or
+//! kept seat, and keep a dropped player's seat for them.
 
 use bevy::prelude::*;
 use bevy_replicon::prelude::*;
 use bevy_replicon::shared::backend::connected_client::NetworkId;
-use heist_shared::protocol::{ClientRole, DisconnectReason, Role, ServerMsg, TokenUserData};
+use std::time::Instant;
+
+use heist_shared::protocol::{ClientRole, DisconnectReason, Role, SeatTicket, ServerMsg, TokenUserData};
 
 use super::limits::MessageLimits;
+use super::seats::Seat;
 use super::transport::GameTransport;
 use super::{Auth, NetSettings};
 use crate::session::{GameState, SessionLog};
@@ -72,6 +76,7 @@ pub(super) fn admit(
     add: On<Add, ConnectedClient>,
     mut commands: Commands,
     ids: Query<&NetworkId>,
+    mut players: Query<&mut Player>,
     transport: Option<Res<GameTransport>>,
     settings: Res<NetSettings>,
     mut roles: ResMut<Roles>,
@@ -98,38 +103,85 @@ pub(super) fn admit(
         }
     };
     let role = claim.role;
-    if roles.get(role).is_some() {
-        warn!("refused the connection from {peer}: the {role} role is taken");
-        log.line(game.0.elapsed_s, format!("a second {role} was refused: the role is taken"));
-        refuse_and_disconnect(client, DisconnectReason::RoleTaken(role), &mut messages, &mut disconnects);
-        return;
+    let seats = &settings.seats;
+    let (ticket, resumed) = match (claim.ticket, seats.get(role)) {
+        (None, Seat::Free) => (SeatTicket::random(), false),
+        (Some(t), Seat::Taken(ticket) | Seat::Kept { ticket, .. }) if t == ticket => (ticket, true),
+        (claimed, seat) => {
+            let reason = match (claimed, seat) {
+                (None, Seat::Taken(_)) => DisconnectReason::RoleTaken(role),
+                (None, _) => DisconnectReason::SeatHeld(role),
+                (Some(_), _) => DisconnectReason::BadSeat,
+            };
+            warn!("refused the connection from {peer} as {role}: {reason:?}");
+            log.line(game.0.elapsed_s, format!("a {role} was refused: {reason:?}"));
+            refuse_and_disconnect(client, reason, &mut messages, &mut disconnects);
+            return;
+        }
+    };
+    // A restarted client may come back before its old connection timed out: the new one replaces it.
+    if let Some(old) = roles.get(role) {
+        if let Ok(mut player) = players.get_mut(old) {
+            player.expelled = true; // nothing more it says counts
+        }
+        info!("{role} came back on a new connection: closing the old one");
+        refuse_and_disconnect(old, DisconnectReason::Replaced, &mut messages, &mut disconnects);
     }
     *roles.slot(role) = Some(client);
-    settings.roles.set(role, true);
+    seats.set(role, Seat::Taken(ticket));
     let limits = MessageLimits::new(time.elapsed_secs_f64());
     commands.entity(client).insert((
         Player { role, strikes: 0.0, expelled: false, leaving: false, limits, peer: peer_addr },
         ClientRole(role),
     ));
-    game.0.join(role);
-    info!("{role} joined from {peer}");
     messages.write(ToClients {
         targets: SendTargets::Single(ClientId::Client(client)),
-        message: ServerMsg::Welcome { role, level: Box::new(game.0.level.clone()) },
+        message: ServerMsg::Welcome { role, level: Box::new(game.0.level.clone()), seat: ticket, resumed },
     });
+    if resumed {
+        info!("{role} took the seat back from {peer}");
+        game.0.resume(role);
+    } else {
+        info!("{role} joined from {peer}");
+        game.0.join(role);
+    }
 }
 
+/// A connection ended: a player who left on purpose (or was expelled) frees the seat; one whose connection
+/// was lost (fell silent) has it kept for them ([`Seat::Kept`]) while the game keeps it.
 pub(super) fn forget(
     remove: On<Remove, ConnectedClient>,
     players: Query<&Player>,
+    ids: Query<&NetworkId>,
+    transport: Option<Res<GameTransport>>,
     settings: Res<NetSettings>,
     mut roles: ResMut<Roles>,
     mut game: ResMut<GameState>,
 ) {
     let Ok(player) = players.get(remove.entity) else { return };
-    if roles.get(player.role) == Some(remove.entity) {
-        *roles.slot(player.role) = None;
-        settings.roles.set(player.role, false);
-        game.0.leave(player.role, !player.leaving);
+    if roles.get(player.role) != Some(remove.entity) {
+        return; // refused, or replaced by its own player's new connection
+    }
+    *roles.slot(player.role) = None;
+    // Closing the connection on purpose (a `Leave`, or netcode's goodbye when a client quits without one)
+    // is leaving, and an expelled client keeps nothing; only a connection that fell silent is a drop,
+    // whose seat is kept.
+    let departed = ids.get(remove.entity).ok().zip(transport.as_ref()).and_then(|(id, t)| t.departure(id.get()));
+    let dropped = !player.leaving && !player.expelled && departed.is_none();
+    game.0.leave(player.role, dropped);
+    let seat = match settings.seats.get(player.role) {
+        Seat::Taken(ticket) if game.0.is_seat_kept(player.role) => Seat::Kept { ticket, since: Instant::now() },
+        _ => Seat::Free,
+    };
+    settings.seats.set(player.role, seat);
+}
+
+/// Frees a kept seat once the game gave it up (its player did not come back in time).
+pub(super) fn give_up_seats(settings: Res<NetSettings>, roles: Res<Roles>, game: Res<GameState>) {
+    for role in [Role::Vive, Role::Phantom] {
+        let kept = matches!(settings.seats.get(role), Seat::Kept { .. });
+        if kept && roles.get(role).is_none() && !game.0.is_seat_kept(role) {
+            settings.seats.set(role, Seat::Free);
+        }
     }
 }

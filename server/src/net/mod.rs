@@ -7,6 +7,7 @@
 mod admission;
 pub mod limits;
 pub mod receive;
+pub mod seats;
 pub mod send;
 pub mod tokens;
 pub mod transport;
@@ -23,7 +24,7 @@ use heist_transport::IntakeLimits;
 use heist_transport::renetcode::{ServerAuthentication, ServerConfig};
 
 pub use admission::{Player, Roles};
-use tokens::RoleTable;
+use seats::Seats;
 
 /// How clients prove who they are.
 #[derive(Clone)]
@@ -44,8 +45,8 @@ pub enum Auth {
 pub struct NetSettings {
     /// Authentication mode.
     pub auth: Auth,
-    /// Roles in play, shared with the token endpoint.
-    pub roles: RoleTable,
+    /// The session's seats, shared with the token endpoint.
+    pub seats: Seats,
     /// Refused messages (leaking one per second) tolerated per client before it is disconnected for abuse.
     pub abuse_limit: u32,
     /// The address put in tokens and checked in connection requests, when not the bound one.
@@ -93,7 +94,10 @@ impl Plugin for ServerNetPlugin {
             .configure_sets(PreUpdate, NetSystems::Receive.after(ServerSystems::Receive))
             .configure_sets(PostUpdate, NetSystems::Send.before(ServerSystems::Send))
             .add_systems(PreUpdate, receive::apply_client_messages.in_set(NetSystems::Receive))
-            .add_systems(PostUpdate, (send::send_outgoing, close_session).chain().in_set(NetSystems::Send));
+            .add_systems(
+                PostUpdate,
+                (send::send_outgoing, admission::give_up_seats, close_session).chain().in_set(NetSystems::Send),
+            );
         transport::add_systems(app);
     }
 }

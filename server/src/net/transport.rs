@@ -39,6 +39,11 @@ impl GameTransport {
         self.intake.client_addr(client_id)
     }
 
+    /// How a client that just went left, unless it fell silent (see [`ServerIntake::departure`]).
+    pub fn departure(&self, client_id: u64) -> Option<heist_transport::Departure> {
+        self.intake.departure(client_id)
+    }
+
     /// What the intake passed and refused so far.
     pub fn stats(&self) -> IntakeStats {
         self.intake.stats()

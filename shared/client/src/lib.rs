@@ -8,23 +8,25 @@
 
 mod error;
 pub mod notice;
+pub mod rejoin;
+pub mod seats;
 mod token;
 pub mod transport;
 
 pub use error::JoinError;
-pub use token::request_token;
+pub use rejoin::{Reconnect, Rejoin};
+pub use seats::{Joining, SeatCache, SeatKeeper, hold_seat, join_or_resume};
+pub use token::{request_resume_token, request_token};
 
-use std::net::UdpSocket;
 use std::time::{SystemTime, UNIX_EPOCH};
 
 use bevy::prelude::*;
 use bevy_replicon::prelude::*;
+use bevy_replicon_renet::RenetChannelsExt;
 use bevy_replicon_renet::renet::ConnectionConfig;
-use bevy_replicon_renet::{RenetChannelsExt, RenetClient};
 use heist_shared::artifact::Briefing;
 use heist_shared::level::Level;
-use heist_shared::protocol::{DisconnectReason, GameEvent, Refusal, Role, ServerMsg, WorkbenchCopy};
-use heist_transport::ClientIntake;
+use heist_shared::protocol::{DisconnectReason, GameEvent, Refusal, Role, SeatTicket, ServerMsg, WorkbenchCopy};
 use heist_transport::renetcode::{ClientAuthentication, ConnectToken};
 
 /// What the server has told this client, kept for the app's systems to read.
@@ -44,6 +46,10 @@ pub struct Inbox {
     pub refusals: Vec<Refusal>,
     /// Why the server disconnected us, if it said so.
     pub disconnect: Option<DisconnectReason>,
+    /// Our seat's ticket (after `Welcome`): what takes the seat back after a lost connection.
+    pub seat: Option<SeatTicket>,
+    /// True when the last `Welcome` took a kept seat back.
+    pub resumed: bool,
     /// The last `RoundStarted` (0 before one: a session's first round sends none; [`Inbox::current_round`]
     /// reads it). A new round clears the briefings and the workbench.
     pub round: u32,
@@ -91,9 +97,10 @@ impl Plugin for ClientNetPlugin {
             .init_resource::<Inbox>()
             .init_resource::<Leaving>()
             .init_resource::<Link>()
+            .init_resource::<Reconnect>()
             .configure_sets(PreUpdate, ClientNetSystems::Receive.after(ClientSystems::Receive))
-            .add_systems(PreUpdate, (fill_inbox, watch_link).in_set(ClientNetSystems::Receive))
-            .add_systems(Update, leave);
+            .add_systems(PreUpdate, (fill_inbox, watch_link, rejoin::drive).chain().in_set(ClientNetSystems::Receive))
+            .add_systems(Update, (leave, seats::keep_seat));
         transport::add_systems(app);
     }
 }
@@ -101,9 +108,11 @@ impl Plugin for ClientNetPlugin {
 fn fill_inbox(mut messages: MessageReader<ServerMsg>, mut inbox: ResMut<Inbox>) {
     for msg in messages.read() {
         match msg.clone() {
-            ServerMsg::Welcome { role, level } => {
+            ServerMsg::Welcome { role, level, seat, resumed } => {
                 inbox.role = Some(role);
                 inbox.level = Some(*level);
+                inbox.seat = Some(seat);
+                inbox.resumed = resumed;
                 inbox.received.welcome += 1;
             }
             ServerMsg::Refused(r) => inbox.refusals.push(r),
@@ -164,6 +173,14 @@ fn watch_link(transport: Option<Res<transport::ClientTransport>>, time: Res<Time
     }
 }
 
+/// True once this client's connection is over for good: the server said why, coming back failed, or the
+/// link is gone and no way back is being tried (no [`Rejoin`], or the loss had a reason).
+pub fn connection_over(link: Link, inbox: &Inbox, reconnect: &Reconnect) -> bool {
+    inbox.disconnect.is_some()
+        || matches!(reconnect, Reconnect::GaveUp(_))
+        || (link == Link::Gone && !reconnect.is_trying())
+}
+
 /// Leaving on purpose: set [`Leaving::since`] (or call [`Leaving::start`]) and the client says `Leave` to
 /// the server (so the partner hears "left", not "dropped"), waits for the server to close the connection
 /// (at most [`LEAVE_WAIT_S`]) and exits the app.
@@ -220,7 +237,7 @@ pub fn connect(app: &mut App, token: ConnectToken) -> Result<(), JoinError> {
 
 /// Connects without a token (the server must run with `--insecure`), claiming `role`.
 pub fn connect_insecure(app: &mut App, server: std::net::SocketAddr, role: Role) -> Result<(), JoinError> {
-    let user_data = heist_shared::protocol::TokenUserData { role, session: 0 }.encode();
+    let user_data = heist_shared::protocol::TokenUserData { role, session: 0, ticket: None }.encode();
     let client_id = SystemTime::now().duration_since(UNIX_EPOCH).unwrap_or_default().as_nanos() as u64;
     let auth = ClientAuthentication::Unsecure {
         protocol_id: heist_shared::protocol::PROTOCOL_ID,
@@ -232,12 +249,7 @@ pub fn connect_insecure(app: &mut App, server: std::net::SocketAddr, role: Role)
 }
 
 fn insert_transport(app: &mut App, server: std::net::SocketAddr, auth: ClientAuthentication) -> Result<(), JoinError> {
-    let bind = if server.ip().is_loopback() { "127.0.0.1:0" } else { "0.0.0.0:0" };
-    let socket = UdpSocket::bind(bind).map_err(JoinError::Socket)?;
-    let now = SystemTime::now().duration_since(UNIX_EPOCH).unwrap_or_default();
-    let intake = ClientIntake::new(now, auth).map_err(|e| JoinError::Transport(e.to_string()))?;
-    let transport = transport::ClientTransport::new(socket, intake).map_err(JoinError::Socket)?;
-    let connection = connection_config(app.world().resource::<RepliconChannels>());
-    app.insert_resource(RenetClient::new(connection)).insert_resource(transport);
+    let (renet, transport) = rejoin::transport_with(server, auth, app.world().resource::<RepliconChannels>())?;
+    app.insert_resource(renet).insert_resource(transport);
     Ok(())
 }

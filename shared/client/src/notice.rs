@@ -11,8 +11,11 @@ pub fn session_notice(event: &GameEvent, me: Role) -> Option<String> {
         GameEvent::Joined(r) if partner(r) => format!("{r} joined."),
         GameEvent::Left { role, dropped: false } if partner(role) => format!("{role} left the session."),
         GameEvent::Left { role, dropped: true } if partner(role) => {
-            format!("{role}'s connection dropped.")
+            format!("{role}'s connection dropped. Their seat is kept for a minute; a heist stands still meanwhile.")
         }
+        GameEvent::Resumed(r) if partner(r) => format!("{r} is back."),
+        GameEvent::Resumed(_) => "You are back in your seat.".to_owned(),
+        GameEvent::GaveUp(r) if partner(r) => format!("{r} did not come back in time."),
         GameEvent::RematchAsked(r) if partner(r) => format!("{r} asks for another round."),
         GameEvent::RematchAsked(_) => "You asked for another round.".to_owned(),
         GameEvent::RoundStarted(n) => format!("Round {n} begins, with new copies."),
@@ -28,21 +31,38 @@ pub fn link_notice(was: crate::Link, now: crate::Link) -> Option<&'static str> {
         (Link::Up, Link::Silent) => Some("The connection to the server is lost. Waiting for it to come back."),
         (Link::Silent, Link::Up) => Some("The connection is back."),
         (Link::Connecting, Link::Silent) => Some("The server does not answer."),
-        (_, Link::Gone) => Some("The server is gone: the session is over for us."),
+        (_, Link::Gone) => {
+            Some("The server is gone. If it comes back within a minute, join again to take your seat back.")
+        }
         _ => None,
     }
 }
 
 /// The line for the link's change from `was` to `now`, unless it ended for a reason the player already
-/// has: the server said why ([`disconnect_notice`]) or the player is leaving.
+/// has: the server said why ([`disconnect_notice`]), the player is leaving, or the client is trying to
+/// get back in ([`reconnect_notice`] tells that).
 pub fn link_change_notice(
     was: crate::Link,
     now: crate::Link,
     inbox: &crate::Inbox,
     leaving: &crate::Leaving,
+    reconnect: &crate::Reconnect,
 ) -> Option<&'static str> {
-    let explained = inbox.disconnect.is_some() || leaving.since.is_some();
+    let explained = inbox.disconnect.is_some() || leaving.since.is_some() || reconnect.is_trying();
     if now == crate::Link::Gone && explained { None } else { link_notice(was, now) }
+}
+
+/// A change of [`crate::Reconnect`] as a line for the player: that the client tries to get back in
+/// (once), and why it gave up. Being back is told by the server's `Resumed` ([`session_notice`]).
+pub fn reconnect_notice(was: &crate::Reconnect, now: &crate::Reconnect) -> Option<String> {
+    use crate::Reconnect;
+    match (was, now) {
+        (Reconnect::Steady, Reconnect::Trying { .. }) => Some("Trying to get back into the session.".to_owned()),
+        (_, Reconnect::GaveUp(why)) if !matches!(was, Reconnect::GaveUp(_)) => {
+            Some(format!("Could not get back into the session: {why}."))
+        }
+        _ => None,
+    }
 }
 
 /// Why the server let us go, as a line for the player.
@@ -52,6 +72,11 @@ pub fn disconnect_notice(reason: &DisconnectReason) -> String {
         DisconnectReason::BadToken => "The server refused our token: join again with a fresh code.".to_owned(),
         DisconnectReason::Abuse => "The server disconnected us for sending too many refused messages.".to_owned(),
         DisconnectReason::SessionEnded => "The session is over. Thank you for playing.".to_owned(),
+        DisconnectReason::SeatHeld(r) => {
+            format!("The server refused us: the {r} seat is kept for the player who dropped from it.")
+        }
+        DisconnectReason::BadSeat => "The server refused our seat ticket: join again with the code.".to_owned(),
+        DisconnectReason::Replaced => "This seat was taken back by our own new connection.".to_owned(),
     }
 }
 
@@ -64,7 +89,10 @@ mod tests {
         assert_eq!(session_notice(&GameEvent::Joined(Role::Vive), Role::Phantom).as_deref(), Some("Vive joined."));
         assert_eq!(session_notice(&GameEvent::Joined(Role::Phantom), Role::Phantom), None);
         let dropped = GameEvent::Left { role: Role::Phantom, dropped: true };
-        assert_eq!(session_notice(&dropped, Role::Vive).as_deref(), Some("Phantom's connection dropped."));
+        let heard = session_notice(&dropped, Role::Vive).unwrap();
+        assert!(heard.starts_with("Phantom's connection dropped.") && heard.contains("seat is kept"), "{heard}");
+        assert_eq!(session_notice(&GameEvent::Resumed(Role::Phantom), Role::Vive).as_deref(), Some("Phantom is back."));
+        assert!(session_notice(&GameEvent::GaveUp(Role::Vive), Role::Phantom).is_some_and(|l| l.contains("did not")));
         let left = GameEvent::Left { role: Role::Phantom, dropped: false };
         assert_eq!(session_notice(&left, Role::Vive).as_deref(), Some("Phantom left the session."));
     }
@@ -74,21 +102,37 @@ mod tests {
         use crate::Link;
         assert!(link_notice(Link::Up, Link::Silent).is_some_and(|l| l.contains("lost")));
         assert_eq!(link_notice(Link::Silent, Link::Up), Some("The connection is back."));
-        assert!(link_notice(Link::Silent, Link::Gone).is_some_and(|l| l.contains("gone")));
+        assert!(link_notice(Link::Silent, Link::Gone).is_some_and(|l| l.contains("gone") && l.contains("seat back")));
         assert_eq!(link_notice(Link::Connecting, Link::Up), None, "connecting is no news");
     }
 
     #[test]
     fn a_lost_server_is_not_announced_when_the_end_was_already_explained() {
-        use crate::{Inbox, Leaving, Link};
-        let (mut inbox, mut leaving) = (Inbox::default(), Leaving::default());
-        assert!(link_change_notice(Link::Up, Link::Gone, &inbox, &leaving).is_some_and(|l| l.contains("gone")));
+        use crate::{Inbox, Leaving, Link, Reconnect};
+        let (mut inbox, mut leaving, steady) = (Inbox::default(), Leaving::default(), Reconnect::Steady);
+        let gone = link_change_notice(Link::Up, Link::Gone, &inbox, &leaving, &steady);
+        assert!(gone.is_some_and(|l| l.contains("gone")));
+        let trying = Reconnect::Trying { attempts: 1 };
+        assert_eq!(link_change_notice(Link::Silent, Link::Gone, &inbox, &leaving, &trying), None, "coming back");
         leaving.start(1.0);
-        assert_eq!(link_change_notice(Link::Up, Link::Gone, &inbox, &leaving), None, "we left");
+        assert_eq!(link_change_notice(Link::Up, Link::Gone, &inbox, &leaving, &steady), None, "we left");
         let leaving = Leaving::default();
         inbox.disconnect = Some(DisconnectReason::SessionEnded);
-        assert_eq!(link_change_notice(Link::Up, Link::Gone, &inbox, &leaving), None, "the server said why");
-        assert!(link_change_notice(Link::Up, Link::Silent, &inbox, &leaving).is_some(), "only the end is muted");
+        assert_eq!(link_change_notice(Link::Up, Link::Gone, &inbox, &leaving, &steady), None, "the server said why");
+        let silent = link_change_notice(Link::Up, Link::Silent, &inbox, &leaving, &steady);
+        assert!(silent.is_some(), "only the end is muted");
+    }
+
+    #[test]
+    fn trying_to_come_back_is_said_once_and_giving_up_says_why() {
+        use crate::Reconnect;
+        let (steady, trying) = (Reconnect::Steady, Reconnect::Trying { attempts: 1 });
+        assert!(reconnect_notice(&steady, &trying).is_some_and(|l| l.starts_with("Trying to get back")));
+        assert_eq!(reconnect_notice(&trying, &Reconnect::Trying { attempts: 2 }), None, "once, not per attempt");
+        assert_eq!(reconnect_notice(&trying, &steady), None, "the server's Resumed tells it");
+        let gave_up = Reconnect::GaveUp("no way back into the session for 60 s".into());
+        let line = reconnect_notice(&trying, &gave_up).unwrap();
+        assert_eq!(line, "Could not get back into the session: no way back into the session for 60 s.");
     }
 
     #[test]

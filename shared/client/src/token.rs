@@ -1,12 +1,13 @@
 //! Asking the host's token endpoint for a connect token: the join exchange of
-//! [`heist_shared::protocol::join`], client side (blocking, with a timeout on every step).
+//! [`heist_shared::protocol::join`] (with the join code, or with a seat ticket to come back), client side
+//! (blocking, with a timeout on every step).
 
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpStream};
 use std::time::Duration;
 
 use heist_shared::protocol::join::{self, JOIN_VERSION, JoinMsg, JoinReply, MAX_FRAME, Pake};
-use heist_shared::protocol::{PROTOCOL_ID, Role};
+use heist_shared::protocol::{PROTOCOL_ID, Role, SeatTicket};
 use heist_transport::renetcode::ConnectToken;
 
 use crate::JoinError;
@@ -18,13 +19,29 @@ pub fn request_token(
     role: Role,
     timeout: Duration,
 ) -> Result<ConnectToken, JoinError> {
+    let (pake, ours) = Pake::client(code);
+    exchange(endpoint, JoinMsg::Hello { version: JOIN_VERSION, role, pake: ours }, pake, timeout)
+}
+
+/// Exchanges a seat ticket for a connect token that takes the kept (or still taken) `role` seat back at
+/// `endpoint`: the resume exchange, keyed by the ticket instead of the join code.
+pub fn request_resume_token(
+    endpoint: SocketAddr,
+    role: Role,
+    ticket: &SeatTicket,
+    timeout: Duration,
+) -> Result<ConnectToken, JoinError> {
+    let (pake, ours) = Pake::client_ticket(ticket);
+    exchange(endpoint, JoinMsg::Resume { version: JOIN_VERSION, role, pake: ours }, pake, timeout)
+}
+
+fn exchange(endpoint: SocketAddr, opening: JoinMsg, pake: Pake, timeout: Duration) -> Result<ConnectToken, JoinError> {
     let unreachable = |cause| JoinError::Unreachable { addr: endpoint, cause };
     let mut stream = TcpStream::connect_timeout(&endpoint, timeout).map_err(unreachable)?;
     stream.set_read_timeout(Some(timeout)).map_err(unreachable)?;
     stream.set_write_timeout(Some(timeout)).map_err(unreachable)?;
 
-    let (pake, ours) = Pake::client(code);
-    let hello = join::frame(&JoinMsg::Hello { version: JOIN_VERSION, role, pake: ours });
+    let hello = join::frame(&opening);
     stream.write_all(&hello).map_err(unreachable)?;
     let challenge = read_frame(&mut stream).map_err(unreachable)?;
     let theirs = match decode(&challenge)? {

@@ -24,6 +24,9 @@ pub const RUN_LOUDNESS: f32 = 6.0;
 pub const ALARM_LOCKDOWN: u8 = 3;
 /// Distance at which a guard catches Vive, metres.
 pub const CATCH_DISTANCE: f32 = 0.9;
+/// Seconds the seat of a player whose connection was lost is kept for them (their seat ticket) before
+/// it is given up; a running heist stands still meanwhile.
+pub const SEAT_HOLD_S: f32 = 60.0;
 
 /// Top speed of `gait`, m/s.
 pub fn gait_speed(gait: crate::protocol::Gait) -> f32 {

@@ -21,7 +21,7 @@ pub mod throttle;
 
 pub use client::ClientIntake;
 pub use error::{DatagramRefusal, PayloadRefusal, TransportError};
-pub use server::{IntakeLimits, IntakeStats, Refused, ServerIntake};
+pub use server::{Departure, IntakeLimits, IntakeStats, Refused, ServerIntake};
 
 pub use renet;
 pub use renetcode;

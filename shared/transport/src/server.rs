@@ -112,6 +112,21 @@ struct Peers {
     now_s: f64,
     connections: HashMap<u64, Connection>,
     stats: IntakeStats,
+    /// The last clients that went other than by falling silent, and how.
+    departures: std::collections::VecDeque<(u64, Departure)>,
+}
+
+/// Departures remembered (the newest kept): enough for the game to ask about the clients that just went.
+const DEPARTURES_KEPT: usize = 64;
+
+/// How a connection ended other than by falling silent.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Departure {
+    /// The client sent netcode's disconnect packet: it closed the connection itself.
+    Goodbye,
+    /// The server let it go: the intake expelled it for refused payloads, renet for a protocol error, or
+    /// the game asked.
+    LetGo,
 }
 
 /// Checks and forwards every datagram of the game socket.
@@ -132,7 +147,13 @@ impl ServerIntake {
         Self {
             netcode: NetcodeServer::new(config),
             requests: KeyedLimiter::new(limits.requests_per_address, limits.requests_total, limits.tracked_addresses),
-            peers: Peers { limits, now_s: 0.0, connections: HashMap::new(), stats: IntakeStats::default() },
+            peers: Peers {
+                limits,
+                now_s: 0.0,
+                connections: HashMap::new(),
+                stats: IntakeStats::default(),
+                departures: std::collections::VecDeque::with_capacity(DEPARTURES_KEPT),
+            },
             log: RefusalLog::new("heist_transport::server", "UDP intake"),
         }
     }
@@ -158,6 +179,11 @@ impl ServerIntake {
             Ok(kind) => {
                 let result = self.netcode.process_packet(from, datagram);
                 let ignored = matches!(result, ServerResult::None);
+                // Netcode ends a connection on a received datagram only for the client's own disconnect
+                // packet (timeouts and the server's disconnects come from `update`).
+                if let ServerResult::ClientDisconnected { client_id, .. } = &result {
+                    self.peers.departed(*client_id, Departure::Goodbye);
+                }
                 return match self.peers.handle(result, renet, send) {
                     Some((client_id, refusal)) => Err(self.refused_payload(client_id, refusal, renet)),
                     // netcode says why only in its own log (`RUST_LOG=renetcode=debug`); a request or a
@@ -190,7 +216,7 @@ impl ServerIntake {
 
     /// Logs a refused payload and disconnects its client once it has sent too many.
     fn refused_payload(&mut self, client_id: u64, refusal: PayloadRefusal, renet: &mut RenetServer) -> Refused {
-        let Peers { limits, now_s, connections, stats } = &mut self.peers;
+        let Peers { limits, now_s, connections, stats, .. } = &mut self.peers;
         stats.refused_payloads += 1;
         let Some(c) = connections.get_mut(&client_id) else { return Refused::Payload(refusal) };
         self.log.refused(c.addr, &Refused::Payload(refusal), *now_s);
@@ -209,6 +235,7 @@ impl ServerIntake {
             self.peers.handle(self.netcode.update_client(id), renet, send);
         }
         for id in renet.disconnections_id() {
+            self.peers.departed(id, Departure::LetGo);
             self.peers.handle(self.netcode.disconnect(id), renet, send);
         }
     }
@@ -249,6 +276,12 @@ impl ServerIntake {
         self.netcode.client_addr(client_id)
     }
 
+    /// How `client_id` went, when it was one of the last 64 to go other than by falling silent (or by a
+    /// disconnect the server asked for): `None` for a connection that timed out.
+    pub fn departure(&self, client_id: u64) -> Option<Departure> {
+        self.peers.departures.iter().find(|(id, _)| *id == client_id).map(|(_, d)| *d)
+    }
+
     /// Counts so far.
     pub fn stats(&self) -> IntakeStats {
         self.peers.stats
@@ -276,6 +309,13 @@ impl Connection {
 }
 
 impl Peers {
+    fn departed(&mut self, client_id: u64, how: Departure) {
+        if self.departures.len() == DEPARTURES_KEPT {
+            self.departures.pop_front();
+        }
+        self.departures.push_back((client_id, how));
+    }
+
     /// Acts on one netcode result: sends what it says to send, passes a checked payload to renet; returns
     /// the payload refusal, if that is what it came to.
     fn handle(

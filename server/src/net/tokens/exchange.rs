@@ -5,7 +5,7 @@ use std::sync::Arc;
 use std::time::{SystemTime, UNIX_EPOCH};
 
 use heist_shared::protocol::join::{self, JOIN_VERSION, JoinMsg, JoinRefusal, JoinReply, Pake};
-use heist_shared::protocol::{PROTOCOL_ID, Role, TokenUserData};
+use heist_shared::protocol::{PROTOCOL_ID, Role, SeatTicket, TokenUserData};
 use heist_transport::limit::address_key;
 use heist_transport::renetcode::ConnectToken;
 use tokio::io::{AsyncReadExt, AsyncWriteExt};
@@ -101,22 +101,36 @@ fn decode(body: &[u8]) -> Result<JoinMsg, Failure> {
     join::decode(body).map_err(|e| Failure::Refused(JoinRefusal::BadRequest(e)))
 }
 
-/// The exchange itself: hello, challenge, confirmation, token.
+/// The exchange itself: hello (or resume), challenge, confirmation, token.
 async fn exchange(stream: &mut TcpStream, peer: SocketAddr, shared: &Shared) -> Result<Role, Failure> {
     let hello = read_frame(stream).await?;
-    let JoinMsg::Hello { version, role, pake } = decode(&hello)? else {
-        return Err(Failure::Refused(JoinRefusal::BadRequest("the exchange starts with a hello".into())));
+    let (version, role, pake, resume) = match decode(&hello)? {
+        JoinMsg::Hello { version, role, pake } => (version, role, pake, false),
+        JoinMsg::Resume { version, role, pake } => (version, role, pake, true),
+        JoinMsg::Confirm { .. } => {
+            return Err(Failure::Refused(JoinRefusal::BadRequest("the exchange starts with a hello".into())));
+        }
     };
     if version != JOIN_VERSION {
         return Err(Failure::Refused(JoinRefusal::Version { server: JOIN_VERSION, client: version }));
     }
-    let code = shared.config.codes.current();
-    if code.is_expired() {
-        log::warn!("token endpoint: {peer} tried to join but the join code has expired (type `rotate` for a new one)");
-        return Err(Failure::Refused(JoinRefusal::CodeExpired));
-    }
+    // A resume is keyed by the seat's ticket, and works after the code expired or was rotated.
+    let (server, ours, ticket) = if resume {
+        let ticket = shared.config.seats.ticket_to_resume(role).map_err(Failure::Refused)?;
+        let (server, ours) = Pake::server_ticket(&ticket);
+        (server, ours, Some(ticket))
+    } else {
+        let code = shared.config.codes.current();
+        if code.is_expired() {
+            log::warn!(
+                "token endpoint: {peer} tried to join but the join code has expired (type `rotate` for a new one)"
+            );
+            return Err(Failure::Refused(JoinRefusal::CodeExpired));
+        }
+        let (server, ours) = Pake::server(&code.code);
+        (server, ours, None)
+    };
     let attempt = Attempt::begin(shared, peer)?;
-    let (server, ours) = Pake::server(&code.code);
     let challenge = join::frame(&JoinReply::Challenge { pake: ours });
     stream.write_all(&challenge).await?;
     let confirm = read_frame(stream).await?;
@@ -128,22 +142,24 @@ async fn exchange(stream: &mut TcpStream, peer: SocketAddr, shared: &Shared) -> 
     if keys.client_mac != blake3::Hash::from(mac) {
         let delay = attempt.end(Outcome::Wrong);
         tokio::time::sleep(std::time::Duration::from_secs_f64(delay)).await;
-        return Err(Failure::Refused(JoinRefusal::WrongCode));
+        let wrong = if resume { JoinRefusal::WrongTicket } else { JoinRefusal::WrongCode };
+        return Err(Failure::Refused(wrong));
     }
     attempt.end(Outcome::Right);
-    if shared.config.roles.is_taken(role) {
-        return Err(Failure::Refused(JoinRefusal::RoleTaken(role)));
+    if !resume {
+        shared.config.seats.check_join(role).map_err(Failure::Refused)?;
     }
-    let token = mint(&shared.config, role).map_err(|e| Failure::Refused(JoinRefusal::Internal(e)))?;
+    let token = mint(&shared.config, role, ticket).map_err(|e| Failure::Refused(JoinRefusal::Internal(e)))?;
     let sealed = keys.seal(&token).map_err(|e| Failure::Refused(JoinRefusal::Internal(e)))?;
     stream.write_all(&join::frame(&JoinReply::Token { sealed })).await?;
     Ok(role)
 }
 
 /// A connect token for `role` in netcode's wire format.
-fn mint(config: &TokenConfig, role: Role) -> Result<Vec<u8>, String> {
+/// A resume's token carries the seat ticket it proved, for admission to check again.
+fn mint(config: &TokenConfig, role: Role, ticket: Option<SeatTicket>) -> Result<Vec<u8>, String> {
     let now = SystemTime::now().duration_since(UNIX_EPOCH).unwrap_or_default();
-    let user_data = TokenUserData { role, session: config.session }.encode();
+    let user_data = TokenUserData { role, session: config.session, ticket }.encode();
     let token = ConnectToken::generate(
         now,
         PROTOCOL_ID,

@@ -16,34 +16,12 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant, SystemTime};
 
-use heist_shared::protocol::Role;
 use heist_transport::limit::address_key;
 use heist_transport::throttle::RefusalLog;
 
+use super::seats::Seats;
 use connections::Connections;
 use guesses::{GuessLimits, Guesses};
-
-/// Which roles are currently taken, shared by the game server and the token endpoint.
-#[derive(Clone, Debug, Default)]
-pub struct RoleTable(Arc<Mutex<[bool; 2]>>);
-
-impl RoleTable {
-    fn index(role: Role) -> usize {
-        usize::from(role.to_byte() - 1)
-    }
-
-    /// Marks a role taken or free.
-    pub fn set(&self, role: Role, taken: bool) {
-        if let Ok(mut t) = self.0.lock() {
-            t[Self::index(role)] = taken;
-        }
-    }
-
-    /// True when someone plays `role`.
-    pub fn is_taken(&self, role: Role) -> bool {
-        self.0.lock().map(|t| t[Self::index(role)]).unwrap_or(true)
-    }
-}
 
 /// A join code and when it stops working.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -139,8 +117,8 @@ pub struct TokenConfig {
     pub server_addr: SocketAddr,
     /// Session id written into every token.
     pub session: u64,
-    /// Roles in play.
-    pub roles: RoleTable,
+    /// The session's seats.
+    pub seats: Seats,
     /// Limits.
     pub limits: TokenLimits,
 }

@@ -13,14 +13,20 @@
 //!   Confirm { mac(K, transcript) }    ──▶  (a wrong mac is a wrong code)
 //!                                     ◀──  Token { sealed(K, connect token) }
 //! ```
+//!
+//! A player coming back to a held seat opens with `Resume` instead of `Hello`: the same exchange, keyed by
+//! the seat ticket the server gave them at their first admission instead of the join code (so it works
+//! after the code expired or was rotated, and only for that seat's holder). The token it yields carries the
+//! ticket, which admission checks again.
 
 use serde::{Deserialize, Serialize};
 use spake2::{Ed25519Group, Identity, Password, Spake2};
 
 use super::ids::Role;
+use super::token::SeatTicket;
 
 /// Version of the join exchange; both sides must speak the same.
-pub const JOIN_VERSION: u8 = 2;
+pub const JOIN_VERSION: u8 = 3;
 /// Largest frame body either side accepts, bytes (a sealed token is ~2.1 KB).
 pub const MAX_FRAME: usize = 4096;
 
@@ -40,6 +46,16 @@ pub enum JoinMsg {
     Confirm {
         /// Keyed hash of the transcript.
         mac: [u8; 32],
+    },
+    /// Opens the exchange of a player taking back a held seat: the SPAKE2 message is keyed by the seat
+    /// ticket ([`Pake::client_ticket`]).
+    Resume {
+        /// [`JOIN_VERSION`] of the client.
+        version: u8,
+        /// The seat's role.
+        role: Role,
+        /// The client's SPAKE2 message.
+        pake: Vec<u8>,
     },
 }
 
@@ -72,6 +88,20 @@ pub enum JoinRefusal {
     /// Someone already plays that role.
     #[error("the {0} role is already taken")]
     RoleTaken(Role),
+    /// The role's player dropped and their seat is kept for them (only their seat ticket takes it).
+    #[error("the {role} seat is kept for its player, who dropped, for {for_s} s more")]
+    SeatHeld {
+        /// The seat.
+        role: Role,
+        /// Seconds the server keeps it at most.
+        for_s: u32,
+    },
+    /// A resume named a seat that is not kept for anyone (the session ended, or it was given up).
+    #[error("there is no {0} seat to come back to: join with the code")]
+    NoSeat(Role),
+    /// A resume's seat ticket is not the seat's.
+    #[error("the seat ticket is not the one of that seat")]
+    WrongTicket,
     /// Too many wrong codes came from this address.
     #[error("too many wrong join codes from your address; try again in {retry_after_s} s")]
     TooManyWrongCodes {
@@ -130,6 +160,11 @@ pub fn normalize_code(code: &str) -> String {
     code.chars().filter(|c| !c.is_whitespace() && *c != '-').map(|c| c.to_ascii_uppercase()).collect()
 }
 
+/// A ticket as a SPAKE2 password: prefixed, so no join code can ever equal one.
+fn ticket_password(ticket: &SeatTicket) -> Password {
+    Password::new(format!("seat:{}", ticket.to_hex()))
+}
+
 fn identities() -> (Identity, Identity) {
     (Identity::new(b"phantom-heist player"), Identity::new(b"phantom-heist host"))
 }
@@ -149,6 +184,20 @@ impl Pake {
     pub fn server(code: &str) -> (Self, Vec<u8>) {
         let (a, b) = identities();
         let (state, msg) = Spake2::<Ed25519Group>::start_b(&Password::new(normalize_code(code)), &a, &b);
+        (Self(state), msg)
+    }
+
+    /// The client's side of a resume, keyed by its seat ticket.
+    pub fn client_ticket(ticket: &SeatTicket) -> (Self, Vec<u8>) {
+        let (a, b) = identities();
+        let (state, msg) = Spake2::<Ed25519Group>::start_a(&ticket_password(ticket), &a, &b);
+        (Self(state), msg)
+    }
+
+    /// The server's side of a resume, keyed by the seat's ticket.
+    pub fn server_ticket(ticket: &SeatTicket) -> (Self, Vec<u8>) {
+        let (a, b) = identities();
+        let (state, msg) = Spake2::<Ed25519Group>::start_b(&ticket_password(ticket), &a, &b);
         (Self(state), msg)
     }
 
@@ -219,6 +268,20 @@ mod tests {
         let (c, s) = exchange("K7QX-2M4Q", "K7QX-2M4P");
         assert_ne!(c.client_mac, s.client_mac);
         assert_eq!(c.open(&s.seal(b"token").unwrap()), None);
+    }
+
+    #[test]
+    fn a_resume_is_keyed_by_the_ticket_and_only_the_same_ticket_agrees() {
+        let keys = |client: &SeatTicket, server: &SeatTicket| {
+            let (c, a) = Pake::client_ticket(client);
+            let (s, b) = Pake::server_ticket(server);
+            (c.finish(&b, b"resume", b"challenge").unwrap(), s.finish(&a, b"resume", b"challenge").unwrap())
+        };
+        let ticket = SeatTicket::random();
+        let (c, s) = keys(&ticket, &ticket);
+        assert_eq!(c.client_mac, s.client_mac);
+        let (c, s) = keys(&SeatTicket::random(), &ticket);
+        assert_ne!(c.client_mac, s.client_mac);
     }
 
     #[test]

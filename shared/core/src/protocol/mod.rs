@@ -18,7 +18,7 @@ pub use replicated::{
     Phase, REPLICATED, SessionView, Stance, ViveAvatar,
 };
 pub use server_msg::{DisconnectReason, GameEvent, NoiseKind, Refusal, ServerMsg, VerdictOutcome, WorkbenchCopy};
-pub use token::{TokenUserData, USER_DATA_MAGIC};
+pub use token::{SeatTicket, TokenUserData, USER_DATA_MAGIC};
 pub use verify::verify;
 
 use bevy::prelude::*;

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use super::client_msg::WarningKind;
 use super::ids::{CaseId, GuardId, ItemId, Role};
 use super::replicated::{GuardAlert, Phase};
+use super::token::SeatTicket;
 use crate::artifact::{Briefing, HapticMesh, Material};
 
 /// Everything the server can say to one client.
@@ -18,6 +19,11 @@ pub enum ServerMsg {
         role: Role,
         /// The level being played (walls, doors, cases, routes).
         level: Box<crate::level::Level>,
+        /// This seat's ticket: keep it (the seat cache) to take the seat back after a lost connection.
+        seat: SeatTicket,
+        /// True when this connection took back a held seat (the session's news follows: briefings, the
+        /// copy on the bench); Vive's move numbers start afresh at 1 on every connection.
+        resumed: bool,
     },
     /// An input was refused; nothing changed.
     Refused(Refusal),
@@ -108,7 +114,13 @@ pub enum GameEvent {
     Warning(WarningKind),
     /// A player came into the session (the first time or again).
     Joined(Role),
-    /// A player went away: `dropped` when the connection was lost rather than closed by the player.
+    /// A player whose connection was lost took their seat back.
+    Resumed(Role),
+    /// A dropped player's seat was kept for [`crate::rules::SEAT_HOLD_S`] and they did not come back: the
+    /// seat is free again (and a running heist is lost, abandoned).
+    GaveUp(Role),
+    /// A player went away: `dropped` when the connection was lost rather than closed by the player (a
+    /// dropped player's seat is then kept for them, and a running heist pauses until they are back).
     Left {
         /// Who.
         role: Role,
@@ -158,6 +170,8 @@ pub enum Refusal {
     NotOnWorkbench,
     /// Too many messages this second.
     RateLimited,
+    /// The heist is paused while a player is away.
+    Paused,
 }
 
 /// Why the server disconnects a client.
@@ -171,4 +185,10 @@ pub enum DisconnectReason {
     Abuse,
     /// The session is over: nobody asked for another round in time, or nobody was left in it.
     SessionEnded,
+    /// The seat is kept for the player who dropped from it; only their seat ticket takes it.
+    SeatHeld(Role),
+    /// The token's seat ticket is not that seat's (or no seat is kept for it).
+    BadSeat,
+    /// The seat's holder came back on another connection, which replaces this one.
+    Replaced,
 }
