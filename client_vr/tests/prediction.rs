@@ -10,9 +10,10 @@ use std::time::{Duration, Instant};
 use bevy::prelude::*;
 use client_vr::intent::IntentSystems;
 use client_vr::{Intent, ViveState};
-use common::{Link, Relay, join_args, quantile, vive_client};
+use common::{join_args, quantile, vive_client};
 use glam::Vec2;
 use heist_bots::PhantomBotPlugin;
+use heist_conditioner::{Conditions, Relay};
 use heist_server::{ServerOptions, build_server, demo};
 use heist_shared::protocol::{Gait, Phase, Role, TICK_HZ};
 
@@ -75,12 +76,12 @@ impl Measured {
     }
 }
 
-fn run(link: Link) -> Measured {
-    let mut relay = Relay::bind();
+fn run(link: Conditions) -> Measured {
+    let mut relay = Relay::bind(link, 0x9E37_79B9_7F4A_7C15).expect("the relay binds");
     let mut options = ServerOptions::local_test(10);
     options.advertise = Some(relay.addr);
     let mut server = build_server(options).expect("server starts");
-    relay.start_with(server.addr, link);
+    relay.start(server.addr).expect("the relay starts");
     let args = join_args(&["--headless", "--ready"]);
     let mut vive = vive_client(&server, &args, |app| {
         app.init_resource::<Clock>().add_systems(RunFixedMainLoop, drive.in_set(IntentSystems::Gather));
@@ -136,7 +137,7 @@ fn run(link: Link) -> Measured {
 
 #[test]
 fn with_150_ms_each_way_the_prediction_matches_the_server() {
-    let m = run(Link { delay: LATENCY, jitter: Duration::ZERO, loss: 0.0 });
+    let m = run(Conditions::delay(LATENCY));
     let (p50, p95, max) = m.report("150 ms each way");
     assert!(m.heist_ticks >= 12 * 60, "the heist ran long enough ({})", m.heist_ticks);
     assert!(m.walked_m > 15.0, "the server moved the body along the course ({} m)", m.walked_m);
@@ -152,7 +153,7 @@ fn with_150_ms_each_way_the_prediction_matches_the_server() {
 fn with_150_ms_jitter_and_loss_reconciliation_keeps_the_prediction_close() {
     // 150 ms + up to 40 ms each way, 3 % of packets lost: the reliable channel resends, inputs arrive
     // bunched, the server moves some ticks on an older input — and the client must follow it.
-    let m = run(Link { delay: LATENCY, jitter: Duration::from_millis(40), loss: 0.03 });
+    let m = run(Conditions { latency: LATENCY, jitter: Duration::from_millis(40), loss: 0.03 });
     let (p50, p95, max) = m.report("150 ms + 0–40 ms jitter, 3 % loss");
     assert!(m.heist_ticks >= 12 * 60, "the heist ran long enough ({})", m.heist_ticks);
     assert!(m.walked_m > 10.0, "the server moved the body along the course ({} m)", m.walked_m);
