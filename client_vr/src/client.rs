@@ -244,6 +244,7 @@ fn events(
     mut out: MessageWriter<Happened>,
     mut pulses: MessageWriter<Pulse>,
     mut state: ResMut<ViveState>,
+    mut sent: ResMut<crate::intent::Sent>,
     time: Res<Time>,
 ) {
     let now = time.elapsed_secs_f64();
@@ -283,6 +284,7 @@ fn events(
         out.write(Happened(e));
     }
     for r in std::mem::take(&mut inbox.refusals) {
+        sent.refused();
         state.say(now, format!("The server refused: {r:?}"));
     }
 }

@@ -96,6 +96,11 @@ pub enum IntentSystems {
     Send,
 }
 
+/// Server ticks an action waits for its answer before the very same action goes again (a second: a
+/// round trip and a resend on a poor link); a refusal lets it go at once. A state seen a round trip late
+/// would otherwise repeat it every tick, each repeat refused and counted against the client as abuse.
+pub const ACTION_ANSWER_TICKS: u32 = 60;
+
 /// Every message sent, counted, for tests and the log.
 #[derive(Resource, Clone, Debug, Default)]
 pub struct Sent {
@@ -103,6 +108,31 @@ pub struct Sent {
     pub seq: u32,
     /// Actions sent, in order.
     pub actions: Vec<Action>,
+    /// Actions held back as repeats of one awaiting its answer.
+    pub repeats_held: u32,
+    /// Sends so far (one per server tick).
+    ticks: u32,
+    /// Actions sent in the last [`ACTION_ANSWER_TICKS`] and the tick each went.
+    awaiting: Vec<(Action, u32)>,
+}
+
+impl Sent {
+    /// Whether `action` may go now (no identical one awaits its answer); if so, it is counted as awaiting.
+    fn admit(&mut self, action: Action) -> bool {
+        let now = self.ticks;
+        self.awaiting.retain(|(_, at)| now.wrapping_sub(*at) < ACTION_ANSWER_TICKS);
+        if self.awaiting.iter().any(|(a, _)| *a == action) {
+            self.repeats_held += 1;
+            return false;
+        }
+        self.awaiting.push((action, now));
+        true
+    }
+
+    /// The server answered with a refusal: whatever awaited may be tried again at once.
+    pub fn refused(&mut self) {
+        self.awaiting.clear();
+    }
 }
 
 /// Picks what an action is about, from where the player stands and looks.
@@ -175,9 +205,12 @@ pub fn send(
     mut out: MessageWriter<ClientMsg>,
     mut state: ResMut<crate::client::ViveState>,
 ) {
+    sent.ticks = sent.ticks.wrapping_add(1);
     for action in intent.actions.drain(..) {
-        out.write(action.message());
-        sent.actions.push(action);
+        if sent.admit(action) {
+            out.write(action.message());
+            sent.actions.push(action);
+        }
     }
     if !state.in_heist() {
         return;
@@ -231,6 +264,24 @@ mod tests {
         let aim = Aim { from: Vec2::new(1.0, 1.0), towards: Vec2::new(0.0, 2.0) };
         assert_eq!(aim.throw_target(5.0), Vec2::new(1.0, 6.0));
         assert_eq!(aim.throw_target(50.0), Vec2::new(1.0, 1.0 + rules::THROW_RANGE));
+    }
+
+    #[test]
+    fn an_action_awaiting_its_answer_is_not_repeated_until_a_second_passed_or_a_refusal_came() {
+        let mut sent = Sent::default();
+        let brk = Action::Break(CaseId(1));
+        assert!(sent.admit(brk));
+        assert!(!sent.admit(brk), "the same action again at once is held back");
+        assert!(sent.admit(Action::PickUp(ItemId(2))), "another action goes");
+        for _ in 0..ACTION_ANSWER_TICKS - 1 {
+            sent.ticks += 1;
+        }
+        assert!(!sent.admit(brk), "still awaiting");
+        sent.ticks += 1;
+        assert!(sent.admit(brk), "a second later it may go again");
+        sent.refused();
+        assert!(sent.admit(brk), "a refusal lets it go at once");
+        assert_eq!(sent.repeats_held, 2);
     }
 
     #[test]
