@@ -262,7 +262,14 @@ fn lobby(
         speaker.say(
             "Welcome to Phantom Heist. You are Phantom, at the workbench. Up and down read the menu; Enter chooses.",
         );
-        speaker.say(MenuItem::ALL[0].label());
+        // A player who joins, or comes back, after the lobby hears where the heist stands instead.
+        speaker.say(match s.phase {
+            Phase::Lobby => MenuItem::ALL[0].label().to_owned(),
+            Phase::Heist => format!("The heist is on. {}", status::status(&s, &[], None)),
+            Phase::Won | Phase::Lost(_) => {
+                format!("{} Enter asks for another round; Q leaves.", status::status(&s, &[], None))
+            }
+        });
         // Last, so R repeats the spelled code.
         for line in hosted.iter().flat_map(|h| h.0.iter()) {
             speaker.say(line.clone());

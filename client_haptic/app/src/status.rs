@@ -76,7 +76,7 @@ fn alert_words(a: GuardAlert) -> &'static str {
 pub fn status(session: &SessionView, guards: &[&GuardView], vive: Option<Vec2>) -> String {
     let mut out = match session.phase {
         Phase::Lobby => "The heist has not started.".to_owned(),
-        Phase::Heist => format!("{} left.", duration_words(session.time_left_s)),
+        Phase::Heist => capitalized(&format!("{} left.", duration_words(session.time_left_s))),
         Phase::Won => "The heist is won.".to_owned(),
         Phase::Lost(_) => "The heist is lost.".to_owned(),
     };
@@ -89,7 +89,10 @@ pub fn status(session: &SessionView, guards: &[&GuardView], vive: Option<Vec2>) 
             (false, false) => format!(" Secured: {}. Still to find: {}.", list(&secured), list(&missing)),
         };
     }
-    out += &format!(" Alarm level {}.", number_in_words(session.alarm as u32));
+    out += &match session.alarm {
+        0 => " No alarm yet.".to_owned(),
+        n => format!(" Alarm level {}.", number_in_words(u32::from(n))),
+    };
     if let Some(v) = vive {
         for g in guards {
             let d = g.position - v;
@@ -103,6 +106,12 @@ pub fn status(session: &SessionView, guards: &[&GuardView], vive: Option<Vec2>) 
         }
     }
     out
+}
+
+/// `text` with its first letter in capitals (a spoken sentence's start).
+fn capitalized(text: &str) -> String {
+    let mut chars = text.chars();
+    chars.next().map(|c| c.to_uppercase().chain(chars).collect()).unwrap_or_default()
 }
 
 fn list(items: &[&str]) -> String {
@@ -196,10 +205,12 @@ mod tests {
         let s = status(&session, &[&clara], Some(Vec2::new(5.0, 2.0)));
         assert_eq!(
             s,
-            "five minutes and one second left. Secured: the crown. Still to find: the amphora and the idol. \
+            "Five minutes and one second left. Secured: the crown. Still to find: the amphora and the idol. \
 Alarm level one. Clara, six metres north of Vive, patrolling."
         );
         assert!(!s.chars().any(|c| c.is_ascii_digit()));
+        let calm = SessionView { alarm: 0, ..session };
+        assert!(status(&calm, &[], None).contains(" No alarm yet."), "no 'alarm level no'");
     }
 
     #[test]

@@ -10,10 +10,16 @@ use std::time::{Duration, Instant};
 /// The client as a screen-reader user runs it: `args` then `--headless --audio memory`, `RUST_LOG` unset;
 /// its stdin to type into and its stdout read line by line on a thread (stderr stays piped for the caller).
 fn headless(args: &[&str]) -> (Child, ChildStdin, mpsc::Receiver<String>) {
+    headless_with_cache(args, &std::env::temp_dir().join(format!("phantom-terminal-{}", std::process::id())))
+}
+
+/// [`headless`] with its seat cache (`XDG_CACHE_HOME`) in `cache`.
+fn headless_with_cache(args: &[&str], cache: &std::path::Path) -> (Child, ChildStdin, mpsc::Receiver<String>) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_client_haptic"))
         .args(args)
         .args(["--headless", "--audio", "memory"])
         .env_remove("RUST_LOG")
+        .env("XDG_CACHE_HOME", cache)
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -258,4 +264,112 @@ fn a_blind_player_hosts_alone_hears_the_code_spelled_and_a_partner_joins_with_it
     assert!(at(&spelled).is_some_and(|s| s > welcome), "the spelled code comes last, for R: {lines:#?}");
     assert!(hosted.contains(&bind), "the address to join is said: {hosted}");
     assert!(!lines.iter().any(|l| l.contains("server is gone")), "leaving on purpose is no lost server: {lines:#?}");
+}
+
+/// Waits up to `within` for a line starting with `text`, keeping every line in `lines`.
+fn hear(rx: &mpsc::Receiver<String>, lines: &mut Vec<String>, text: &str, within: Duration) -> bool {
+    let deadline = Instant::now() + within;
+    while Instant::now() < deadline {
+        if let Ok(line) = rx.recv_timeout(Duration::from_millis(100)) {
+            let found = line.starts_with(text);
+            lines.push(line);
+            if found {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+#[test]
+fn a_blind_player_hears_the_link_lost_gets_back_in_by_itself_and_after_a_restart() {
+    use heist_server::{ServerOptions, build_server};
+    use heist_shared::protocol::Role;
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    // The host on its own thread (about 60 Hz of wall-clock time); `stall` stops its game loop (the token
+    // endpoint, on its own thread, still answers), as a hung server process or a dead network would.
+    let (stop, stall) = (Arc::new(AtomicBool::new(false)), Arc::new(AtomicBool::new(false)));
+    let (tx, rx_host) = mpsc::channel();
+    let host = {
+        let (stop, stall) = (stop.clone(), stall.clone());
+        std::thread::spawn(move || {
+            let mut options = ServerOptions::local_test(14);
+            options.game.time_limit_s = Some(300.0);
+            let mut server = build_server(options).expect("server starts");
+            let tokens = server.tokens.as_ref().expect("secure");
+            tx.send((tokens.addr, tokens.codes.current().code.clone())).expect("the test waits");
+            let mut vive: Option<bevy::app::App> = None;
+            let deadline = Instant::now() + Duration::from_secs(150);
+            while !stop.load(Ordering::Relaxed) && Instant::now() < deadline {
+                if !stall.load(Ordering::Relaxed) {
+                    server.app.update();
+                    if vive.is_none() && server.game().is_present(Role::Phantom) {
+                        let app = heist_server::demo::join(&server, Role::Vive, |app| {
+                            app.add_plugins(heist_bots::ViveBotPlugin { style: heist_bots::ViveStyle::Idle });
+                        })
+                        .expect("the Vive bot joins");
+                        vive = Some(app);
+                    }
+                    if let Some(v) = vive.as_mut() {
+                        v.update();
+                    }
+                }
+                std::thread::sleep(Duration::from_millis(16));
+            }
+            server.log().to_vec()
+        })
+    };
+    let (addr, code) = rx_host.recv_timeout(Duration::from_secs(30)).expect("the host starts");
+    let cache = std::env::temp_dir().join(format!("phantom-terminal-{}-rejoin", std::process::id()));
+    let join = ["join", &addr.to_string(), "--code", &code].map(str::to_owned);
+    let join: Vec<&str> = join.iter().map(String::as_str).collect();
+    let (mut child, mut stdin, rx) = headless_with_cache(&join, &cache);
+    let mut lines = Vec::new();
+    let t = Duration::from_secs(30);
+    assert!(hear(&rx, &mut lines, "Vive joined.", t), "{lines:#?}");
+    writeln!(stdin).expect("types Enter: ready");
+    assert!(hear(&rx, &mut lines, "The heist has begun.", t), "{lines:#?}");
+
+    // The server's loop stalls: within seconds Phantom hears it and the client tries to get back in.
+    stall.store(true, Ordering::Relaxed);
+    assert!(hear(&rx, &mut lines, "The connection to the server is lost.", Duration::from_secs(6)), "{lines:#?}");
+    assert!(hear(&rx, &mut lines, "Trying to get back into the session.", Duration::from_secs(3)), "{lines:#?}");
+    std::thread::sleep(Duration::from_secs(2));
+    stall.store(false, Ordering::Relaxed);
+    assert!(hear(&rx, &mut lines, "You are back in your seat.", t), "{lines:#?}");
+
+    // The client is killed; started again, it takes the seat back with the ticket in its seat cache.
+    child.kill().expect("kills");
+    let _ = child.wait();
+    let (mut again, mut stdin, rx) = headless_with_cache(&join, &cache);
+    let restarted = lines.len();
+    assert!(hear(&rx, &mut lines, "You are back in your seat.", t), "{lines:#?}");
+    let told_where = lines[restarted..].iter().any(|l| l.starts_with("The heist is on."))
+        || hear(&rx, &mut lines, "The heist is on.", t);
+    assert!(told_where, "where the heist stands, not the lobby's menu: {lines:#?}");
+    assert!(!lines[restarted..].iter().any(|l| l.starts_with("Ready.")), "{lines:#?}");
+    writeln!(stdin, "q").expect("types q: leave");
+    assert!(hear(&rx, &mut lines, "Leaving the session.", t), "{lines:#?}");
+    let status = wait(&mut again, Duration::from_secs(10));
+    stop.store(true, Ordering::Relaxed);
+    let log = host.join().expect("the host thread");
+    println!("Phantom heard:\n{}", lines.join("\n"));
+    assert!(status.is_some_and(|s| s.success()), "client_haptic exited with {status:?}: {lines:#?}");
+    assert_eq!(log.iter().filter(|l| l.contains("Phantom is back")).count(), 2, "{log:#?}");
+    assert!(!lines.iter().any(|l| l.starts_with("Could not get back")), "{lines:#?}");
+    let _ = std::fs::remove_dir_all(cache);
+}
+
+/// Waits for `child` to exit, killing it after `limit`.
+fn wait(child: &mut Child, limit: Duration) -> Option<std::process::ExitStatus> {
+    let deadline = Instant::now() + limit;
+    while Instant::now() < deadline {
+        if let Ok(Some(status)) = child.try_wait() {
+            return Some(status);
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let _ = child.kill();
+    None
 }
