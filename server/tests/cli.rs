@@ -91,22 +91,35 @@ fn wait_for(child: &mut std::process::Child, limit: std::time::Duration) -> Opti
     None
 }
 
-#[test]
-fn a_hosted_session_plays_two_rounds_for_two_bot_processes_logs_them_as_json_and_ends() {
+/// A `heist-server --log-format json host` process on a free loopback port, as an operator starts one.
+struct Host {
+    child: std::process::Child,
+    /// `127.0.0.1:PORT`, UDP and TCP alike.
+    addr: String,
+    port: u16,
+    /// Its stdout, line by line.
+    out: std::sync::mpsc::Receiver<String>,
+    /// Its log (stderr), line by line.
+    log: std::sync::mpsc::Receiver<String>,
+    /// The join code it printed.
+    code: String,
+}
+
+/// Starts `host --bind ADDR ARGS…` and waits (at most 20 s) for the join code it prints.
+fn host(args: &[&str]) -> Host {
     use std::process::Stdio;
     use std::time::{Duration, Instant};
-    let bin = env!("CARGO_BIN_EXE_heist-server");
-    // A free loopback port for UDP and TCP alike.
     let port = std::net::UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
     let addr = format!("127.0.0.1:{port}");
-    let mut host = Command::new(bin)
-        .args(["--log-format", "json", "host", "--bind", &addr, "--time-limit", "4", "--idle-end", "30"])
+    let mut child = Command::new(env!("CARGO_BIN_EXE_heist-server"))
+        .args(["--log-format", "json", "host", "--bind", &addr])
+        .args(args)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let out = lines_of(host.stdout.take().unwrap());
-    let log = lines_of(host.stderr.take().unwrap());
+    let out = lines_of(child.stdout.take().unwrap());
+    let log = lines_of(child.stderr.take().unwrap());
     let deadline = Instant::now() + Duration::from_secs(20);
     let code = loop {
         let line =
@@ -115,6 +128,15 @@ fn a_hosted_session_plays_two_rounds_for_two_bot_processes_logs_them_as_json_and
             break rest.split_whitespace().next().unwrap().to_owned();
         }
     };
+    Host { child, addr, port, out, log, code }
+}
+
+#[test]
+fn a_hosted_session_plays_two_rounds_for_two_bot_processes_logs_them_as_json_and_ends() {
+    use std::process::Stdio;
+    use std::time::Duration;
+    let bin = env!("CARGO_BIN_EXE_heist-server");
+    let Host { child: mut host, addr, out, log, code, .. } = host(&["--time-limit", "4", "--idle-end", "30"]);
     let cache = std::env::temp_dir().join(format!("heist-cli-seats-{}-rounds", std::process::id()));
     let bot = |role: &str| {
         Command::new(bin)
@@ -162,24 +184,7 @@ fn a_bot_process_killed_mid_heist_and_started_again_takes_its_seat_back() {
     use std::process::Stdio;
     use std::time::{Duration, Instant};
     let bin = env!("CARGO_BIN_EXE_heist-server");
-    let port = std::net::UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
-    let addr = format!("127.0.0.1:{port}");
-    let mut host = Command::new(bin)
-        .args(["--log-format", "json", "host", "--bind", &addr, "--time-limit", "120", "--idle-end", "5"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let out = lines_of(host.stdout.take().unwrap());
-    let log = lines_of(host.stderr.take().unwrap());
-    let deadline = Instant::now() + Duration::from_secs(20);
-    let code = loop {
-        let line =
-            out.recv_timeout(deadline.saturating_duration_since(Instant::now())).expect("the host prints its code");
-        if let Some(rest) = line.strip_prefix("join code: ") {
-            break rest.split_whitespace().next().unwrap().to_owned();
-        }
-    };
+    let Host { child: mut host, addr, port, log, code, .. } = host(&["--time-limit", "120", "--idle-end", "5"]);
     // Each bot has its own seat cache, as two players on two machines would.
     let cache = |role: &str| std::env::temp_dir().join(format!("heist-cli-seats-{}-{role}", std::process::id()));
     let bot = |role: &str| {

@@ -125,24 +125,33 @@ fn a_join_that_cannot_reach_the_host_fails_on_one_line_without_a_backtrace() {
     assert_eq!(lines[0].matches("refused").count(), 1, "the cause once: {err}");
 }
 
-/// A host for the next test, on its own thread: a loopback server (4 s heists) and, once Phantom is in, a
-/// Vive bot that asks for another round after the first. Stepped at about 60 Hz of wall-clock time until
-/// `stop` is set; sends the join code, then the server's log at the end.
+/// A host on its own thread: a loopback server (heists of `time_limit_s`) and, once Phantom is in, a Vive
+/// bot that asks for another round after the first. Stepped at about 60 Hz of wall-clock time until
+/// `stop` is set, its game loop standing still while `stall` is set (the token endpoint, on its own
+/// thread, still answers: a hung server process or a dead network); sends the join code, then the
+/// server's log at the end.
 fn host_with_a_vive_bot(
     stop: std::sync::Arc<std::sync::atomic::AtomicBool>,
+    stall: std::sync::Arc<std::sync::atomic::AtomicBool>,
+    time_limit_s: f32,
 ) -> (std::net::SocketAddr, String, std::thread::JoinHandle<Vec<String>>) {
     use heist_server::{ServerOptions, build_server};
     use heist_shared::protocol::Role;
+    use std::sync::atomic::Ordering;
     let (tx, rx) = mpsc::channel();
     let host = std::thread::spawn(move || {
         let mut options = ServerOptions::local_test(12);
-        options.game.time_limit_s = Some(4.0);
+        options.game.time_limit_s = Some(time_limit_s);
         let mut server = build_server(options).expect("server starts");
         let tokens = server.tokens.as_ref().expect("secure");
         tx.send((tokens.addr, tokens.codes.current().code.clone())).expect("the test waits");
         let mut vive: Option<bevy::app::App> = None;
-        let deadline = Instant::now() + Duration::from_secs(120);
-        while !stop.load(std::sync::atomic::Ordering::Relaxed) && Instant::now() < deadline {
+        let deadline = Instant::now() + Duration::from_secs(150);
+        while !stop.load(Ordering::Relaxed) && Instant::now() < deadline {
+            std::thread::sleep(Duration::from_millis(16));
+            if stall.load(Ordering::Relaxed) {
+                continue;
+            }
             server.app.update();
             if vive.is_none() && server.game().is_present(Role::Phantom) {
                 let app = heist_server::demo::join(&server, Role::Vive, |app| {
@@ -155,7 +164,6 @@ fn host_with_a_vive_bot(
             if let Some(v) = vive.as_mut() {
                 v.update();
             }
-            std::thread::sleep(Duration::from_millis(16));
         }
         server.log().to_vec()
     });
@@ -166,7 +174,7 @@ fn host_with_a_vive_bot(
 #[test]
 fn a_blind_player_hears_the_partner_plays_a_rematch_and_leaves_by_typed_lines() {
     let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
-    let (addr, code, host) = host_with_a_vive_bot(stop.clone());
+    let (addr, code, host) = host_with_a_vive_bot(stop.clone(), Default::default(), 4.0);
     let (mut child, mut stdin, rx) = headless(&["join", &addr.to_string(), "--code", &code]);
     // Ready when the partner is in; after the first result, Enter for another round; after the second, q.
     let mut lines: Vec<String> = Vec::new();
@@ -283,44 +291,10 @@ fn hear(rx: &mpsc::Receiver<String>, lines: &mut Vec<String>, text: &str, within
 
 #[test]
 fn a_blind_player_hears_the_link_lost_gets_back_in_by_itself_and_after_a_restart() {
-    use heist_server::{ServerOptions, build_server};
-    use heist_shared::protocol::Role;
     use std::sync::Arc;
     use std::sync::atomic::{AtomicBool, Ordering};
-    // The host on its own thread (about 60 Hz of wall-clock time); `stall` stops its game loop (the token
-    // endpoint, on its own thread, still answers), as a hung server process or a dead network would.
     let (stop, stall) = (Arc::new(AtomicBool::new(false)), Arc::new(AtomicBool::new(false)));
-    let (tx, rx_host) = mpsc::channel();
-    let host = {
-        let (stop, stall) = (stop.clone(), stall.clone());
-        std::thread::spawn(move || {
-            let mut options = ServerOptions::local_test(14);
-            options.game.time_limit_s = Some(300.0);
-            let mut server = build_server(options).expect("server starts");
-            let tokens = server.tokens.as_ref().expect("secure");
-            tx.send((tokens.addr, tokens.codes.current().code.clone())).expect("the test waits");
-            let mut vive: Option<bevy::app::App> = None;
-            let deadline = Instant::now() + Duration::from_secs(150);
-            while !stop.load(Ordering::Relaxed) && Instant::now() < deadline {
-                if !stall.load(Ordering::Relaxed) {
-                    server.app.update();
-                    if vive.is_none() && server.game().is_present(Role::Phantom) {
-                        let app = heist_server::demo::join(&server, Role::Vive, |app| {
-                            app.add_plugins(heist_bots::ViveBotPlugin { style: heist_bots::ViveStyle::Idle });
-                        })
-                        .expect("the Vive bot joins");
-                        vive = Some(app);
-                    }
-                    if let Some(v) = vive.as_mut() {
-                        v.update();
-                    }
-                }
-                std::thread::sleep(Duration::from_millis(16));
-            }
-            server.log().to_vec()
-        })
-    };
-    let (addr, code) = rx_host.recv_timeout(Duration::from_secs(30)).expect("the host starts");
+    let (addr, code, host) = host_with_a_vive_bot(stop.clone(), stall.clone(), 300.0);
     let cache = std::env::temp_dir().join(format!("phantom-terminal-{}-rejoin", std::process::id()));
     let join = ["join", &addr.to_string(), "--code", &code].map(str::to_owned);
     let join: Vec<&str> = join.iter().map(String::as_str).collect();

@@ -152,7 +152,7 @@ pub enum Link {
     Up,
     /// Silent for [`SILENCE_LOST_S`] or more: the connection may come back until netcode gives up.
     Silent,
-    /// The transport stopped: the server let us go, or went silent until netcode's timeout (15 s).
+    /// The transport stopped: the server let us go, or went silent until netcode's timeout (6 s).
     Gone,
 }
 

@@ -18,8 +18,10 @@ use super::{Closer, Shared, TokenConfig, lock};
 const MAX_CLIENT_FRAME: usize = 256;
 /// Seconds a token stays valid.
 const TOKEN_EXPIRE_S: u64 = 300;
-/// Seconds of silence after which netcode drops a client.
-const TIMEOUT_S: i32 = 15;
+/// Seconds of silence after which netcode drops a client (and a client its server): long enough for a
+/// poor link's worst gap (keep-alives go 10 times a second), short enough that a dead player's seat is
+/// kept, and a running heist paused, within seconds.
+const TIMEOUT_S: i32 = 6;
 
 /// Why an exchange ended without a token.
 enum Failure {
