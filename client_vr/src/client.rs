@@ -291,36 +291,18 @@ fn events(
 
 /// The connection's changes on the HUD: lost after 3 s of silence, back, gone, trying to get back in or
 /// giving up; and why the server let us go.
-#[allow(clippy::too_many_arguments)]
 fn tell_the_link(
     link: Res<heist_client::Link>,
     inbox: Res<Inbox>,
     leaving: Res<heist_client::Leaving>,
     reconnect: Res<heist_client::Reconnect>,
-    mut was: Local<heist_client::Link>,
-    mut was_reconnect: Local<heist_client::Reconnect>,
-    mut told_disconnect: Local<bool>,
+    mut news: Local<heist_client::notice::LinkNews>,
     mut state: ResMut<ViveState>,
     time: Res<Time>,
 ) {
     let now = time.elapsed_secs_f64();
-    if let Some(reason) = &inbox.disconnect
-        && !*told_disconnect
-    {
-        *told_disconnect = true;
-        state.say(now, heist_client::notice::disconnect_notice(reason));
-    }
-    if *link != *was {
-        if let Some(line) = heist_client::notice::link_change_notice(*was, *link, &inbox, &leaving, &reconnect) {
-            state.say(now, line.to_owned());
-        }
-        *was = *link;
-    }
-    if *reconnect != *was_reconnect {
-        if let Some(line) = heist_client::notice::reconnect_notice(&was_reconnect, &reconnect) {
-            state.say(now, line);
-        }
-        *was_reconnect = reconnect.clone();
+    for line in news.news(*link, &inbox, &leaving, &reconnect) {
+        state.say(now, line);
     }
 }
 

@@ -289,31 +289,15 @@ fn tell_the_link(
     inbox: Res<heist_client::Inbox>,
     reconnect: Res<heist_client::Reconnect>,
     time: Res<Time<Real>>,
-    mut was: Local<heist_client::Link>,
-    mut was_reconnect: Local<heist_client::Reconnect>,
+    mut news: Local<heist_client::notice::LinkNews>,
     mut ended_at: Local<Option<f32>>,
     leaving: Res<heist_client::Leaving>,
     mut speaker: NonSendMut<crate::speech::Speaker>,
     mut exit: MessageWriter<AppExit>,
 ) {
     let now = time.elapsed_secs();
-    if let Some(reason) = &inbox.disconnect
-        && ended_at.is_none()
-    {
-        *ended_at = Some(now);
-        speaker.say(heist_client::notice::disconnect_notice(reason));
-    }
-    if *link != *was {
-        if let Some(line) = heist_client::notice::link_change_notice(*was, *link, &inbox, &leaving, &reconnect) {
-            speaker.say(line);
-        }
-        *was = *link;
-    }
-    if *reconnect != *was_reconnect {
-        if let Some(line) = heist_client::notice::reconnect_notice(&was_reconnect, &reconnect) {
-            speaker.say(line);
-        }
-        *was_reconnect = reconnect.clone();
+    for line in news.news(*link, &inbox, &leaving, &reconnect) {
+        speaker.say(line);
     }
     if heist_client::connection_over(*link, &inbox, &reconnect) {
         ended_at.get_or_insert(now);

@@ -231,8 +231,9 @@ pub fn connection_config(channels: &RepliconChannels) -> ConnectionConfig {
 /// Creates the netcode transport for `token` (call after [`ClientNetPlugin`] is added and all protocol
 /// registration is done, before the first update).
 pub fn connect(app: &mut App, token: ConnectToken) -> Result<(), JoinError> {
-    let server = token.server_addresses.iter().flatten().next().copied().ok_or(JoinError::NoServerAddress)?;
-    insert_transport(app, server, ClientAuthentication::Secure { connect_token: token })
+    let (renet, transport) = transport::open_with_token(token, app.world().resource::<RepliconChannels>())?;
+    app.insert_resource(renet).insert_resource(transport);
+    Ok(())
 }
 
 /// Connects without a token (the server must run with `--insecure`), claiming `role`.
@@ -245,11 +246,7 @@ pub fn connect_insecure(app: &mut App, server: std::net::SocketAddr, role: Role)
         server_addr: server,
         user_data: Some(user_data),
     };
-    insert_transport(app, server, auth)
-}
-
-fn insert_transport(app: &mut App, server: std::net::SocketAddr, auth: ClientAuthentication) -> Result<(), JoinError> {
-    let (renet, transport) = rejoin::transport_with(server, auth, app.world().resource::<RepliconChannels>())?;
+    let (renet, transport) = transport::open(server, auth, app.world().resource::<RepliconChannels>())?;
     app.insert_resource(renet).insert_resource(transport);
     Ok(())
 }

@@ -65,6 +65,43 @@ pub fn reconnect_notice(was: &crate::Reconnect, now: &crate::Reconnect) -> Optio
     }
 }
 
+/// What a client tells its player about the connection, each once: why the server let us go, the link's
+/// changes, trying to get back in and giving up. Keep one per app and ask for [`LinkNews::news`] each frame.
+#[derive(Debug, Default)]
+pub struct LinkNews {
+    link: crate::Link,
+    reconnect: crate::Reconnect,
+    told_disconnect: bool,
+}
+
+impl LinkNews {
+    /// The lines to tell now, in order (none when nothing changed).
+    pub fn news(
+        &mut self,
+        link: crate::Link,
+        inbox: &crate::Inbox,
+        leaving: &crate::Leaving,
+        reconnect: &crate::Reconnect,
+    ) -> Vec<String> {
+        let mut lines = Vec::new();
+        if let Some(reason) = &inbox.disconnect
+            && !self.told_disconnect
+        {
+            self.told_disconnect = true;
+            lines.push(disconnect_notice(reason));
+        }
+        if link != self.link {
+            lines.extend(link_change_notice(self.link, link, inbox, leaving, reconnect).map(str::to_owned));
+            self.link = link;
+        }
+        if *reconnect != self.reconnect {
+            lines.extend(reconnect_notice(&self.reconnect, reconnect));
+            self.reconnect = reconnect.clone();
+        }
+        lines
+    }
+}
+
 /// Why the server let us go, as a line for the player.
 pub fn disconnect_notice(reason: &DisconnectReason) -> String {
     match reason {
@@ -133,6 +170,23 @@ mod tests {
         let gave_up = Reconnect::GaveUp("no way back into the session for 60 s".into());
         let line = reconnect_notice(&trying, &gave_up).unwrap();
         assert_eq!(line, "Could not get back into the session: no way back into the session for 60 s.");
+    }
+
+    #[test]
+    fn link_news_tells_each_change_once_and_the_reason_before_the_rest() {
+        use crate::{Inbox, Leaving, Link, Reconnect};
+        let (mut news, mut inbox, leaving) = (LinkNews::default(), Inbox::default(), Leaving::default());
+        let trying = Reconnect::Trying { attempts: 1 };
+        let steady = Reconnect::Steady;
+        assert!(news.news(Link::Up, &inbox, &leaving, &steady).is_empty(), "connecting to up is no news");
+        let lost = news.news(Link::Silent, &inbox, &leaving, &trying);
+        assert_eq!(lost.len(), 2, "{lost:?}");
+        assert!(lost[0].contains("lost") && lost[1].starts_with("Trying to get back"), "{lost:?}");
+        assert!(news.news(Link::Silent, &inbox, &leaving, &trying).is_empty(), "said once");
+        inbox.disconnect = Some(DisconnectReason::SessionEnded);
+        let ended = news.news(Link::Gone, &inbox, &leaving, &steady);
+        assert_eq!(ended, vec![disconnect_notice(&DisconnectReason::SessionEnded)], "the reason, not 'gone'");
+        assert!(news.news(Link::Gone, &inbox, &leaving, &steady).is_empty());
     }
 
     #[test]

@@ -5,18 +5,17 @@
 //! replicated entities of the old connection are despawned (the new one receives the whole world again),
 //! and the server's catch-up (briefings, the bench copy, Vive's fresh move numbering) follows the welcome.
 
-use std::net::{SocketAddr, UdpSocket};
+use std::net::SocketAddr;
 use std::sync::Mutex;
 use std::sync::mpsc::{Receiver, TryRecvError};
-use std::time::{Duration, SystemTime, UNIX_EPOCH};
+use std::time::Duration;
 
 use bevy::prelude::*;
 use bevy_replicon::prelude::*;
 use bevy_replicon_renet::RenetClient;
 use heist_shared::protocol::join::JoinRefusal;
 use heist_shared::protocol::{Role, SeatTicket};
-use heist_transport::ClientIntake;
-use heist_transport::renetcode::{ClientAuthentication, ConnectToken};
+use heist_transport::renetcode::ConnectToken;
 
 use crate::{Inbox, JoinError, Leaving, Link};
 
@@ -175,7 +174,7 @@ pub(crate) fn drive(
                 }
             }
         }
-        Step::Swapping { since, token, welcomes } => match transport_for(*token, &channels) {
+        Step::Swapping { since, token, welcomes } => match crate::transport::open_with_token(*token, &channels) {
             Ok((renet, transport)) => {
                 commands.insert_resource(renet);
                 commands.insert_resource(transport);
@@ -213,27 +212,4 @@ fn ask(endpoint: SocketAddr, role: Role, ticket: SeatTicket) -> Mutex<Receiver<A
         warn!("cannot start a rejoin attempt: {e}");
     }
     Mutex::new(rx)
-}
-
-/// A fresh renet client and transport for `token`.
-pub(crate) fn transport_for(
-    token: ConnectToken,
-    channels: &RepliconChannels,
-) -> Result<(RenetClient, crate::transport::ClientTransport), JoinError> {
-    let server = token.server_addresses.iter().flatten().next().copied().ok_or(JoinError::NoServerAddress)?;
-    transport_with(server, ClientAuthentication::Secure { connect_token: token }, channels)
-}
-
-/// A renet client and transport authenticating with `auth` to `server`.
-pub(crate) fn transport_with(
-    server: SocketAddr,
-    auth: ClientAuthentication,
-    channels: &RepliconChannels,
-) -> Result<(RenetClient, crate::transport::ClientTransport), JoinError> {
-    let bind = if server.ip().is_loopback() { "127.0.0.1:0" } else { "0.0.0.0:0" };
-    let socket = UdpSocket::bind(bind).map_err(JoinError::Socket)?;
-    let now = SystemTime::now().duration_since(UNIX_EPOCH).unwrap_or_default();
-    let intake = ClientIntake::new(now, auth).map_err(|e| JoinError::Transport(e.to_string()))?;
-    let transport = crate::transport::ClientTransport::new(socket, intake).map_err(JoinError::Socket)?;
-    Ok((RenetClient::new(crate::connection_config(channels)), transport))
 }

@@ -3,12 +3,16 @@
 //! schedule slots), so a datagram spoofed from the server's address cannot panic the client.
 
 use std::net::{SocketAddr, UdpSocket};
+use std::time::{SystemTime, UNIX_EPOCH};
 
 use bevy::prelude::*;
+use bevy_replicon::prelude::RepliconChannels;
 use bevy_replicon_renet::{RenetClient, RenetClientPlugin, RenetReceive, RenetSend};
-use heist_transport::renetcode::{DisconnectReason, NetcodeError};
+use heist_transport::renetcode::{ClientAuthentication, ConnectToken, DisconnectReason, NetcodeError};
 use heist_transport::socket::{self, send_to};
 use heist_transport::{ClientIntake, TransportError};
+
+use crate::JoinError;
 
 /// Datagrams read per frame at most, so a flood cannot stall a frame.
 pub const MAX_DATAGRAMS_PER_FRAME: usize = 1024;
@@ -111,4 +115,27 @@ fn disconnect_on_exit(exit: MessageReader<AppExit>, mut transport: ResMut<Client
         let ClientTransport { socket, intake, .. } = &mut *transport;
         intake.disconnect(&mut send_to(socket));
     }
+}
+
+/// A fresh renet client and transport for `token` (the server is the first address it names).
+pub(crate) fn open_with_token(
+    token: ConnectToken,
+    channels: &RepliconChannels,
+) -> Result<(RenetClient, ClientTransport), JoinError> {
+    let server = token.server_addresses.iter().flatten().next().copied().ok_or(JoinError::NoServerAddress)?;
+    open(server, ClientAuthentication::Secure { connect_token: token }, channels)
+}
+
+/// A renet client and transport authenticating with `auth` to `server`.
+pub(crate) fn open(
+    server: SocketAddr,
+    auth: ClientAuthentication,
+    channels: &RepliconChannels,
+) -> Result<(RenetClient, ClientTransport), JoinError> {
+    let bind = if server.ip().is_loopback() { "127.0.0.1:0" } else { "0.0.0.0:0" };
+    let socket = UdpSocket::bind(bind).map_err(JoinError::Socket)?;
+    let now = SystemTime::now().duration_since(UNIX_EPOCH).unwrap_or_default();
+    let intake = ClientIntake::new(now, auth).map_err(|e| JoinError::Transport(e.to_string()))?;
+    let transport = ClientTransport::new(socket, intake).map_err(JoinError::Socket)?;
+    Ok((RenetClient::new(crate::connection_config(channels)), transport))
 }

@@ -276,8 +276,8 @@ impl ServerIntake {
         self.netcode.client_addr(client_id)
     }
 
-    /// How `client_id` went, when it was one of the last 64 to go other than by falling silent (or by a
-    /// disconnect the server asked for): `None` for a connection that timed out.
+    /// How `client_id` went, when it was one of the last 64 to go other than by falling silent: `None` for
+    /// a connection that timed out (or one this intake never saw go).
     pub fn departure(&self, client_id: u64) -> Option<Departure> {
         self.peers.departures.iter().find(|(id, _)| *id == client_id).map(|(_, d)| *d)
     }
