@@ -23,7 +23,7 @@ const RELIABLE: u8 = 0;
 #[test]
 fn crafted_datagrams_from_every_kind_of_address_leave_a_real_heist_running() {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(12);
-    let mut server = build_server(ServerOptions::local_test(10)).expect("server starts");
+    let mut server = build_server(ServerOptions::local_test(18)).expect("server starts");
     // Tokens minted while both roles are free: every attacker holds a real one.
     let mut intruder = UdpAttacker::new(token_for(&server, Role::Vive));
     let mut pending = UdpAttacker::new(token_for(&server, Role::Phantom));
@@ -112,7 +112,7 @@ fn crafted_datagrams_from_every_kind_of_address_leave_a_real_heist_running() {
 fn idle_and_slow_connections_never_delay_a_join() {
     let server = build_server(ServerOptions::local_test(1)).expect("server starts");
     let tokens = server.tokens.as_ref().unwrap();
-    let (endpoint, code) = (tokens.addr, tokens.codes.current().code);
+    let (endpoint, code) = (tokens.addr, server.codes.as_ref().expect("a host session").current().code);
     let idle: Vec<TcpStream> = (0..200).map(|_| TcpStream::connect(endpoint).expect("connects")).collect();
     // One connection dribbles its hello a byte at a time.
     let slow = std::thread::spawn(move || {
@@ -160,7 +160,7 @@ fn refusal(result: Result<impl std::fmt::Debug, JoinError>) -> JoinRefusal {
 fn wrong_codes_slow_down_then_the_sixth_from_an_address_is_refused() {
     let server = build_server(ServerOptions::local_test(1)).expect("server starts");
     let tokens = server.tokens.as_ref().unwrap();
-    let (endpoint, code) = (tokens.addr, tokens.codes.current().code);
+    let (endpoint, code) = (tokens.addr, server.codes.as_ref().expect("a host session").current().code);
     let wrong = wrong_code(&code);
     let t = Duration::from_secs(5);
     let mut took = Vec::new();
@@ -184,11 +184,11 @@ fn codes_expire_and_the_host_can_rotate_them() {
     options.code_ttl = Duration::from_millis(300);
     let server = build_server(options).expect("server starts");
     let tokens = server.tokens.as_ref().unwrap();
-    let old = tokens.codes.current().code;
+    let old = server.codes.as_ref().expect("a host session").current().code;
     std::thread::sleep(Duration::from_millis(400));
     let t = Duration::from_secs(5);
     assert_eq!(refusal(request_token(tokens.addr, &old, Role::Vive, t)), JoinRefusal::CodeExpired);
-    let fresh = tokens.codes.rotate().code;
+    let fresh = server.codes.as_ref().expect("a host session").rotate().code;
     assert!(request_token(tokens.addr, &fresh, Role::Vive, t).is_ok(), "the new code works");
     assert_eq!(refusal(request_token(tokens.addr, &old, Role::Phantom, t)), JoinRefusal::WrongCode);
 }
@@ -236,7 +236,7 @@ fn leaks(wire: &[u8], secret: &[u8]) -> bool {
 fn a_passive_observer_of_a_join_learns_neither_the_code_nor_the_token_nor_its_keys() {
     let server = build_server(ServerOptions::local_test(1)).expect("server starts");
     let tokens = server.tokens.as_ref().unwrap();
-    let code = tokens.codes.current().code;
+    let code = server.codes.as_ref().expect("a host session").current().code;
     let (relay, wire) = recording_relay(tokens.addr);
     let token = request_token(relay, &code, Role::Phantom, Duration::from_secs(5)).expect("a token through the relay");
     std::thread::sleep(Duration::from_millis(100));

@@ -116,7 +116,7 @@ fn a_phantom_back_gets_the_briefings_and_the_copy_on_the_bench_and_judges_it() {
 
     // The seat is kept: a stranger with the join code is refused, and the heist stands still.
     let tokens = heist.server.tokens.as_ref().expect("endpoint");
-    let code = tokens.codes.current().code;
+    let code = heist.server.codes.as_ref().expect("a host session").current().code;
     let stranger =
         refusal(heist_client::request_token(tokens.addr, &code, Role::Phantom, std::time::Duration::from_secs(5)));
     assert!(matches!(stranger, JoinRefusal::SeatHeld { role: Role::Phantom, for_s: 1..=60 }), "{stranger:?}");
@@ -179,10 +179,13 @@ fn a_ticket_only_takes_its_own_seat_back() {
     let t = std::time::Duration::from_secs(5);
     // Vive's ticket does not open Phantom's seat, and a made-up one opens nothing.
     let wrong_seat = heist_client::request_resume_token(endpoint, Role::Phantom, &vive_ticket, t);
-    assert_eq!(refusal(wrong_seat), JoinRefusal::WrongTicket);
+    assert_eq!(refusal(wrong_seat), JoinRefusal::NoSeat(Role::Phantom));
     let made_up =
         heist_client::request_resume_token(endpoint, Role::Vive, &heist_shared::protocol::SeatTicket::random(), t);
-    assert_eq!(refusal(made_up), JoinRefusal::WrongTicket);
+    assert_eq!(refusal(made_up), JoinRefusal::NoSeat(Role::Vive));
+    // Someone who saw a resume go by knows the seat's public id, not its ticket: refused.
+    let forged = forged_resume(endpoint, Role::Vive, vive_ticket.public_id());
+    assert_eq!(forged, JoinRefusal::WrongTicket);
     // A stale ticket in a cache, for a seat nobody holds, falls back to the code.
     let stale = seat_cache("stale");
     let server = build_server(ServerOptions::local_test(33)).expect("a second server");
@@ -191,6 +194,33 @@ fn a_ticket_only_takes_its_own_seat_back() {
     let (_, resumed) = join_with_seat(&server, Role::Vive, &stale, |_| {}).expect("joins with the code");
     assert!(!resumed, "no seat was kept there: joined anew");
     let _ = std::fs::remove_dir_all(stale.dir());
+}
+
+/// A resume naming `seat` (as an observer of another resume saw it) keyed by a ticket of its own: the
+/// server's answer to the confirmation.
+fn forged_resume(endpoint: std::net::SocketAddr, role: Role, seat: [u8; 16]) -> JoinRefusal {
+    use heist_shared::protocol::join::{self, JOIN_VERSION, JoinMsg, JoinReply, MAX_FRAME, Pake};
+    use std::io::{Read, Write};
+    let read = |stream: &mut std::net::TcpStream| {
+        let mut header = [0u8; 2];
+        stream.read_exact(&mut header).expect("a frame header");
+        let mut body = vec![0u8; join::frame_len(header, MAX_FRAME).expect("a frame length")];
+        stream.read_exact(&mut body).expect("a frame");
+        body
+    };
+    let mut stream = std::net::TcpStream::connect(endpoint).expect("the endpoint");
+    stream.set_read_timeout(Some(std::time::Duration::from_secs(5))).expect("a timeout");
+    let (pake, ours) = Pake::client_ticket(&heist_shared::protocol::SeatTicket::random());
+    let hello = join::frame(&JoinMsg::Resume { version: JOIN_VERSION, role, seat, pake: ours });
+    stream.write_all(&hello).expect("sent");
+    let challenge = read(&mut stream);
+    let Ok(JoinReply::Challenge { pake: theirs }) = join::decode(&challenge) else { panic!("no challenge") };
+    let keys = pake.finish(&theirs, &hello[2..], &challenge).expect("keys");
+    stream.write_all(&join::frame(&JoinMsg::Confirm { mac: *keys.client_mac.as_bytes() })).expect("sent");
+    match join::decode(&read(&mut stream)) {
+        Ok(JoinReply::Refused(r)) => r,
+        other => panic!("not refused: {other:?}"),
+    }
 }
 
 fn reconnect(app: &App) -> heist_client::Reconnect {

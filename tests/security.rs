@@ -244,3 +244,42 @@ fn a_tool_pose_from_vive_moves_nothing() {
     });
     assert!(seen, "Vive's client sees Phantom's tool where Phantom put it");
 }
+
+#[test]
+fn the_vive_client_never_receives_a_guard_he_could_not_perceive_and_phantom_keeps_them_all() {
+    use heist_shared::protocol::GuardView;
+    let mut heist =
+        heist_server::demo::Heist::start(ServerOptions::local_test(10), heist_bots::ViveStyle::Careful).unwrap();
+    let guards = heist.server.game().guards.len();
+    // Which guards Vive could perceive, tick by tick (the last few: what the client holds was sent a
+    // round trip ago).
+    let mut perceivable: std::collections::VecDeque<Vec<bool>> = std::collections::VecDeque::new();
+    let (mut fewer, mut some) = (0, 0);
+    for tick in 0..(150 * HZ) {
+        heist.step();
+        let game = heist.server.game();
+        if !game.is_running() && tick > 10 * HZ {
+            break;
+        }
+        perceivable.push_back((0..guards).map(|i| game.vive_perceives(i)).collect());
+        if perceivable.len() > 12 {
+            perceivable.pop_front();
+        }
+        let world = heist.vive.world_mut();
+        let held: Vec<u16> = world.query::<&GuardView>().iter(world).map(|g| g.id.0).collect();
+        for id in &held {
+            assert!(
+                perceivable.iter().any(|p| p[usize::from(*id)]),
+                "tick {tick}: Vive's client holds guard {id}, out of his sight and earshot for {} ticks",
+                perceivable.len()
+            );
+        }
+        fewer += usize::from(held.len() < guards);
+        some += usize::from(!held.is_empty());
+        if tick > 2 * HZ {
+            let world = heist.phantom.world_mut();
+            assert_eq!(world.query::<&GuardView>().iter(world).count(), guards, "tick {tick}: Phantom holds them all");
+        }
+    }
+    assert!(fewer > 0 && some > 0, "some guards were out of Vive's perception ({fewer} ticks), some in ({some})");
+}

@@ -5,7 +5,7 @@ use heist_bots::ViveStyle;
 use heist_server::ServerOptions;
 use heist_server::build_server;
 use heist_server::game::next_round_seed;
-use heist_shared::protocol::{ClientMsg, DisconnectReason, GameEvent, LobbyMsg, LossReason, Phase, Role};
+use heist_shared::protocol::{ClientMsg, DisconnectReason, GameEvent, LobbyMsg, LossReason, Phase, Role, ServerMsg};
 use heist_tests::{HZ, Heist, Session};
 
 /// Both plain clients joined and ready; the heist runs on a `time_limit_s` clock.
@@ -130,4 +130,132 @@ fn a_client_notices_within_seconds_that_the_server_went_silent_and_when_it_is_ba
     assert!(lost_after.as_secs_f64() >= SILENCE_LOST_S - 0.5, "{lost_after:?}");
     assert!(lost_after < Duration::from_secs(6), "{lost_after:?}");
     assert!(s.step_until(3 * HZ, |s| link(s, vive) == Link::Up && link(s, phantom) == Link::Up), "back");
+}
+
+/// Every server message a client got, in order (a reader of its own: the bots take theirs from the inbox).
+#[derive(bevy::prelude::Resource, Default)]
+struct Heard(Vec<ServerMsg>);
+
+fn hear(mut messages: bevy::prelude::MessageReader<ServerMsg>, mut heard: bevy::prelude::ResMut<Heard>) {
+    heard.0.extend(messages.read().cloned());
+}
+
+/// Replicated entities of each kind a client holds: (sessions, Vives, tools, guards, cases, items).
+fn held(app: &mut bevy::prelude::App) -> [usize; 6] {
+    use heist_shared::protocol::{CaseView, GuardView, ItemView, PhantomTool, SessionView, ViveAvatar};
+    let world = app.world_mut();
+    [
+        world.query::<&SessionView>().iter(world).count(),
+        world.query::<&ViveAvatar>().iter(world).count(),
+        world.query::<&PhantomTool>().iter(world).count(),
+        world.query::<&GuardView>().iter(world).count(),
+        world.query::<&CaseView>().iter(world).count(),
+        world.query::<&ItemView>().iter(world).count(),
+    ]
+}
+
+#[test]
+fn twenty_sessions_of_bot_pairs_play_whole_heists_at_once_and_no_client_sees_another_sessions_entities_or_messages() {
+    const SESSIONS: usize = 20;
+    let mut options = heist_server::load::load_server_options(SESSIONS);
+    options.game.time_limit_s = Some(60.0);
+    options.game.idle_end_s = Some(3.0);
+    let mut server = build_server(options).expect("server starts");
+    let probe = |app: &mut bevy::prelude::App| {
+        app.init_resource::<Heard>().add_systems(bevy::prelude::PreUpdate, hear);
+    };
+    let mut clients = Vec::new();
+    for _ in 0..SESSIONS {
+        clients.extend(heist_server::load::create_bot_pair(&server, ViveStyle::Careful, 1, probe).expect("a pair"));
+    }
+    assert_eq!(server.registry.len(), SESSIONS);
+    let level = heist_shared::level::Level::museum();
+    let most = [1, 1, 1, level.guards.len(), level.cases.len(), usize::MAX];
+    let mut all_running_at_once = false;
+    let mut own_entities_seen = vec![false; clients.len()];
+    let over = |server: &mut heist_server::HostedServer| {
+        let sessions = server.sessions();
+        sessions.len() == SESSIONS && sessions.iter().all(|s| !s.game.is_running() && s.game.phase != Phase::Lobby)
+    };
+    let mut ticks = 0;
+    while !over(&mut server) && ticks < 90 * HZ {
+        server.app.update();
+        clients.iter_mut().for_each(bevy::prelude::App::update);
+        ticks += 1;
+        if ticks % 30 == 0 {
+            let sessions = server.sessions();
+            all_running_at_once |= sessions.len() == SESSIONS && sessions.iter().all(|s| s.game.is_running());
+            for (i, client) in clients.iter_mut().enumerate() {
+                let counts = held(client);
+                assert!(
+                    counts.iter().zip(most).all(|(n, m)| *n <= m),
+                    "client {i} holds {counts:?}: another session's?"
+                );
+                // Vive's client (even) holds only the guards he perceives; Phantom's (odd) holds them all.
+                let guards_whole = i % 2 == 0 || counts[3] == most[3];
+                own_entities_seen[i] |= counts[..3] == [1, 1, 1] && guards_whole && counts[4] == most[4];
+            }
+        }
+    }
+    assert!(over(&mut server), "every session played its heist to a result within {ticks} ticks");
+    assert!(all_running_at_once, "the twenty heists ran at the same time");
+    assert!(own_entities_seen.iter().all(|s| *s), "every client saw its own session whole");
+    for _ in 0..10 {
+        server.app.update();
+        clients.iter_mut().for_each(bevy::prelude::App::update);
+    }
+
+    // Each client heard exactly its own session's story: one welcome, one heist start, its own result,
+    // and only the cases its own session broke.
+    let mut seeds = std::collections::HashSet::new();
+    let mut games: Vec<(u64, Phase, Vec<u16>)> = Vec::new();
+    for s in server.sessions() {
+        let broken = s.game.cases.iter().enumerate().filter(|(_, c)| c.broken).map(|(i, _)| i as u16).collect();
+        seeds.insert(s.game.seed);
+        games.push((s.id, s.game.phase, broken));
+    }
+    assert_eq!(seeds.len(), SESSIONS, "every session drew its own seed");
+    for (i, client) in clients.iter().enumerate() {
+        let heard = &client.world().resource::<Heard>().0;
+        let welcomes = heard.iter().filter(|m| matches!(m, ServerMsg::Welcome { .. })).count();
+        let events: Vec<&GameEvent> =
+            heard.iter().filter_map(|m| if let ServerMsg::Event(e) = m { Some(e) } else { None }).collect();
+        let starts = events.iter().filter(|e| **e == &GameEvent::PhaseChanged(Phase::Heist)).count();
+        let results: Vec<Phase> = events
+            .iter()
+            .filter_map(|e| match e {
+                GameEvent::PhaseChanged(p @ (Phase::Won | Phase::Lost(_))) => Some(*p),
+                _ => None,
+            })
+            .collect();
+        let mut broken: Vec<u16> =
+            events.iter().filter_map(|e| if let GameEvent::CaseBroken(c) = e { Some(c.0) } else { None }).collect();
+        broken.sort_unstable();
+        assert_eq!((welcomes, starts, results.len()), (1, 1, 1), "client {i} heard one session");
+        let own = games.iter().filter(|(_, phase, cases)| *phase == results[0] && *cases == broken).count();
+        assert!(own >= 1, "client {i} heard {results:?} and cases {broken:?}: no session played that");
+        // Its partner (the other client of the pair) heard the same story.
+        let partner = &clients[i ^ 1].world().resource::<Heard>().0;
+        let partner_broken = partner.iter().filter(|m| matches!(m, ServerMsg::Event(GameEvent::CaseBroken(_)))).count();
+        assert_eq!(partner_broken, broken.len(), "client {i} and its partner heard the same session");
+    }
+
+    // Over, the sessions end and free what they held: codes, seats, games, mirrors.
+    let freed = |server: &mut heist_server::HostedServer| {
+        let world = server.app.world_mut();
+        let mirrors = world.query::<&bevy_replicon::prelude::Replicated>().iter(world).count();
+        server.sessions().is_empty() && server.registry.is_empty() && mirrors == 0
+    };
+    let mut ticks = 0;
+    while !freed(&mut server) && ticks < 30 * HZ {
+        server.app.update();
+        clients.iter_mut().for_each(bevy::prelude::App::update);
+        ticks += 1;
+        std::thread::sleep(std::time::Duration::from_millis(1));
+    }
+    assert!(freed(&mut server), "every session ended and freed its game, mirrors, code and seats");
+    for client in &clients {
+        let inbox = client.world().resource::<heist_client::Inbox>();
+        assert_eq!(inbox.disconnect, Some(DisconnectReason::SessionEnded), "each player is told");
+    }
 }

@@ -159,7 +159,7 @@ pub fn join_with_seat(
     setup: impl FnOnce(&mut App),
 ) -> Result<(App, bool), heist_client::JoinError> {
     let tokens = server.tokens.as_ref().expect("a token endpoint");
-    let code = tokens.codes.current().code;
+    let code = server.join_code().expect("a host session").code;
     let timeout = std::time::Duration::from_secs(5);
     let joining = heist_client::join_or_resume(tokens.addr, &code, role, Some(cache), timeout)?;
     let mut app = heist_server::demo::stepped_client_app();

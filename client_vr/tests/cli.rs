@@ -6,7 +6,7 @@ use std::process::Command;
 fn a_join_that_cannot_reach_the_host_fails_on_one_line_without_a_backtrace() {
     // Nothing listens on port 1; RUST_BACKTRACE as a developer's shell has it.
     let out = Command::new(env!("CARGO_BIN_EXE_client_vr"))
-        .args(["join", "127.0.0.1:1", "--code", "ABCD-EFGH", "--headless", "--bot"])
+        .args(["join", "127.0.0.1:1", "--code", "ABCD-EFGH-JKLM", "--headless", "--bot"])
         .env("RUST_BACKTRACE", "1")
         .output()
         .expect("client_vr runs");

@@ -30,12 +30,17 @@ pub fn stepped_client_app() -> App {
 /// A connect token for `role` from `server`'s endpoint with its current code, as a player gets one.
 pub fn token(server: &HostedServer, role: Role) -> anyhow::Result<ConnectToken> {
     let tokens = server.tokens.as_ref().context("the server runs without a token endpoint")?;
-    Ok(request_token(tokens.addr, &tokens.codes.current().code, role, TOKEN_TIMEOUT)?)
+    let code = server.join_code().context("the server has no host session")?;
+    Ok(request_token(tokens.addr, &code.code, role, TOKEN_TIMEOUT)?)
 }
 
 /// Joins `server` as `role` through its token endpoint; `plugins` add the bot (or test probes).
 pub fn join(server: &HostedServer, role: Role, setup: impl FnOnce(&mut App)) -> anyhow::Result<App> {
-    let token = token(server, role)?;
+    client_with_token(token(server, role)?, setup)
+}
+
+/// A stepped client connecting with `token`; `setup` adds the bot (or test probes).
+pub fn client_with_token(token: ConnectToken, setup: impl FnOnce(&mut App)) -> anyhow::Result<App> {
     let mut app = stepped_client_app();
     setup(&mut app);
     app.finish();

@@ -6,6 +6,7 @@
 
 pub mod demo;
 pub mod game;
+pub mod load;
 pub mod net;
 pub mod session;
 
@@ -23,9 +24,11 @@ use heist_shared::level::Level;
 use heist_shared::protocol::{ProtocolPlugin, TICK_HZ};
 
 use game::{Game, GameOptions};
+use heist_transport::IntakeLimits;
+use net::registry::Registry;
 use net::tokens::{CodeBook, JoinCode, TokenConfig, TokenLimits, TokenService};
-use net::{Auth, NetSettings, ServerNetPlugin};
-use session::{GameState, LogEcho, SessionLog, SessionPlugin};
+use net::{Auth, NetSettings, NewSessions, ServerNetPlugin};
+use session::{HostSession, LogEcho, Session, SessionPlugin};
 
 /// How the server's clock advances.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -41,8 +44,14 @@ pub enum Clock {
 pub struct ServerOptions {
     /// The level to play.
     pub level: Level,
-    /// Seed and overrides.
+    /// Seed and overrides of the host's session; sessions created on request share the overrides and
+    /// draw their own seeds.
     pub game: GameOptions,
+    /// Open a session at start-up (the host's: `host`, tests, the demo); without one (`serve`) every
+    /// session is created on a player's request.
+    pub host_session: bool,
+    /// Sessions open at once, the host's included (at most [`net::MAX_SESSIONS`]).
+    pub max_sessions: usize,
     /// UDP address for the game (port 0 picks a free one).
     pub bind: SocketAddr,
     /// TCP address for the token endpoint (port 0 picks a free one). Ignored when insecure.
@@ -62,6 +71,8 @@ pub struct ServerOptions {
     pub code_ttl: Duration,
     /// The token endpoint's limits.
     pub token_limits: TokenLimits,
+    /// The game socket's limits.
+    pub intake_limits: IntakeLimits,
 }
 
 /// How long a join code works unless the host says otherwise.
@@ -74,6 +85,8 @@ impl ServerOptions {
         Self {
             level: Level::museum(),
             game: GameOptions { seed, ..Default::default() },
+            host_session: true,
+            max_sessions: 1,
             bind: loopback,
             token_bind: loopback,
             insecure: false,
@@ -83,6 +96,7 @@ impl ServerOptions {
             advertise: None,
             code_ttl: DEFAULT_CODE_TTL,
             token_limits: TokenLimits::default(),
+            intake_limits: IntakeLimits::default(),
         }
     }
 }
@@ -97,22 +111,46 @@ pub struct HostedServer {
     pub advertised: SocketAddr,
     /// The token endpoint (secure mode).
     pub tokens: Option<TokenService>,
+    /// The sessions, as the endpoint sees them.
+    pub registry: Registry,
+    /// The host's session's code book (secure mode, with a host session).
+    pub codes: Option<CodeBook>,
 }
 
 impl HostedServer {
-    /// The session's game state.
+    /// The host's session (the one opened at start-up).
+    ///
+    /// # Panics
+    /// When the server was built without one ([`ServerOptions::host_session`] false): a test's mistake.
+    pub fn host_session(&self) -> &Session {
+        self.app
+            .world()
+            .resource::<HostSession>()
+            .0
+            .and_then(|e| self.app.world().get::<Session>(e))
+            .expect("the server was built with a host session")
+    }
+
+    /// The host's session's game state (see [`HostedServer::host_session`]).
     pub fn game(&self) -> &Game {
-        &self.app.world().resource::<GameState>().0
+        &self.host_session().game
     }
 
-    /// The join code in force (secure mode).
+    /// The host's session's join code in force (secure mode).
     pub fn join_code(&self) -> Option<JoinCode> {
-        self.tokens.as_ref().map(|t| t.codes.current())
+        self.codes.as_ref().map(CodeBook::current)
     }
 
-    /// The session log so far.
+    /// The host's session's log so far.
     pub fn log(&self) -> &[String] {
-        &self.app.world().resource::<SessionLog>().lines
+        &self.host_session().log.lines
+    }
+
+    /// Every session being played, in no particular order.
+    pub fn sessions(&mut self) -> Vec<&Session> {
+        let world = self.app.world_mut();
+        let mut query = world.query::<&Session>();
+        query.iter(world).collect()
     }
 }
 
@@ -125,26 +163,33 @@ pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
         a => a,
     };
     let advertised = advertise.unwrap_or(addr);
-    let seats = net::seats::Seats::default();
+    let max_sessions = options.max_sessions.clamp(1, net::MAX_SESSIONS);
+    let registry = Registry::new(max_sessions, options.code_ttl, options.token_limits.creates);
+    let host_entry = if options.host_session {
+        let entry = registry.open(None).map_err(|e| anyhow::anyhow!("cannot open the host's session: {e}"))?;
+        registry.take_opened(); // spawned below, with the host's options
+        Some(entry)
+    } else {
+        None
+    };
     let (auth, tokens) = if options.insecure {
         (Auth::Insecure, None)
     } else {
         let private_key: [u8; 32] = rand::random();
-        let session: u64 = rand::random();
         let service = TokenService::spawn(
             options.token_bind,
             TokenConfig {
-                codes: CodeBook::new(options.code_ttl),
+                registry: registry.clone(),
                 private_key,
                 server_addr: advertised,
-                session,
-                seats: seats.clone(),
                 limits: options.token_limits,
             },
         )
         .with_context(|| format!("cannot bind the token endpoint on TCP {}", options.token_bind))?;
-        (Auth::Secure { private_key, session }, Some(service))
+        (Auth::Secure { private_key }, Some(service))
     };
+    let codes = host_entry.as_ref().filter(|_| !options.insecure).map(|e| e.codes.clone());
+    let new_sessions = NewSessions { level: options.level.clone(), game: options.game.clone(), echo: options.echo_log };
 
     let mut app = App::new();
     let period = Duration::from_secs_f64(1.0 / TICK_HZ);
@@ -158,26 +203,30 @@ pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
     }
     app.insert_resource(Time::<Fixed>::from_hz(TICK_HZ))
         .add_plugins((StatesPlugin, RepliconPlugins, RepliconRenetPlugins, ProtocolPlugin))
-        .insert_resource(GameState(Game::new(options.level, &options.game)))
-        .insert_resource(SessionLog {
-            echo: options.echo_log,
-            id: format!("{:08x}", rand::random::<u32>()),
-            round: 1,
-            ..Default::default()
-        })
         .add_plugins(SessionPlugin)
         .add_plugins(ServerNetPlugin {
             socket: std::sync::Mutex::new(Some(socket)),
-            settings: NetSettings { auth, seats, abuse_limit: options.abuse_limit, advertise },
+            settings: NetSettings {
+                auth,
+                registry: registry.clone(),
+                abuse_limit: options.abuse_limit,
+                advertise,
+                new_sessions: new_sessions.clone(),
+                exit_with_host: options.host_session,
+            },
+            intake: options.intake_limits,
         });
-    app.world_mut().resource_mut::<SessionLog>().record(
-        0.0,
-        session::Record::SessionCreated,
-        "session created; waiting for players".into(),
-    );
+    if let Some(entry) = &host_entry {
+        let mut session = new_sessions.session(entry, Some(&options.game));
+        session.log.record(0.0, session::Record::SessionCreated, "session created; waiting for players".into());
+        let world = app.world_mut();
+        let entity = session::spawn_session(&mut world.commands(), session);
+        world.flush();
+        world.insert_resource(HostSession(Some(entity)));
+    }
     if options.clock == Clock::Stepped {
         app.finish();
         app.cleanup();
     }
-    Ok(HostedServer { app, addr, advertised, tokens })
+    Ok(HostedServer { app, addr, advertised, tokens, registry, codes })
 }

@@ -48,8 +48,8 @@ impl From<Style> for ViveStyle {
 enum Command {
     /// Host a session on loopback with both bots, print the live log and the result.
     Demo {
-        /// Seed for the copies and the guards (default 10: a heist the bots win).
-        #[arg(long, default_value_t = 10)]
+        /// Seed for the copies and the guards (default 18: a heist the bots win).
+        #[arg(long, default_value_t = 18)]
         seed: u64,
         /// Level file (default: the shipped museum).
         #[arg(long)]
@@ -75,6 +75,46 @@ enum Command {
         /// How the Vive bot plays.
         #[arg(long, value_enum, default_value_t = Style::Careful)]
         vive: Style,
+    },
+    /// Serve many sessions: any player may create one (and gets its join code for a partner), up to
+    /// --max-sessions at once; each session ends on its own when it is over, the server runs on.
+    Serve {
+        /// UDP game address; the token endpoint listens on the same port over TCP.
+        #[arg(long, default_value = "127.0.0.1:5757")]
+        bind: SocketAddr,
+        /// The address players reach the server at, put in their tokens (a NAT, a relay).
+        #[arg(long)]
+        advertise: Option<SocketAddr>,
+        /// Sessions open at once.
+        #[arg(long, default_value_t = heist_server::net::tokens::DEFAULT_MAX_SESSIONS,
+              value_parser = max_sessions)]
+        max_sessions: usize,
+        /// Minutes a session's join code works.
+        #[arg(long, default_value_t = 30)]
+        code_ttl: u64,
+        /// Level file (default: the shipped museum).
+        #[arg(long)]
+        level: Option<PathBuf>,
+        /// Seconds a session waits after a result for another round (and outlives its last player)
+        /// before it ends.
+        #[arg(long, default_value_t = heist_server::game::SESSION_IDLE_S, value_parser = positive_seconds)]
+        idle_end: f32,
+        /// Override the level's time limit, seconds.
+        #[arg(long, value_parser = positive_seconds)]
+        time_limit: Option<f32>,
+    },
+    /// Play N bot pairs, each in its own session, against one server over loopback, and print what the
+    /// server spends: CPU per session-tick, tick time, bytes per client.
+    Load {
+        /// Sessions (bot pairs).
+        #[arg(long, default_value_t = 10, value_parser = max_sessions)]
+        sessions: usize,
+        /// Seconds of play measured, once every bot is in.
+        #[arg(long, default_value_t = 30.0, value_parser = positive_seconds)]
+        seconds: f32,
+        /// Print one JSON object as the last line.
+        #[arg(long)]
+        json: bool,
     },
     /// Host a session for players: prints the address and the join code.
     Host {
@@ -105,15 +145,21 @@ enum Command {
         /// Override the level's time limit, seconds.
         #[arg(long, value_parser = positive_seconds)]
         time_limit: Option<f32>,
+        /// Sessions open at once: besides the host's, players may create this many less one.
+        #[arg(long, default_value_t = 1, value_parser = max_sessions)]
+        max_sessions: usize,
     },
     /// Join a hosted session as a bot (restarted within a minute of losing its connection, it takes its
     /// seat back through the seat cache, `$XDG_CACHE_HOME/phantom-heist/seats`).
     Join {
         /// The host's game address.
         addr: SocketAddr,
-        /// Join code printed by the host.
-        #[arg(long)]
-        code: String,
+        /// Join code printed by the host (or by the partner who created the session).
+        #[arg(long, required_unless_present = "create")]
+        code: Option<String>,
+        /// Create a new session on the server instead, print its join code for a partner, and play it.
+        #[arg(long, conflicts_with = "code")]
+        create: bool,
         /// Role to play.
         #[arg(long)]
         role: Role,
@@ -174,6 +220,62 @@ fn leave_after_the_last_round(
     }
 }
 
+/// A number of sessions for a flag: 1 to the most one server hosts.
+fn max_sessions(text: &str) -> Result<usize, String> {
+    let max = heist_server::net::MAX_SESSIONS;
+    match text.parse::<usize>() {
+        Ok(n) if (1..=max).contains(&n) => Ok(n),
+        Ok(n) => Err(format!("must be 1 to {max} sessions, got {n}")),
+        Err(e) => Err(format!("not a number of sessions ({e})")),
+    }
+}
+
+/// What `host` and `serve` share.
+struct Hosting {
+    bind: SocketAddr,
+    advertise: Option<SocketAddr>,
+    code_ttl: u64,
+    level: Option<PathBuf>,
+    idle_end: f32,
+    time_limit: Option<f32>,
+    max_sessions: usize,
+}
+
+impl Hosting {
+    fn options(self, seed: Option<u64>, insecure: bool, host_session: bool) -> anyhow::Result<ServerOptions> {
+        Ok(ServerOptions {
+            level: load_level(self.level)?,
+            game: GameOptions {
+                seed: seed.unwrap_or_else(rand::random),
+                random_rounds: seed.is_none(),
+                idle_end_s: Some(self.idle_end),
+                time_limit_s: self.time_limit,
+                ends_unjoined: false,
+            },
+            host_session,
+            max_sessions: self.max_sessions,
+            bind: self.bind,
+            token_bind: self.bind,
+            insecure,
+            clock: Clock::RealTime,
+            echo_log: LogEcho::Tracing,
+            abuse_limit: 50,
+            advertise: self.advertise,
+            code_ttl: Duration::from_secs(self.code_ttl.max(1) * 60),
+            token_limits: Default::default(),
+            intake_limits: Default::default(),
+        })
+    }
+}
+
+fn print_address(server: &heist_server::HostedServer) {
+    if server.advertised == server.addr {
+        println!("hosting on {} (UDP game, TCP tokens)", server.addr);
+    } else {
+        println!("hosting on {} (UDP game, TCP tokens); players connect to {}", server.addr, server.advertised);
+    }
+}
+
 /// A number of seconds for a flag: finite and above zero.
 fn positive_seconds(text: &str) -> Result<f32, String> {
     match text.parse::<f32>() {
@@ -192,7 +294,7 @@ fn load_level(path: Option<PathBuf>) -> anyhow::Result<Level> {
 
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
-    let quiet = matches!(cli.command, Command::Demo { .. } | Command::Sweep { .. });
+    let quiet = matches!(cli.command, Command::Demo { .. } | Command::Sweep { .. } | Command::Load { .. });
     logging::init(cli.log_format, if quiet { "warn" } else { "info" });
     match run(cli) {
         Ok(()) => std::process::ExitCode::SUCCESS,
@@ -221,38 +323,16 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             println!("{tally}");
             Ok(())
         }
-        Command::Host { bind, advertise, seed, code_ttl, level, insecure, idle_end, time_limit } => {
+        Command::Host { bind, advertise, seed, code_ttl, level, insecure, idle_end, time_limit, max_sessions } => {
             if insecure {
                 eprintln!("WARNING: --insecure: anyone who reaches {bind} can join as any role. LAN development only!");
             }
-            let options = ServerOptions {
-                level: load_level(level)?,
-                game: GameOptions {
-                    seed: seed.unwrap_or_else(rand::random),
-                    random_rounds: seed.is_none(),
-                    idle_end_s: Some(idle_end),
-                    time_limit_s: time_limit,
-                },
-                bind,
-                token_bind: bind,
-                insecure,
-                clock: Clock::RealTime,
-                echo_log: LogEcho::Tracing,
-                abuse_limit: 50,
-                advertise,
-                code_ttl: Duration::from_secs(code_ttl.max(1) * 60),
-                token_limits: Default::default(),
-            };
-            let mut server = build_server(options)?;
-            if server.advertised == server.addr {
-                println!("hosting on {} (UDP game, TCP tokens)", server.addr);
-            } else {
-                println!("hosting on {} (UDP game, TCP tokens); players connect to {}", server.addr, server.advertised);
-            }
-            if let Some(tokens) = &server.tokens {
-                println!("join code: {}", tokens.codes.current().describe());
+            let hosting = Hosting { bind, advertise, code_ttl, level, idle_end, time_limit, max_sessions };
+            let mut server = build_server(hosting.options(seed, insecure, true)?)?;
+            print_address(&server);
+            if let Some(codes) = server.codes.clone() {
+                println!("join code: {}", codes.current().describe());
                 println!("type `rotate` and Enter for a new join code");
-                let codes = tokens.codes.clone();
                 std::thread::Builder::new().name("host-console".into()).spawn(move || {
                     for line in std::io::stdin().lock().lines().map_while(Result::ok) {
                         if line.trim() == "rotate" {
@@ -265,10 +345,36 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             println!("the session is over");
             Ok(())
         }
-        Command::Join { addr, code, role, vive, rounds } => {
+        Command::Serve { bind, advertise, max_sessions, code_ttl, level, idle_end, time_limit } => {
+            let hosting = Hosting { bind, advertise, code_ttl, level, idle_end, time_limit, max_sessions };
+            let mut server = build_server(hosting.options(None, false, false)?)?;
+            print_address(&server);
+            println!("serving up to {max_sessions} sessions: a player creates one and gets its join code");
+            server.app.run();
+            Ok(())
+        }
+        Command::Load { sessions, seconds, json } => {
+            let options = heist_server::load::LoadOptions { sessions, seconds, style: ViveStyle::Careful };
+            let report = heist_server::load::run_load(&options, |line| println!("{line}"))?;
+            println!("{report}");
+            if json {
+                println!("{}", serde_json::to_string(&report)?);
+            }
+            Ok(())
+        }
+        Command::Join { addr, code, create, role, vive, rounds } => {
             let cache = heist_client::SeatCache::in_default_dir();
-            let joining = heist_client::join_or_resume(addr, &code, role, cache.as_ref(), Duration::from_secs(5))
-                .with_context(|| format!("joining {addr} as {role}"))?;
+            let timeout = Duration::from_secs(5);
+            let joining = match (code, create) {
+                (Some(code), _) => heist_client::join_or_resume(addr, &code, role, cache.as_ref(), timeout)
+                    .with_context(|| format!("joining {addr} as {role}"))?,
+                (None, _) => {
+                    let (code, token) = heist_client::create_session(addr, role, timeout)
+                        .with_context(|| format!("creating a session on {addr}"))?;
+                    println!("created a session on {addr}; join code: {code}");
+                    heist_client::Joining { token, resuming: false }
+                }
+            };
             let mut app = App::new();
             app.add_plugins(
                 MinimalPlugins.set(bevy::app::ScheduleRunnerPlugin::run_loop(Duration::from_secs_f64(1.0 / 60.0))),

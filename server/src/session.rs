@@ -1,5 +1,7 @@
-//! The session in the ECS: the [`Game`] as a resource stepped in `FixedUpdate`, its state mirrored
-//! into replicated entities in `PostUpdate`, and a readable log of what happened.
+//! Sessions in the ECS: each hosted session is an entity with a [`Session`] (its [`Game`], stepped in
+//! `FixedUpdate`, its players and its log); its state is mirrored in `PostUpdate` into replicated
+//! entities related to it ([`MirrorOf`]) and tagged with its [`SessionTag`], the visibility filter that
+//! shows them only to that session's players.
 
 use bevy::prelude::*;
 use bevy_replicon::prelude::*;
@@ -10,10 +12,54 @@ use heist_shared::protocol::{
 
 use crate::game::Game;
 use crate::net::NetSystems;
+use crate::net::Roles;
+use crate::net::seats::Seats;
 
-/// The authoritative game.
-#[derive(Resource)]
-pub struct GameState(pub Game);
+/// One hosted session: its game, who plays it, and its log.
+#[derive(Component)]
+pub struct Session {
+    /// Its id, as its players' tokens carry it.
+    pub id: u64,
+    /// The authoritative game.
+    pub game: Game,
+    /// Its log.
+    pub log: SessionLog,
+    /// Which client plays which role.
+    pub roles: Roles,
+    /// Its seats, shared with the token endpoint.
+    pub seats: Seats,
+    /// When (real seconds) the session was closed and its players told; it is despawned a little later.
+    pub closed_at: Option<f64>,
+}
+
+/// Which session a replicated entity or a client belongs to: replicon shows an entity to a client only
+/// when both carry the same tag (and an untagged client, one not admitted, sees nothing).
+#[derive(Component, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[component(immutable)]
+pub struct SessionTag(pub u64);
+
+impl VisibilityFilter for SessionTag {
+    type ClientComponent = Self;
+    type Scope = Entity;
+
+    fn is_visible(&self, _client: Entity, client: Option<&Self>) -> bool {
+        client == Some(self)
+    }
+}
+
+/// A replicated mirror's session (despawned with it).
+#[derive(Component, Clone, Copy, Debug)]
+#[relationship(relationship_target = Mirrors)]
+pub struct MirrorOf(pub Entity);
+
+/// A session's replicated mirrors.
+#[derive(Component, Debug, Default)]
+#[relationship_target(relationship = MirrorOf, linked_spawn)]
+pub struct Mirrors(Vec<Entity>);
+
+/// The session the server was started with (`host`, tests, the demo), if any.
+#[derive(Resource, Clone, Copy, Debug, Default)]
+pub struct HostSession(pub Option<Entity>);
 
 /// Where the session log's lines go besides [`SessionLog::lines`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -249,6 +295,8 @@ pub enum Mirror {
     Case(usize),
     /// Item by index.
     Item(usize),
+    /// Phantom's tool.
+    Tool,
 }
 
 /// System sets of the session.
@@ -260,21 +308,24 @@ pub enum SessionSystems {
     Mirror,
 }
 
-/// Runs the game and mirrors it.
+/// Runs the games and mirrors them.
 pub struct SessionPlugin;
 
 impl Plugin for SessionPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<SessionLog>()
+        app.init_resource::<HostSession>()
+            .add_visibility_filter::<SessionTag>()
             .configure_sets(PostUpdate, SessionSystems::Mirror.before(NetSystems::Send))
-            .add_systems(Startup, spawn_mirrors)
-            .add_systems(FixedUpdate, step_game.in_set(SessionSystems::Step))
-            .add_systems(PostUpdate, mirror_game.in_set(SessionSystems::Mirror));
+            .add_systems(FixedUpdate, step_games.in_set(SessionSystems::Step))
+            .add_systems(PostUpdate, mirror_games.in_set(SessionSystems::Mirror));
     }
 }
 
-fn step_game(mut game: ResMut<GameState>, time: Res<Time>) {
-    game.0.step(time.delta_secs());
+fn step_games(mut sessions: Query<&mut Session>, time: Res<Time>) {
+    let dt = time.delta_secs();
+    for mut session in &mut sessions {
+        session.game.step(dt);
+    }
 }
 
 /// `RESULT: Won` or `RESULT: Lost(<reason>)` once the session has ended.
@@ -286,56 +337,81 @@ pub fn result_line(game: &Game) -> Option<String> {
     }
 }
 
-fn spawn_mirrors(mut commands: Commands, game: Res<GameState>) {
-    let g = &game.0;
-    let both = (Replicated, Audience::Both);
-    commands.spawn((both, Mirror::Session, session_view(g)));
-    commands.spawn((both, Mirror::Vive, vive_view(g)));
-    commands.spawn((both, g.tool));
-    for i in 0..g.guards.len() {
-        commands.spawn((both, Mirror::Guard(i), guard_view(g, i)));
+/// Spawns `session` and its replicated mirrors; returns the session's entity.
+pub fn spawn_session(commands: &mut Commands, session: Session) -> Entity {
+    let tag = SessionTag(session.id);
+    let g = &session.game;
+    let both = (Replicated, Audience::Both, tag);
+    let mut mirrors = vec![
+        (Mirror::Session, commands.spawn((both, Mirror::Session, session_view(g))).id()),
+        (Mirror::Vive, commands.spawn((both, Mirror::Vive, vive_view(g))).id()),
+        (Mirror::Tool, commands.spawn((both, Mirror::Tool, g.tool)).id()),
+    ];
+    mirrors.extend((0..g.guards.len()).map(|i| {
+        let guard = (Replicated, guard_audience(g, i), tag, Mirror::Guard(i), guard_view(g, i));
+        (Mirror::Guard(i), commands.spawn(guard).id())
+    }));
+    mirrors.extend(
+        (0..g.cases.len()).map(|i| (Mirror::Case(i), commands.spawn((both, Mirror::Case(i), case_view(g, i))).id())),
+    );
+    mirrors.extend(
+        (0..g.items.len()).map(|i| (Mirror::Item(i), commands.spawn((both, Mirror::Item(i), item_view(g, i))).id())),
+    );
+    let entity = commands.spawn((session, tag)).id();
+    for (_, mirror) in mirrors {
+        commands.entity(mirror).insert(MirrorOf(entity));
     }
-    for i in 0..g.cases.len() {
-        commands.spawn((both, Mirror::Case(i), case_view(g, i)));
-    }
-    for i in 0..g.items.len() {
-        commands.spawn((both, Mirror::Item(i), item_view(g, i)));
-    }
+    entity
+}
+
+/// Who may see guard `i`'s mirror: both players while Vive could perceive the guard, else only Phantom
+/// (interest management: Vive's client never holds a guard he could not see or hear).
+fn guard_audience(g: &Game, i: usize) -> Audience {
+    if g.vive_perceives(i) { Audience::Both } else { Audience::Only(Role::Phantom) }
 }
 
 #[allow(clippy::type_complexity)]
-fn mirror_game(
-    game: Res<GameState>,
-    mut session: Query<&mut SessionView>,
-    mut vive: Query<&mut ViveAvatar>,
-    mut guards: Query<(&Mirror, &mut GuardView)>,
-    mut cases: Query<(&Mirror, &mut CaseView)>,
-    mut items: Query<(&Mirror, &mut ItemView)>,
-    mut tool: Query<&mut PhantomTool>,
+fn mirror_games(
+    mut commands: Commands,
+    sessions: Query<(&Session, &Mirrors)>,
+    mut mirrors: Query<(
+        Entity,
+        &Mirror,
+        &Audience,
+        AnyOf<(&mut SessionView, &mut ViveAvatar, &mut PhantomTool, &mut GuardView, &mut CaseView, &mut ItemView)>,
+    )>,
 ) {
-    let g = &game.0;
-    for mut s in &mut session {
-        s.set_if_neq(session_view(g));
-    }
-    for mut v in &mut vive {
-        v.set_if_neq(vive_view(g));
-    }
-    for mut t in &mut tool {
-        t.set_if_neq(g.tool);
-    }
-    for (m, mut v) in &mut guards {
-        if let Mirror::Guard(i) = *m {
-            v.set_if_neq(guard_view(g, i));
-        }
-    }
-    for (m, mut v) in &mut cases {
-        if let Mirror::Case(i) = *m {
-            v.set_if_neq(case_view(g, i));
-        }
-    }
-    for (m, mut v) in &mut items {
-        if let Mirror::Item(i) = *m {
-            v.set_if_neq(item_view(g, i));
+    for (session, of) in &sessions {
+        let g = &session.game;
+        let mut iter = mirrors.iter_many_mut(of.iter());
+        while let Some((entity, mirror, audience, views)) = iter.fetch_next() {
+            if let Mirror::Guard(i) = *mirror {
+                let should = guard_audience(g, i);
+                if *audience != should {
+                    commands.entity(entity).insert(should);
+                }
+            }
+            match (*mirror, views) {
+                (Mirror::Session, (Some(mut v), ..)) => {
+                    v.set_if_neq(session_view(g));
+                }
+                (Mirror::Vive, (_, Some(mut v), ..)) => {
+                    v.set_if_neq(vive_view(g));
+                }
+                (Mirror::Tool, (_, _, Some(mut v), ..)) => {
+                    v.set_if_neq(g.tool);
+                }
+                (Mirror::Guard(i), (_, _, _, Some(mut v), ..)) => {
+                    v.set_if_neq(guard_view(g, i));
+                }
+                (Mirror::Case(i), (_, _, _, _, Some(mut v), _)) => {
+                    v.set_if_neq(case_view(g, i));
+                }
+                (Mirror::Item(i), (_, _, _, _, _, Some(mut v))) => {
+                    v.set_if_neq(item_view(g, i));
+                }
+                _ => {}
+            }
         }
     }
 }

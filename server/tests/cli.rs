@@ -238,3 +238,81 @@ fn a_bot_process_killed_mid_heist_and_started_again_takes_its_seat_back() {
         let _ = std::fs::remove_dir_all(cache(role));
     }
 }
+
+#[test]
+fn a_served_server_hosts_two_sessions_bot_processes_created_and_each_ends_on_its_own() {
+    use std::process::Stdio;
+    use std::time::{Duration, Instant};
+    let bin = env!("CARGO_BIN_EXE_heist-server");
+    let port = std::net::UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
+    let addr = format!("127.0.0.1:{port}");
+    let mut serve = Command::new(bin)
+        .args(["--log-format", "json", "serve", "--bind", &addr, "--max-sessions", "2", "--time-limit", "3"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let out = lines_of(serve.stdout.take().unwrap());
+    let log = lines_of(serve.stderr.take().unwrap());
+    let deadline = Instant::now() + Duration::from_secs(20);
+    while !out
+        .recv_timeout(deadline.saturating_duration_since(Instant::now()))
+        .expect("serve starts")
+        .contains("serving")
+    {}
+    let cache = std::env::temp_dir().join(format!("heist-cli-seats-{}-serve", std::process::id()));
+    let bot = |args: &[&str], role: &str, name: &str| {
+        Command::new(bin)
+            .args(["join", &addr])
+            .args(args)
+            .args(["--role", role, "--vive", "idle"])
+            .env("XDG_CACHE_HOME", cache.join(name))
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    // Two Vive bots each create a session and print its code; a Phantom bot joins each with it.
+    let mut bots = Vec::new();
+    let mut codes = Vec::new();
+    for n in 0..2 {
+        let mut creator = bot(&["--create"], "vive", &format!("creator{n}"));
+        let printed = lines_of(creator.stdout.take().unwrap());
+        let line = printed.recv_timeout(Duration::from_secs(20)).expect("the creator prints the code");
+        let code = line.split("join code: ").nth(1).expect("a code").trim().to_owned();
+        bots.push(bot(&["--code", &code], "phantom", &format!("partner{n}")));
+        bots.push(creator);
+        codes.push(code);
+    }
+    assert_ne!(codes[0], codes[1], "each session has its own code");
+    // A third creator finds the server full, on one line.
+    let full = Command::new(bin).args(["join", &addr, "--create", "--role", "vive"]).output().unwrap();
+    let err = String::from_utf8_lossy(&full.stderr);
+    assert!(!full.status.success() && err.contains("hosts 2 sessions already"), "{err}");
+    // Each 3 s heist ends on time, the bots leave, each session ends; the server runs on.
+    for b in &mut bots {
+        assert!(wait_for(b, Duration::from_secs(60)).is_some(), "a bot leaves after its heist");
+    }
+    let mut names = Vec::new();
+    let deadline = Instant::now() + Duration::from_secs(20);
+    while names.iter().filter(|(n, _): &&(String, String)| n == "session_ended").count() < 2
+        && Instant::now() < deadline
+    {
+        if let Ok(line) = log.recv_timeout(Duration::from_millis(200))
+            && let Ok(v) = serde_json::from_str::<serde_json::Value>(&line)
+            && v["target"] == "session"
+        {
+            names
+                .push((v["event"].as_str().unwrap_or("?").to_owned(), v["session"].as_str().unwrap_or("?").to_owned()));
+        }
+    }
+    let sessions: std::collections::HashSet<&String> = names.iter().map(|(_, s)| s).collect();
+    let count = |e: &str| names.iter().filter(|(n, _)| n == e).count();
+    assert_eq!(sessions.len(), 2, "two sessions in the log: {names:?}");
+    assert_eq!((count("session_created"), count("player_joined"), count("result")), (2, 4, 2), "{names:?}");
+    assert_eq!(count("session_ended"), 2, "{names:?}");
+    assert!(serve.try_wait().unwrap().is_none(), "serve runs on after its sessions ended");
+    let _ = serve.kill();
+    let _ = serve.wait();
+    let _ = std::fs::remove_dir_all(cache);
+}

@@ -1,6 +1,7 @@
 //! `client_haptic host`: a blind player hosts alone. The server runs in this process (on its own thread,
-//! in real time), the client joins it as Phantom, and the join code to give the partner is said twice:
-//! as written, and spelled slowly character by character in the NATO alphabet (R repeats it).
+//! in real time) — or, with `--server ADDR`, the client creates a session on a running `heist-server
+//! serve` — the client joins it as Phantom, and the join code to give the partner is said twice: as
+//! written, and spelled slowly character by character in the NATO alphabet (R repeats it).
 
 use std::net::SocketAddr;
 use std::time::Duration;
@@ -24,6 +25,9 @@ pub struct HostArgs {
     /// Seed of the first round (default: random, so nobody knows which copies are real).
     #[arg(long)]
     pub seed: Option<u64>,
+    /// Create the session on this running server (`heist-server serve`) instead of hosting one here.
+    #[arg(long, conflicts_with_all = ["bind", "advertise", "seed"])]
+    pub server: Option<SocketAddr>,
     /// Device, window, audio and bot settings, as for `join`.
     #[command(flatten)]
     pub client: ClientArgs,
@@ -52,6 +56,31 @@ pub fn spell(code: &str) -> String {
 /// Runs `host`: starts the server, joins it as Phantom, says the code, plays until the session ends.
 pub fn host(args: &HostArgs) -> anyhow::Result<()> {
     let settings = args.client.settings().map_err(anyhow::Error::msg)?;
+    let (advertised, endpoint, code, token) = match args.server {
+        Some(server) => {
+            let (code, token) = heist_client::create_session(server, Role::Phantom, Duration::from_secs(5))
+                .with_context(|| format!("creating a session on {server}"))?;
+            (server, server, code, token)
+        }
+        None => host_here(args)?,
+    };
+    let mut app = crate::cli::app(settings, args.client.headless, None)?;
+    args.client.request_shot(&mut app);
+    app.finish();
+    app.cleanup();
+    app.insert_resource(crate::client::HostedCode(vec![
+        format!("You host the heist. Your partner joins at {advertised} with the code {code}."),
+        format!("The code, spelled: {}. R repeats it.", spell(&code)),
+    ]));
+    heist_client::connect(&mut app, token)?;
+    heist_client::hold_seat(&mut app, heist_client::SeatCache::in_default_dir(), endpoint, Role::Phantom);
+    app.run();
+    Ok(())
+}
+
+/// Starts the server in this process; returns its advertised address, its endpoint, the code and
+/// Phantom's token.
+fn host_here(args: &HostArgs) -> anyhow::Result<(SocketAddr, SocketAddr, String, heist_client::ConnectToken)> {
     let options = ServerOptions {
         level: Level::museum(),
         game: heist_server::game::GameOptions {
@@ -59,6 +88,8 @@ pub fn host(args: &HostArgs) -> anyhow::Result<()> {
             random_rounds: args.seed.is_none(),
             ..Default::default()
         },
+        host_session: true,
+        max_sessions: 1,
         bind: args.bind,
         token_bind: args.bind,
         insecure: false,
@@ -68,6 +99,7 @@ pub fn host(args: &HostArgs) -> anyhow::Result<()> {
         advertise: args.advertise,
         code_ttl: DEFAULT_CODE_TTL,
         token_limits: Default::default(),
+        intake_limits: Default::default(),
     };
     let (tx, rx) = std::sync::mpsc::channel();
     // The server's app is built and run on its own thread (a Bevy app stays on the thread that made it).
@@ -86,17 +118,7 @@ pub fn host(args: &HostArgs) -> anyhow::Result<()> {
     let (endpoint, code) = endpoint.zip(code).context("the server runs without a join endpoint")?;
     let token = heist_client::request_token(endpoint, &code, Role::Phantom, Duration::from_secs(5))
         .with_context(|| format!("joining the session hosted on {endpoint}"))?;
-    let mut app = crate::cli::app(settings, args.client.headless, None)?;
-    args.client.request_shot(&mut app);
-    app.finish();
-    app.cleanup();
-    app.insert_resource(crate::client::HostedCode(vec![
-        format!("You host the heist. Your partner joins at {advertised} with the code {code}."),
-        format!("The code, spelled: {}. R repeats it.", spell(&code)),
-    ]));
-    heist_client::connect(&mut app, token)?;
-    app.run();
-    Ok(())
+    Ok((advertised, endpoint, code, token))
 }
 
 #[cfg(test)]
@@ -105,7 +127,10 @@ mod tests {
 
     #[test]
     fn a_code_is_spelled_in_the_nato_alphabet_with_digits_by_name() {
-        assert_eq!(spell("K7QX-2M4P"), "kilo, seven, quebec, x-ray, then, two, mike, four, papa");
+        assert_eq!(
+            spell("K7QX-2M4P-R9TC"),
+            "kilo, seven, quebec, x-ray, then, two, mike, four, papa, then, romeo, nine, tango, charlie"
+        );
         assert_eq!(spell("ab"), "alfa, bravo");
     }
 }

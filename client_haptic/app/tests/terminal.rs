@@ -113,7 +113,7 @@ fn headless_practice_prints_each_spoken_line_once_and_nothing_else() {
 fn a_join_that_cannot_reach_the_host_fails_on_one_line_without_a_backtrace() {
     // Nothing listens on port 1; RUST_BACKTRACE as a developer's shell has it.
     let out = Command::new(env!("CARGO_BIN_EXE_client_haptic"))
-        .args(["join", "127.0.0.1:1", "--code", "ABCD-EFGH", "--headless", "--audio", "memory"])
+        .args(["join", "127.0.0.1:1", "--code", "ABCD-EFGH-JKLM", "--headless", "--audio", "memory"])
         .env("RUST_BACKTRACE", "1")
         .output()
         .expect("client_haptic runs");
@@ -144,7 +144,7 @@ fn host_with_a_vive_bot(
         options.game.time_limit_s = Some(time_limit_s);
         let mut server = build_server(options).expect("server starts");
         let tokens = server.tokens.as_ref().expect("secure");
-        tx.send((tokens.addr, tokens.codes.current().code.clone())).expect("the test waits");
+        tx.send((tokens.addr, server.join_code().expect("a host session").code)).expect("the test waits");
         let mut vive: Option<bevy::app::App> = None;
         let deadline = Instant::now() + Duration::from_secs(150);
         while !stop.load(Ordering::Relaxed) && Instant::now() < deadline {
@@ -226,10 +226,42 @@ fn a_blind_player_hears_the_partner_plays_a_rematch_and_leaves_by_typed_lines() 
 
 #[test]
 fn a_blind_player_hosts_alone_hears_the_code_spelled_and_a_partner_joins_with_it() {
-    use heist_shared::protocol::{Role, TICK_HZ};
     let port = std::net::UdpSocket::bind("127.0.0.1:0").expect("a free port").local_addr().expect("addr").port();
     let bind = format!("127.0.0.1:{port}");
-    let (mut child, mut stdin, rx) = headless(&["host", "--bind", &bind]);
+    host_and_hear_a_partner_join(&["host", "--bind", &bind], &bind);
+}
+
+#[test]
+fn a_blind_player_creates_a_session_on_a_running_server_and_a_partner_joins_with_its_code() {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let stop = std::sync::Arc::new(AtomicBool::new(false));
+    let (tx, rx) = mpsc::channel();
+    let serving = stop.clone();
+    // `heist-server serve`, in-process: no session until a player creates one.
+    let server = std::thread::spawn(move || {
+        let mut options = heist_server::ServerOptions::local_test(0);
+        options.host_session = false;
+        options.max_sessions = 4;
+        let mut server = heist_server::build_server(options).expect("server starts");
+        tx.send(server.tokens.as_ref().expect("secure").addr).expect("the test waits");
+        let deadline = Instant::now() + Duration::from_secs(90);
+        while !serving.load(Ordering::Relaxed) && Instant::now() < deadline {
+            std::thread::sleep(Duration::from_millis(16));
+            server.app.update();
+        }
+        server.sessions().len()
+    });
+    let addr = rx.recv_timeout(Duration::from_secs(30)).expect("the server starts").to_string();
+    host_and_hear_a_partner_join(&["host", "--server", &addr], &addr);
+    stop.store(true, Ordering::Relaxed);
+    assert_eq!(server.join().expect("the server thread"), 1, "the session was created on the running server");
+}
+
+/// Runs `client_haptic <args>` (a host), joins a Vive bot with the code it says, leaves once Vive is in,
+/// and checks what was said; `addr` is where the partner was told to join.
+fn host_and_hear_a_partner_join(args: &[&str], addr: &str) {
+    use heist_shared::protocol::{Role, TICK_HZ};
+    let (mut child, mut stdin, rx) = headless(args);
     let mut lines: Vec<String> = Vec::new();
     let mut vive: Option<bevy::app::App> = None;
     let deadline = Instant::now() + Duration::from_secs(60);
@@ -240,7 +272,7 @@ fn a_blind_player_hosts_alone_hears_the_code_spelled_and_a_partner_joins_with_it
             // The code as a sighted or screen-reader user reads it off the line, and a partner joins with it.
             if let Some(code) = line.split("with the code ").nth(1).map(|c| c.trim_end_matches('.').to_owned()) {
                 let token =
-                    heist_client::request_token(bind.parse().expect("addr"), &code, Role::Vive, Duration::from_secs(5))
+                    heist_client::request_token(addr.parse().expect("addr"), &code, Role::Vive, Duration::from_secs(5))
                         .expect("the spoken code admits the partner");
                 let mut app = heist_server::demo::stepped_client_app();
                 app.add_plugins(heist_bots::ViveBotPlugin { style: heist_bots::ViveStyle::Idle });
@@ -270,7 +302,7 @@ fn a_blind_player_hosts_alone_hears_the_code_spelled_and_a_partner_joins_with_it
     let at = |l: &str| lines.iter().position(|x| x == l);
     let welcome = lines.iter().position(|l| l.starts_with("Welcome")).expect("welcomed");
     assert!(at(&spelled).is_some_and(|s| s > welcome), "the spelled code comes last, for R: {lines:#?}");
-    assert!(hosted.contains(&bind), "the address to join is said: {hosted}");
+    assert!(hosted.contains(addr), "the address to join is said: {hosted}");
     assert!(!lines.iter().any(|l| l.contains("server is gone")), "leaving on purpose is no lost server: {lines:#?}");
 }
 

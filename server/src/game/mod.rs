@@ -46,6 +46,9 @@ pub struct GameOptions {
     /// hosted session with a random first seed needs, since the host reads the log, where a round's seed
     /// appears when it ends, and a derived seed would tell him the next round's real copies.
     pub random_rounds: bool,
+    /// A lobby nobody ever joined idles out too (a session created on a `serve`d server whose creator
+    /// never came); a `host`'s own session waits for its players for as long as the process runs.
+    pub ends_unjoined: bool,
 }
 
 /// The seed of the round after one played on `seed` (SplitMix64), when rounds are reproducible (a given
@@ -300,6 +303,16 @@ impl Game {
         matches!(self.phase, Phase::Lobby | Phase::Heist)
     }
 
+    /// Whether Vive could perceive guard `i` now: in a clear line within [`rules::VIVE_SIGHT_RANGE`], or
+    /// within earshot of his footsteps ([`rules::GUARD_STEP_LOUDNESS`] along the door path). Only such
+    /// guards are replicated to Vive's client; Phantom's status readout keeps them all.
+    pub fn vive_perceives(&self, i: usize) -> bool {
+        let (Some(guard), me) = (self.guards.get(i), self.vive.position) else { return false };
+        let seen =
+            guard.position.distance(me) <= rules::VIVE_SIGHT_RANGE && self.walls.line_of_sight(me, guard.position);
+        seen || self.nav.heard_margin(guard.position, me, rules::GUARD_STEP_LOUDNESS) > 0.0
+    }
+
     /// Seconds the session has been idle (after a result, or with nobody in it after someone was).
     pub fn idle_s(&self) -> f32 {
         self.idle_s
@@ -383,7 +396,7 @@ impl Game {
             Phase::Lobby => {
                 self.start_if_ready();
                 // A lobby waits for its players; once someone came and everyone left, it idles.
-                let deserted = self.present == (false, false) && self.joined_once;
+                let deserted = self.present == (false, false) && (self.joined_once || self.options.ends_unjoined);
                 self.idle(dt, deserted);
             }
             Phase::Heist => self.step_heist(dt),

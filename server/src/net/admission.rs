@@ -1,5 +1,5 @@
-//! Admitting a client: read role, session and seat ticket from its token, refuse thieves of a taken or
-//! kept seat, and keep a dropped player's seat for them.
+//! Admitting a client: read role, session and seat ticket from its token, find its session, refuse
+//! thieves of a taken or kept seat, and keep a dropped player's seat for them.
 
 use bevy::prelude::*;
 use bevy_replicon::prelude::*;
@@ -12,11 +12,13 @@ use super::limits::MessageLimits;
 use super::seats::Seat;
 use super::transport::GameTransport;
 use super::{Auth, NetSettings};
-use crate::session::{GameState, SessionLog};
+use crate::session::{HostSession, Session, SessionTag};
 
 /// An admitted player's client entity.
 #[derive(Component, Clone, Copy, Debug)]
 pub struct Player {
+    /// Its session's entity.
+    pub session: Entity,
     /// Role from the token.
     pub role: Role,
     /// Refused messages, leaking away at one per second: sustained abuse fills it.
@@ -31,8 +33,8 @@ pub struct Player {
     pub peer: Option<std::net::SocketAddr>,
 }
 
-/// Which client entity plays which role.
-#[derive(Resource, Default, Debug)]
+/// Which client entity plays which role in a session.
+#[derive(Default, Debug)]
 pub struct Roles {
     /// Vive's client.
     pub vive: Option<Entity>,
@@ -49,7 +51,7 @@ impl Roles {
         }
     }
 
-    fn slot(&mut self, role: Role) -> &mut Option<Entity> {
+    pub(super) fn slot(&mut self, role: Role) -> &mut Option<Entity> {
         match role {
             Role::Vive => &mut self.vive,
             Role::Phantom => &mut self.phantom,
@@ -77,11 +79,10 @@ pub(super) fn admit(
     mut commands: Commands,
     ids: Query<&NetworkId>,
     mut players: Query<&mut Player>,
+    mut sessions: Query<(Entity, &mut Session)>,
+    host: Res<HostSession>,
     transport: Option<Res<GameTransport>>,
     settings: Res<NetSettings>,
-    mut roles: ResMut<Roles>,
-    mut game: ResMut<GameState>,
-    mut log: ResMut<SessionLog>,
     mut messages: MessageWriter<ToClients<ServerMsg>>,
     mut disconnects: MessageWriter<DisconnectRequest>,
     time: Res<Time<Real>>,
@@ -92,19 +93,21 @@ pub(super) fn admit(
     let peer_addr = network_id.zip(transport.as_ref()).and_then(|(id, t)| t.client_addr(id));
     let peer = peer_addr.map_or_else(|| "an unknown address".to_owned(), |a| a.to_string());
     let claim = user_data.as_ref().and_then(TokenUserData::decode);
-    let claim = match (&settings.auth, claim) {
-        (Auth::Secure { session, .. }, Some(c)) if c.session == *session => c,
-        (Auth::Insecure, Some(c)) => c,
-        _ => {
-            warn!("refused the connection from {peer}: its token is foreign or missing");
-            log.line(game.0.elapsed_s, "a client with a foreign or missing token was refused".into());
-            refuse_and_disconnect(client, DisconnectReason::BadToken, &mut messages, &mut disconnects);
-            return;
-        }
+    // Secure: the token's session (the endpoint minted it, for an open session). Insecure (LAN
+    // development, one session): the host's, whatever the claim says.
+    let found = match (&settings.auth, &claim) {
+        (Auth::Secure { .. }, Some(c)) => sessions.iter_mut().find(|(_, s)| s.id == c.session && s.closed_at.is_none()),
+        (Auth::Insecure, Some(_)) => host.0.and_then(|h| sessions.get_mut(h).ok()),
+        _ => None,
     };
+    let (Some(claim), Some((session_entity, mut session))) = (claim, found) else {
+        warn!("refused the connection from {peer}: its token is foreign, missing or for a session that is over");
+        refuse_and_disconnect(client, DisconnectReason::BadToken, &mut messages, &mut disconnects);
+        return;
+    };
+    let session = &mut *session;
     let role = claim.role;
-    let seats = &settings.seats;
-    let (ticket, resumed) = match (claim.ticket, seats.get(role)) {
+    let (ticket, resumed) = match (claim.ticket, session.seats.get(role)) {
         (None, Seat::Free) => (SeatTicket::random(), false),
         (Some(t), Seat::Taken(ticket) | Seat::Kept { ticket, .. }) if t == ticket => (ticket, true),
         (claimed, seat) => {
@@ -114,36 +117,45 @@ pub(super) fn admit(
                 (Some(_), _) => DisconnectReason::BadSeat,
             };
             warn!("refused the connection from {peer} as {role}: {reason:?}");
-            log.line(game.0.elapsed_s, format!("a {role} was refused: {reason:?}"));
+            session.log.line(session.game.elapsed_s, format!("a {role} was refused: {reason:?}"));
             refuse_and_disconnect(client, reason, &mut messages, &mut disconnects);
             return;
         }
     };
     // A restarted client may come back before its old connection timed out: the new one replaces it.
-    if let Some(old) = roles.get(role) {
+    if let Some(old) = session.roles.get(role) {
         if let Ok(mut player) = players.get_mut(old) {
             player.expelled = true; // nothing more it says counts
         }
         info!("{role} came back on a new connection: closing the old one");
         refuse_and_disconnect(old, DisconnectReason::Replaced, &mut messages, &mut disconnects);
     }
-    *roles.slot(role) = Some(client);
-    seats.set(role, Seat::Taken(ticket));
+    *session.roles.slot(role) = Some(client);
+    session.seats.set(role, Seat::Taken(ticket));
     let limits = MessageLimits::new(time.elapsed_secs_f64());
     commands.entity(client).insert((
-        Player { role, strikes: 0.0, expelled: false, leaving: false, limits, peer: peer_addr },
+        Player {
+            session: session_entity,
+            role,
+            strikes: 0.0,
+            expelled: false,
+            leaving: false,
+            limits,
+            peer: peer_addr,
+        },
         ClientRole(role),
+        SessionTag(session.id),
     ));
     messages.write(ToClients {
         targets: SendTargets::Single(ClientId::Client(client)),
-        message: ServerMsg::Welcome { role, level: Box::new(game.0.level.clone()), seat: ticket, resumed },
+        message: ServerMsg::Welcome { role, level: Box::new(session.game.level.clone()), seat: ticket, resumed },
     });
     if resumed {
         info!("{role} took the seat back from {peer}");
-        game.0.resume(role);
+        session.game.resume(role);
     } else {
         info!("{role} joined from {peer}");
-        game.0.join(role);
+        session.game.join(role);
     }
 }
 
@@ -154,34 +166,36 @@ pub(super) fn forget(
     players: Query<&Player>,
     ids: Query<&NetworkId>,
     transport: Option<Res<GameTransport>>,
-    settings: Res<NetSettings>,
-    mut roles: ResMut<Roles>,
-    mut game: ResMut<GameState>,
+    mut sessions: Query<&mut Session>,
 ) {
     let Ok(player) = players.get(remove.entity) else { return };
-    if roles.get(player.role) != Some(remove.entity) {
+    let Ok(mut session) = sessions.get_mut(player.session) else { return };
+    let session = &mut *session;
+    if session.roles.get(player.role) != Some(remove.entity) {
         return; // refused, or replaced by its own player's new connection
     }
-    *roles.slot(player.role) = None;
+    *session.roles.slot(player.role) = None;
     // Closing the connection on purpose (a `Leave`, or netcode's goodbye when a client quits without one)
     // is leaving, and an expelled client keeps nothing; only a connection that fell silent is a drop,
     // whose seat is kept.
     let departed = ids.get(remove.entity).ok().zip(transport.as_ref()).and_then(|(id, t)| t.departure(id.get()));
     let dropped = !player.leaving && !player.expelled && departed.is_none();
-    game.0.leave(player.role, dropped);
-    let seat = match settings.seats.get(player.role) {
-        Seat::Taken(ticket) if game.0.is_seat_kept(player.role) => Seat::Kept { ticket, since: Instant::now() },
+    session.game.leave(player.role, dropped);
+    let seat = match session.seats.get(player.role) {
+        Seat::Taken(ticket) if session.game.is_seat_kept(player.role) => Seat::Kept { ticket, since: Instant::now() },
         _ => Seat::Free,
     };
-    settings.seats.set(player.role, seat);
+    session.seats.set(player.role, seat);
 }
 
 /// Frees a kept seat once the game gave it up (its player did not come back in time).
-pub(super) fn give_up_seats(settings: Res<NetSettings>, roles: Res<Roles>, game: Res<GameState>) {
-    for role in [Role::Vive, Role::Phantom] {
-        let kept = matches!(settings.seats.get(role), Seat::Kept { .. });
-        if kept && roles.get(role).is_none() && !game.0.is_seat_kept(role) {
-            settings.seats.set(role, Seat::Free);
+pub(super) fn give_up_seats(sessions: Query<&Session>) {
+    for session in &sessions {
+        for role in [Role::Vive, Role::Phantom] {
+            let kept = matches!(session.seats.get(role), Seat::Kept { .. });
+            if kept && session.roles.get(role).is_none() && !session.game.is_seat_kept(role) {
+                session.seats.set(role, Seat::Free);
+            }
         }
     }
 }

@@ -7,6 +7,7 @@
 mod admission;
 pub mod limits;
 pub mod receive;
+pub mod registry;
 pub mod seats;
 pub mod send;
 pub mod tokens;
@@ -24,7 +25,10 @@ use heist_transport::IntakeLimits;
 use heist_transport::renetcode::{ServerAuthentication, ServerConfig};
 
 pub use admission::{Player, Roles};
-use seats::Seats;
+use registry::{Registry, SessionEntry};
+
+use crate::game::{Game, GameOptions};
+use crate::session::{HostSession, LogEcho, Session, SessionLog};
 
 /// How clients prove who they are.
 #[derive(Clone)]
@@ -33,8 +37,6 @@ pub enum Auth {
     Secure {
         /// Netcode private key.
         private_key: [u8; 32],
-        /// Session id the tokens must carry.
-        session: u64,
     },
     /// Any client may claim any role: LAN development only.
     Insecure,
@@ -45,17 +47,58 @@ pub enum Auth {
 pub struct NetSettings {
     /// Authentication mode.
     pub auth: Auth,
-    /// The session's seats, shared with the token endpoint.
-    pub seats: Seats,
+    /// The sessions, shared with the token endpoint.
+    pub registry: Registry,
     /// Refused messages (leaking one per second) tolerated per client before it is disconnected for abuse.
     pub abuse_limit: u32,
     /// The address put in tokens and checked in connection requests, when not the bound one.
     pub advertise: Option<std::net::SocketAddr>,
+    /// What every session created on request plays: the level, and options whose seed is replaced by a
+    /// fresh random one.
+    pub new_sessions: NewSessions,
+    /// End the app once the host's session is over (`host`); a `serve`d server runs on.
+    pub exit_with_host: bool,
+}
+
+/// What a session created on request plays.
+#[derive(Clone)]
+pub struct NewSessions {
+    /// The level.
+    pub level: heist_shared::level::Level,
+    /// Options (time limit, idle end); each session draws its own seeds.
+    pub game: GameOptions,
+    /// Where its log goes.
+    pub echo: LogEcho,
+}
+
+impl NewSessions {
+    /// A session for `entry`: a fresh random seed (and random later rounds), unless `game` is given.
+    pub fn session(&self, entry: &SessionEntry, game: Option<&GameOptions>) -> Session {
+        let options = game.cloned().unwrap_or_else(|| GameOptions {
+            seed: rand::random(),
+            random_rounds: true,
+            ends_unjoined: true,
+            ..self.game.clone()
+        });
+        Session {
+            id: entry.id,
+            game: Game::new(self.level.clone(), &options),
+            log: SessionLog {
+                echo: self.echo,
+                id: format!("{:08x}", rand::random::<u32>()),
+                round: 1,
+                ..Default::default()
+            },
+            roles: Roles::default(),
+            seats: entry.seats.clone(),
+            closed_at: None,
+        }
+    }
 }
 
 /// The bound game socket, waiting for the transport to be created at start-up.
 #[derive(Resource)]
-struct PendingSocket(Option<UdpSocket>);
+struct PendingSocket(Option<UdpSocket>, IntakeLimits);
 
 /// The server's public game address.
 #[derive(Resource, Clone, Copy, Debug)]
@@ -76,6 +119,8 @@ pub struct ServerNetPlugin {
     pub socket: std::sync::Mutex<Option<UdpSocket>>,
     /// Settings.
     pub settings: NetSettings,
+    /// The game socket's limits.
+    pub intake: IntakeLimits,
 }
 
 impl Plugin for ServerNetPlugin {
@@ -84,10 +129,10 @@ impl Plugin for ServerNetPlugin {
         if let Some(addr) = socket.as_ref().and_then(|s| s.local_addr().ok()) {
             app.insert_resource(ServerAddr(addr));
         }
-        app.insert_resource(PendingSocket(socket))
+        app.insert_resource(PendingSocket(socket, self.intake))
             .insert_resource(self.settings.clone())
-            .init_resource::<Roles>()
             .add_systems(Startup, start_transport)
+            .add_systems(First, open_sessions)
             .add_observer(admission::admit)
             .add_observer(admission::forget)
             .add_observer(log_disconnect)
@@ -96,7 +141,7 @@ impl Plugin for ServerNetPlugin {
             .add_systems(PreUpdate, receive::apply_client_messages.in_set(NetSystems::Receive))
             .add_systems(
                 PostUpdate,
-                (send::send_outgoing, admission::give_up_seats, close_session).chain().in_set(NetSystems::Send),
+                (send::send_outgoing, admission::give_up_seats, close_sessions).chain().in_set(NetSystems::Send),
             );
         transport::add_systems(app);
     }
@@ -122,13 +167,13 @@ fn start_transport(
     };
     let config = ServerConfig {
         current_time: SystemTime::now().duration_since(UNIX_EPOCH).unwrap_or_default(),
-        // Room for a third client, so it can be told why it is refused.
-        max_clients: 4,
+        // Two players a session, and room for a few more, so they can be told why they are refused.
+        max_clients: (settings.registry.max() * 2 + 16).min(MAX_CLIENTS),
         protocol_id: PROTOCOL_ID,
         public_addresses: vec![settings.advertise.unwrap_or(addr)],
         authentication,
     };
-    match transport::GameTransport::new(socket, config, IntakeLimits::default()) {
+    match transport::GameTransport::new(socket, config, pending.1) {
         Ok(transport) => {
             commands.insert_resource(RenetServer::new(heist_client::connection_config(&channels)));
             commands.insert_resource(transport);
@@ -137,49 +182,72 @@ fn start_transport(
     }
 }
 
-/// Seconds between telling the players a session is over and the process exiting (so the message goes).
+/// Netcode's most clients on one server.
+pub const MAX_CLIENTS: usize = 1024;
+/// The most sessions one server may host (two players each, within [`MAX_CLIENTS`]).
+pub const MAX_SESSIONS: usize = 500;
+
+/// Spawns the game of every session the token endpoint opened.
+fn open_sessions(mut commands: Commands, settings: Res<NetSettings>) {
+    for entry in settings.registry.take_opened() {
+        let mut session = settings.new_sessions.session(&entry, None);
+        session.log.record(0.0, crate::session::Record::SessionCreated, "session created; waiting for players".into());
+        crate::session::spawn_session(&mut commands, session);
+    }
+}
+
+/// Seconds between telling the players a session is over and freeing it (so the message goes).
 const CLOSE_LINGER_S: f64 = 1.0;
 
-/// Once the game is closed (idle after a result, or deserted): tells each player why, lets them go, and a
-/// second later ends the app (`host` then exits 0).
+/// Once a game is closed (idle after a result, or deserted): closes its session in the registry (its code
+/// and seats stop working), tells each player why and lets them go, and a second later despawns it with
+/// its mirrors. With `exit_with_host`, the end of the host's session ends the app (`host` then exits 0).
 #[allow(clippy::too_many_arguments)]
-fn close_session(
-    game: Res<crate::session::GameState>,
-    roles: Res<Roles>,
-    mut log: ResMut<crate::session::SessionLog>,
+fn close_sessions(
+    mut commands: Commands,
+    mut sessions: Query<(Entity, &mut Session)>,
+    settings: Res<NetSettings>,
+    host: Res<HostSession>,
     mut messages: MessageWriter<ToClients<heist_shared::protocol::ServerMsg>>,
     mut disconnects: MessageWriter<DisconnectRequest>,
     mut exit: MessageWriter<AppExit>,
     time: Res<Time<Real>>,
-    mut closed_at: Local<Option<f64>>,
 ) {
-    if !game.0.closed {
-        return;
-    }
     let now = time.elapsed_secs_f64();
-    match *closed_at {
-        None => {
-            *closed_at = Some(now);
-            let why = if game.0.present == (false, false) {
-                "nobody is left in it"
-            } else {
-                "nobody asked for another round"
-            };
-            info!("the session is over: {why}");
-            log.record(game.0.elapsed_s, crate::session::Record::SessionEnded, format!("session ended: {why}"));
-            for client in [roles.vive, roles.phantom].into_iter().flatten() {
-                admission::refuse_and_disconnect(
-                    client,
-                    heist_shared::protocol::DisconnectReason::SessionEnded,
-                    &mut messages,
-                    &mut disconnects,
-                );
+    for (entity, mut session) in &mut sessions {
+        if !session.game.closed {
+            continue;
+        }
+        match session.closed_at {
+            None => {
+                session.closed_at = Some(now);
+                let why = if session.game.present == (false, false) {
+                    "nobody is left in it"
+                } else {
+                    "nobody asked for another round"
+                };
+                info!("session {} is over: {why}", session.log.id);
+                settings.registry.close(session.id);
+                let t = session.game.elapsed_s;
+                session.log.record(t, crate::session::Record::SessionEnded, format!("session ended: {why}"));
+                for client in [session.roles.vive, session.roles.phantom].into_iter().flatten() {
+                    admission::refuse_and_disconnect(
+                        client,
+                        heist_shared::protocol::DisconnectReason::SessionEnded,
+                        &mut messages,
+                        &mut disconnects,
+                    );
+                }
             }
+            Some(at) if now - at >= CLOSE_LINGER_S => {
+                if host.0 == Some(entity) && settings.exit_with_host {
+                    exit.write(AppExit::Success);
+                } else if host.0 != Some(entity) {
+                    commands.entity(entity).despawn();
+                }
+            }
+            Some(_) => {}
         }
-        Some(at) if now - at >= CLOSE_LINGER_S => {
-            exit.write(AppExit::Success);
-        }
-        Some(_) => {}
     }
 }
 
@@ -222,6 +290,11 @@ fn route_address(bound: SocketAddr) -> Option<std::net::IpAddr> {
     socket.connect(probe).ok()?;
     let ip = socket.local_addr().ok()?.ip();
     (!ip.is_unspecified() && !ip.is_loopback()).then_some(ip)
+}
+
+/// How many clients are admitted as players, in every session.
+pub fn admission_count(world: &mut World) -> usize {
+    world.query::<&Player>().iter(world).count()
 }
 
 /// The role a connected client entity plays, if admitted.

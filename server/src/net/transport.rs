@@ -20,13 +20,37 @@ pub struct GameTransport {
     socket: UdpSocket,
     intake: ServerIntake,
     buffer: Box<[u8; socket::BUFFER_BYTES]>,
+    bytes: Traffic,
+}
+
+/// Bytes through the game socket so far (UDP payloads: everything netcode and renet add included).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Traffic {
+    /// Received (every datagram read, refused ones included).
+    pub received: u64,
+    /// Sent.
+    pub sent: u64,
+}
+
+/// `send_to` that also counts what it sends.
+fn counted<'a>(socket: &'a UdpSocket, sent: &'a mut u64) -> impl FnMut(SocketAddr, &[u8]) + 'a {
+    let mut send = send_to(socket);
+    move |to, bytes| {
+        *sent += bytes.len() as u64;
+        send(to, bytes);
+    }
 }
 
 impl GameTransport {
     /// Serves `socket` (made non-blocking) with a netcode server made from `config`.
     pub fn new(socket: UdpSocket, config: ServerConfig, limits: IntakeLimits) -> std::io::Result<Self> {
         socket.set_nonblocking(true)?;
-        Ok(Self { socket, intake: ServerIntake::new(config, limits), buffer: Box::new([0; socket::BUFFER_BYTES]) })
+        Ok(Self {
+            socket,
+            intake: ServerIntake::new(config, limits),
+            buffer: Box::new([0; socket::BUFFER_BYTES]),
+            bytes: Traffic::default(),
+        })
     }
 
     /// The user data in a connected client's token.
@@ -42,6 +66,11 @@ impl GameTransport {
     /// How a client that just went left, unless it fell silent (see [`ServerIntake::departure`]).
     pub fn departure(&self, client_id: u64) -> Option<heist_transport::Departure> {
         self.intake.departure(client_id)
+    }
+
+    /// Bytes through the socket so far.
+    pub fn traffic(&self) -> Traffic {
+        self.bytes
     }
 
     /// What the intake passed and refused so far.
@@ -72,10 +101,12 @@ pub(super) fn add_systems(app: &mut App) {
 }
 
 fn receive(mut transport: ResMut<GameTransport>, mut renet: ResMut<RenetServer>, time: Res<Time<Real>>) {
-    let GameTransport { socket, intake, buffer } = &mut *transport;
+    let GameTransport { socket, intake, buffer, bytes } = &mut *transport;
     intake.advance(time.delta());
-    let mut send = send_to(socket);
+    let mut received = 0;
+    let mut send = counted(socket, &mut bytes.sent);
     let drained = socket::drain(socket, buffer, MAX_DATAGRAMS_PER_FRAME, |from, datagram| {
+        received += datagram.len() as u64;
         // Refusals are counted and logged (throttled) by the intake.
         let _ = intake.receive(from, datagram, &mut renet, &mut send);
     });
@@ -83,11 +114,12 @@ fn receive(mut transport: ResMut<GameTransport>, mut renet: ResMut<RenetServer>,
         error!("the game socket failed: {e}");
     }
     intake.update(&mut renet, &mut send);
+    bytes.received += received;
 }
 
 fn send(mut transport: ResMut<GameTransport>, mut renet: ResMut<RenetServer>) {
-    let GameTransport { socket, intake, .. } = &mut *transport;
-    intake.send_packets(&mut renet, &mut send_to(socket));
+    let GameTransport { socket, intake, bytes, .. } = &mut *transport;
+    intake.send_packets(&mut renet, &mut counted(socket, &mut bytes.sent));
 }
 
 fn disconnect_on_exit(

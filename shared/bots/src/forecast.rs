@@ -66,6 +66,25 @@ impl Forecast {
         Self { futures, alarm: f32::from(alarm) }
     }
 
+    /// Where a guard last seen as `last`, `ago_s` seconds ago, is likely now (what a player who lost
+    /// sight of it would guess): walked on along its route if it was patrolling; where it was if it was
+    /// alerted, for `alert_memory_s`, and after that back on its patrol from there.
+    pub fn imagine(level: &Level, last: &GuardView, alarm: u8, ago_s: f32, alert_memory_s: f32) -> GuardView {
+        if last.alert != GuardAlert::Patrolling && ago_s < alert_memory_s {
+            return last.clone();
+        }
+        let calm = GuardView { alert: GuardAlert::Patrolling, ..last.clone() };
+        let ago_s = if last.alert == GuardAlert::Patrolling { ago_s } else { ago_s - alert_memory_s };
+        let forecast = Self::new(level, &[&calm], alarm, last.position);
+        match forecast.futures.first() {
+            Some(Future::Patrol(..)) => {
+                let (position, facing) = forecast.pose(0, ago_s);
+                GuardView { position, facing: facing.unwrap_or(last.facing), ..calm }
+            }
+            _ => calm,
+        }
+    }
+
     /// Pose (position, facing) of guard `i` after `t` seconds.
     fn pose(&self, i: usize, t: f32) -> (Vec2, Option<f32>) {
         match &self.futures[i] {

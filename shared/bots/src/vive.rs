@@ -55,9 +55,16 @@ pub struct ViveBrain {
     level: Option<heist_shared::level::Level>,
     /// When the refuge was last chosen.
     refuge_at: f32,
+    /// Each guard as last seen and when (the server sends only guards Vive could perceive): one out of
+    /// sight is imagined where it has likely walked since.
+    remembered: Vec<(GuardView, f32)>,
     /// Actions taken, for tests and logs.
     pub actions: Vec<String>,
 }
+
+/// Seconds an alerted guard out of sight is imagined where it was last seen; after that it is
+/// imagined back on its patrol.
+const ALERT_MEMORY_S: f32 = 8.0;
 
 /// Plays Vive with a given style.
 pub struct ViveBotPlugin {
@@ -149,10 +156,25 @@ impl ViveBrain {
         if session.phase != Phase::Heist || self.style == ViveStyle::Idle || self.map.is_none() {
             return turn;
         }
+        // Guards out of perception are imagined where they have likely walked since.
+        let now = self.clock_s;
+        for g in &sight.guards {
+            self.remembered.retain(|(r, _)| r.id != g.id);
+            self.remembered.push(((*g).clone(), now));
+        }
+        let imagined: Vec<GuardView> = match &self.level {
+            Some(level) => self
+                .remembered
+                .iter()
+                .filter(|(r, _)| !sight.guards.iter().any(|g| g.id == r.id))
+                .map(|(r, at)| crate::forecast::Forecast::imagine(level, r, session.alarm, now - at, ALERT_MEMORY_S))
+                .collect(),
+            None => Vec::new(),
+        };
         let view = View {
             me,
             alarm: session.alarm,
-            guards: sight.guards.clone(),
+            guards: sight.guards.iter().copied().chain(imagined.iter()).collect(),
             cases: sight.cases.clone(),
             items: sight.items.clone(),
             secured: session.targets.iter().filter(|t| t.1).map(|t| t.0).collect(),

@@ -16,6 +16,9 @@ pub enum JoinError {
     /// The endpoint refused (wrong code, role taken...).
     #[error("the host refused to let us join: {0}")]
     Refused(heist_shared::protocol::join::JoinRefusal),
+    /// The join code cannot be one (before anything is sent).
+    #[error("{0}")]
+    BadCode(String),
     /// The endpoint's answer was not understood.
     #[error("the token endpoint sent something we do not understand: {0}")]
     BadResponse(String),

@@ -14,9 +14,10 @@ mod token;
 pub mod transport;
 
 pub use error::JoinError;
+pub use heist_transport::renetcode::ConnectToken;
 pub use rejoin::{Reconnect, Rejoin};
 pub use seats::{Joining, SeatCache, SeatKeeper, hold_seat, join_or_resume};
-pub use token::{request_resume_token, request_token};
+pub use token::{create_session, request_resume_token, request_token};
 
 use std::time::{SystemTime, UNIX_EPOCH};
 
@@ -27,7 +28,7 @@ use bevy_replicon_renet::renet::ConnectionConfig;
 use heist_shared::artifact::Briefing;
 use heist_shared::level::Level;
 use heist_shared::protocol::{DisconnectReason, GameEvent, Refusal, Role, SeatTicket, ServerMsg, WorkbenchCopy};
-use heist_transport::renetcode::{ClientAuthentication, ConnectToken};
+use heist_transport::renetcode::ClientAuthentication;
 
 /// What the server has told this client, kept for the app's systems to read.
 #[derive(Resource, Default, Debug)]

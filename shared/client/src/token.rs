@@ -6,7 +6,7 @@ use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpStream};
 use std::time::Duration;
 
-use heist_shared::protocol::join::{self, JOIN_VERSION, JoinMsg, JoinReply, MAX_FRAME, Pake};
+use heist_shared::protocol::join::{self, JOIN_VERSION, JoinMsg, JoinReply, MAX_FRAME, NewSession, Pake};
 use heist_shared::protocol::{PROTOCOL_ID, Role, SeatTicket};
 use heist_transport::renetcode::ConnectToken;
 
@@ -19,8 +19,24 @@ pub fn request_token(
     role: Role,
     timeout: Duration,
 ) -> Result<ConnectToken, JoinError> {
+    let room = join::room_of(code).map_err(JoinError::BadCode)?;
     let (pake, ours) = Pake::client(code);
-    exchange(endpoint, JoinMsg::Hello { version: JOIN_VERSION, role, pake: ours }, pake, timeout)
+    let sealed = exchange(endpoint, JoinMsg::Hello { version: JOIN_VERSION, room, role, pake: ours }, pake, timeout)?;
+    open_token(&sealed)
+}
+
+/// Asks the server at `endpoint` to create a new session in which this client plays `role`; returns the
+/// session's join code (for the partner) and this client's connect token.
+pub fn create_session(
+    endpoint: SocketAddr,
+    role: Role,
+    timeout: Duration,
+) -> Result<(String, ConnectToken), JoinError> {
+    let (pake, ours) = Pake::client_create();
+    let plain = exchange(endpoint, JoinMsg::Create { version: JOIN_VERSION, role, pake: ours }, pake, timeout)?;
+    let created: NewSession = join::decode(&plain).map_err(JoinError::BadResponse)?;
+    join::room_of(&created.code).map_err(|e| JoinError::BadResponse(format!("the new session's code: {e}")))?;
+    Ok((created.code, open_token(&created.token)?))
 }
 
 /// Exchanges a seat ticket for a connect token that takes the kept (or still taken) `role` seat back at
@@ -32,10 +48,13 @@ pub fn request_resume_token(
     timeout: Duration,
 ) -> Result<ConnectToken, JoinError> {
     let (pake, ours) = Pake::client_ticket(ticket);
-    exchange(endpoint, JoinMsg::Resume { version: JOIN_VERSION, role, pake: ours }, pake, timeout)
+    let seat = ticket.public_id();
+    let sealed = exchange(endpoint, JoinMsg::Resume { version: JOIN_VERSION, role, seat, pake: ours }, pake, timeout)?;
+    open_token(&sealed)
 }
 
-fn exchange(endpoint: SocketAddr, opening: JoinMsg, pake: Pake, timeout: Duration) -> Result<ConnectToken, JoinError> {
+/// Runs the exchange opened by `opening`; returns the plain text of the server's sealed last reply.
+fn exchange(endpoint: SocketAddr, opening: JoinMsg, pake: Pake, timeout: Duration) -> Result<Vec<u8>, JoinError> {
     let unreachable = |cause| JoinError::Unreachable { addr: endpoint, cause };
     let mut stream = TcpStream::connect_timeout(&endpoint, timeout).map_err(unreachable)?;
     stream.set_read_timeout(Some(timeout)).map_err(unreachable)?;
@@ -47,18 +66,28 @@ fn exchange(endpoint: SocketAddr, opening: JoinMsg, pake: Pake, timeout: Duratio
     let theirs = match decode(&challenge)? {
         JoinReply::Challenge { pake } => pake,
         JoinReply::Refused(r) => return Err(JoinError::Refused(r)),
-        JoinReply::Token { .. } => return Err(JoinError::BadResponse("a token before the key exchange".into())),
+        JoinReply::Token { .. } | JoinReply::Created { .. } => {
+            return Err(JoinError::BadResponse("a token before the key exchange".into()));
+        }
     };
     let keys = pake.finish(&theirs, &hello[2..], &challenge).map_err(JoinError::BadResponse)?;
     stream.write_all(&join::frame(&JoinMsg::Confirm { mac: *keys.client_mac.as_bytes() })).map_err(unreachable)?;
+    let creating = matches!(opening, JoinMsg::Create { .. });
     let sealed = match decode(&read_frame(&mut stream).map_err(unreachable)?)? {
-        JoinReply::Token { sealed } => sealed,
+        JoinReply::Token { sealed } if !creating => sealed,
+        JoinReply::Created { sealed } if creating => sealed,
+        JoinReply::Token { .. } | JoinReply::Created { .. } => {
+            return Err(JoinError::BadResponse("an answer to another request".into()));
+        }
         JoinReply::Refused(r) => return Err(JoinError::Refused(r)),
         JoinReply::Challenge { .. } => return Err(JoinError::BadResponse("a second challenge".into())),
     };
-    let bytes = keys.open(&sealed).ok_or_else(|| JoinError::BadResponse("the token was not sealed for us".into()))?;
-    let token =
-        ConnectToken::read(&mut bytes.as_slice()).map_err(|e| JoinError::BadResponse(format!("bad token: {e}")))?;
+    keys.open(&sealed).ok_or_else(|| JoinError::BadResponse("the answer was not sealed for us".into()))
+}
+
+/// Reads and checks a connect token in netcode's wire format.
+fn open_token(bytes: &[u8]) -> Result<ConnectToken, JoinError> {
+    let token = ConnectToken::read(&mut &bytes[..]).map_err(|e| JoinError::BadResponse(format!("bad token: {e}")))?;
     check(&token)?;
     Ok(token)
 }

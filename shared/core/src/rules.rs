@@ -50,3 +50,8 @@ pub fn move_body(
 ) -> glam::Vec2 {
     walls.slide(from, direction * speed * dt, BODY_RADIUS)
 }
+/// Farthest Vive sees a guard in a clear line (he turns his head at will, so in every direction),
+/// metres: generous, so a guard never pops into view in the middle of a gallery.
+pub const VIVE_SIGHT_RANGE: f32 = 30.0;
+/// Audible radius of a guard's footsteps for Vive, metres, along the door path (closed doors muffle).
+pub const GUARD_STEP_LOUDNESS: f32 = 15.0;

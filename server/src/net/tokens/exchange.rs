@@ -4,13 +4,14 @@ use std::net::SocketAddr;
 use std::sync::Arc;
 use std::time::{SystemTime, UNIX_EPOCH};
 
-use heist_shared::protocol::join::{self, JOIN_VERSION, JoinMsg, JoinRefusal, JoinReply, Pake};
+use heist_shared::protocol::join::{self, JOIN_VERSION, JoinMsg, JoinRefusal, JoinReply, NewSession, Pake};
 use heist_shared::protocol::{PROTOCOL_ID, Role, SeatTicket, TokenUserData};
 use heist_transport::limit::address_key;
 use heist_transport::renetcode::ConnectToken;
 use tokio::io::{AsyncReadExt, AsyncWriteExt};
 use tokio::net::TcpStream;
 
+use super::super::registry::SessionEntry;
 use super::guesses::Outcome;
 use super::{Closer, Shared, TokenConfig, lock};
 
@@ -103,12 +104,23 @@ fn decode(body: &[u8]) -> Result<JoinMsg, Failure> {
     join::decode(body).map_err(|e| Failure::Refused(JoinRefusal::BadRequest(e)))
 }
 
-/// The exchange itself: hello (or resume), challenge, confirmation, token.
+/// What the opening asked for, once its session is found.
+enum Request {
+    /// A seat in an open session, with its code.
+    Join(SessionEntry),
+    /// A kept (or still taken) seat back, with its ticket.
+    Resume(SessionEntry, SeatTicket),
+    /// A new session.
+    Create,
+}
+
+/// The exchange itself: hello (or resume, or create), challenge, confirmation, token.
 async fn exchange(stream: &mut TcpStream, peer: SocketAddr, shared: &Shared) -> Result<Role, Failure> {
     let hello = read_frame(stream).await?;
-    let (version, role, pake, resume) = match decode(&hello)? {
-        JoinMsg::Hello { version, role, pake } => (version, role, pake, false),
-        JoinMsg::Resume { version, role, pake } => (version, role, pake, true),
+    let opening = decode(&hello)?;
+    let (version, role) = match &opening {
+        JoinMsg::Hello { version, role, .. } | JoinMsg::Resume { version, role, .. } => (*version, *role),
+        JoinMsg::Create { version, role, .. } => (*version, *role),
         JoinMsg::Confirm { .. } => {
             return Err(Failure::Refused(JoinRefusal::BadRequest("the exchange starts with a hello".into())));
         }
@@ -116,23 +128,40 @@ async fn exchange(stream: &mut TcpStream, peer: SocketAddr, shared: &Shared) -> 
     if version != JOIN_VERSION {
         return Err(Failure::Refused(JoinRefusal::Version { server: JOIN_VERSION, client: version }));
     }
-    // A resume is keyed by the seat's ticket, and works after the code expired or was rotated.
-    let (server, ours, ticket) = if resume {
-        let ticket = shared.config.seats.ticket_to_resume(role).map_err(Failure::Refused)?;
-        let (server, ours) = Pake::server_ticket(&ticket);
-        (server, ours, Some(ticket))
-    } else {
-        let code = shared.config.codes.current();
-        if code.is_expired() {
-            log::warn!(
-                "token endpoint: {peer} tried to join but the join code has expired (type `rotate` for a new one)"
-            );
-            return Err(Failure::Refused(JoinRefusal::CodeExpired));
+    let registry = &shared.config.registry;
+    let (request, theirs, server, ours, attempt) = match opening {
+        JoinMsg::Hello { room, pake, .. } => {
+            let attempt = Attempt::begin(shared, peer)?;
+            let Some(entry) = registry.by_room(&room) else {
+                // No such session: as wrong as a wrong code, and counted like one (rooms are not probed
+                // for free).
+                let delay = attempt.end(Outcome::Wrong);
+                tokio::time::sleep(std::time::Duration::from_secs_f64(delay)).await;
+                return Err(Failure::Refused(JoinRefusal::WrongCode));
+            };
+            let code = entry.codes.current();
+            if code.is_expired() {
+                log::warn!(
+                    "token endpoint: {peer} tried to join but the join code has expired (type `rotate` for a new one)"
+                );
+                return Err(Failure::Refused(JoinRefusal::CodeExpired));
+            }
+            let (server, ours) = Pake::server(&code.code);
+            (Request::Join(entry), pake, server, ours, Some(attempt))
         }
-        let (server, ours) = Pake::server(&code.code);
-        (server, ours, None)
+        // A resume is keyed by the seat's ticket, and works after the code expired or was rotated.
+        JoinMsg::Resume { seat, pake, .. } => {
+            let (entry, ticket) = registry.by_seat(role, &seat).map_err(Failure::Refused)?;
+            let attempt = Attempt::begin(shared, peer)?;
+            let (server, ours) = Pake::server_ticket(&ticket);
+            (Request::Resume(entry, ticket), pake, server, ours, Some(attempt))
+        }
+        JoinMsg::Create { pake, .. } => {
+            let (server, ours) = Pake::server_create();
+            (Request::Create, pake, server, ours, None)
+        }
+        JoinMsg::Confirm { .. } => unreachable!("refused above"),
     };
-    let attempt = Attempt::begin(shared, peer)?;
     let challenge = join::frame(&JoinReply::Challenge { pake: ours });
     stream.write_all(&challenge).await?;
     let confirm = read_frame(stream).await?;
@@ -140,28 +169,51 @@ async fn exchange(stream: &mut TcpStream, peer: SocketAddr, shared: &Shared) -> 
         return Err(Failure::Refused(JoinRefusal::BadRequest("expected the confirmation".into())));
     };
     let keys =
-        server.finish(&pake, &hello, &challenge[2..]).map_err(|e| Failure::Refused(JoinRefusal::BadRequest(e)))?;
+        server.finish(&theirs, &hello, &challenge[2..]).map_err(|e| Failure::Refused(JoinRefusal::BadRequest(e)))?;
     if keys.client_mac != blake3::Hash::from(mac) {
-        let delay = attempt.end(Outcome::Wrong);
-        tokio::time::sleep(std::time::Duration::from_secs_f64(delay)).await;
-        let wrong = if resume { JoinRefusal::WrongTicket } else { JoinRefusal::WrongCode };
+        let wrong = match request {
+            Request::Join(_) => JoinRefusal::WrongCode,
+            Request::Resume(..) => JoinRefusal::WrongTicket,
+            Request::Create => JoinRefusal::BadRequest("the key exchange did not agree".into()),
+        };
+        if let Some(attempt) = attempt {
+            let delay = attempt.end(Outcome::Wrong);
+            tokio::time::sleep(std::time::Duration::from_secs_f64(delay)).await;
+        }
         return Err(Failure::Refused(wrong));
     }
-    attempt.end(Outcome::Right);
-    if !resume {
-        shared.config.seats.check_join(role).map_err(Failure::Refused)?;
+    if let Some(attempt) = attempt {
+        attempt.end(Outcome::Right);
     }
-    let token = mint(&shared.config, role, ticket).map_err(|e| Failure::Refused(JoinRefusal::Internal(e)))?;
-    let sealed = keys.seal(&token).map_err(|e| Failure::Refused(JoinRefusal::Internal(e)))?;
-    stream.write_all(&join::frame(&JoinReply::Token { sealed })).await?;
+    let internal = |e| Failure::Refused(JoinRefusal::Internal(e));
+    let reply = match request {
+        Request::Join(entry) => {
+            entry.seats.check_join(role).map_err(Failure::Refused)?;
+            let token = mint(&shared.config, entry.id, role, None).map_err(internal)?;
+            JoinReply::Token { sealed: keys.seal(&token).map_err(internal)? }
+        }
+        Request::Resume(entry, ticket) => {
+            let token = mint(&shared.config, entry.id, role, Some(ticket)).map_err(internal)?;
+            JoinReply::Token { sealed: keys.seal(&token).map_err(internal)? }
+        }
+        Request::Create => {
+            let entry = registry.open(Some(peer.ip())).map_err(Failure::Refused)?;
+            log::info!("token endpoint: {peer} created a session ({} open)", registry.len());
+            let token = mint(&shared.config, entry.id, role, None).map_err(internal)?;
+            let created = postcard::to_allocvec(&NewSession { code: entry.codes.current().code, token })
+                .map_err(|e| internal(format!("cannot encode the new session: {e}")))?;
+            JoinReply::Created { sealed: keys.seal(&created).map_err(internal)? }
+        }
+    };
+    stream.write_all(&join::frame(&reply)).await?;
     Ok(role)
 }
 
 /// A connect token for `role` in netcode's wire format.
 /// A resume's token carries the seat ticket it proved, for admission to check again.
-fn mint(config: &TokenConfig, role: Role, ticket: Option<SeatTicket>) -> Result<Vec<u8>, String> {
+fn mint(config: &TokenConfig, session: u64, role: Role, ticket: Option<SeatTicket>) -> Result<Vec<u8>, String> {
     let now = SystemTime::now().duration_since(UNIX_EPOCH).unwrap_or_default();
-    let user_data = TokenUserData { role, session: config.session, ticket }.encode();
+    let user_data = TokenUserData { role, session, ticket }.encode();
     let token = ConnectToken::generate(
         now,
         PROTOCOL_ID,

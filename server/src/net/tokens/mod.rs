@@ -1,4 +1,5 @@
-//! The token endpoint: a player who knows the join code gets a netcode connect token for their role.
+//! The token endpoint: a player who knows a session's join code gets a netcode connect token for their
+//! role in it; a player may also create a new session (within the server's limits) and gets its code.
 //!
 //! TCP, on the game's port. Each connection runs the join exchange of [`heist_shared::protocol::join`]
 //! (SPAKE2 keyed by the code: neither the code nor the token crosses the wire in clear) as its own task
@@ -19,14 +20,14 @@ use std::time::{Duration, Instant, SystemTime};
 use heist_transport::limit::address_key;
 use heist_transport::throttle::RefusalLog;
 
-use super::seats::Seats;
+use super::registry::{CreateLimits, Registry};
 use connections::Connections;
 use guesses::{GuessLimits, Guesses};
 
 /// A join code and when it stops working.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct JoinCode {
-    /// The code, like `K7QX-2M4P`.
+    /// The code, like `K7QX-2M4P-R9TC`.
     pub code: String,
     /// When it expires (wall clock).
     pub expires_at: SystemTime,
@@ -38,7 +39,7 @@ impl JoinCode {
         SystemTime::now() >= self.expires_at
     }
 
-    /// "K7QX-2M4P (expires 09:54:26 UTC, in 30 min)", for the host's terminal.
+    /// "K7QX-2M4P-R9TC (expires 09:54:26 UTC, in 30 min)", for the host's terminal.
     pub fn describe(&self) -> String {
         let left = self.expires_at.duration_since(SystemTime::now()).unwrap_or_default();
         let at = self.expires_at.duration_since(SystemTime::UNIX_EPOCH).unwrap_or_default().as_secs() % 86_400;
@@ -53,21 +54,23 @@ impl JoinCode {
     }
 }
 
-/// The current join code, shared by the endpoint and the host, who can replace it.
+/// A session's current join code, shared by the endpoint and the host, who can replace it. Every code
+/// of the book starts with the session's room.
 #[derive(Clone, Debug)]
 pub struct CodeBook {
     current: Arc<Mutex<JoinCode>>,
+    room: String,
     ttl: Duration,
 }
 
 impl CodeBook {
-    /// A fresh code valid for `ttl`.
-    pub fn new(ttl: Duration) -> Self {
-        Self { current: Arc::new(Mutex::new(Self::fresh(ttl))), ttl }
+    /// A fresh code in `room` valid for `ttl`.
+    pub fn new(room: &str, ttl: Duration) -> Self {
+        Self { current: Arc::new(Mutex::new(Self::fresh(room, ttl))), room: room.to_owned(), ttl }
     }
 
-    fn fresh(ttl: Duration) -> JoinCode {
-        JoinCode { code: new_join_code(), expires_at: SystemTime::now() + ttl }
+    fn fresh(room: &str, ttl: Duration) -> JoinCode {
+        JoinCode { code: format!("{room}-{}", new_secret()), expires_at: SystemTime::now() + ttl }
     }
 
     fn lock(&self) -> MutexGuard<'_, JoinCode> {
@@ -81,7 +84,7 @@ impl CodeBook {
 
     /// Replaces the code with a fresh one (the old one stops working at once).
     pub fn rotate(&self) -> JoinCode {
-        let fresh = Self::fresh(self.ttl);
+        let fresh = Self::fresh(&self.room, self.ttl);
         *self.lock() = fresh.clone();
         fresh
     }
@@ -98,27 +101,34 @@ pub struct TokenLimits {
     pub total: usize,
     /// Wrong codes.
     pub guesses: GuessLimits,
+    /// New sessions.
+    pub creates: CreateLimits,
 }
+
+/// How many sessions a `serve` hosts at once unless told otherwise.
+pub const DEFAULT_MAX_SESSIONS: usize = 64;
 
 impl Default for TokenLimits {
     fn default() -> Self {
-        Self { deadline: Duration::from_secs(2), per_address: 32, total: 256, guesses: GuessLimits::default() }
+        Self {
+            deadline: Duration::from_secs(2),
+            per_address: 32,
+            total: 256,
+            guesses: GuessLimits::default(),
+            creates: CreateLimits::default(),
+        }
     }
 }
 
 /// What the endpoint needs to mint tokens.
 #[derive(Clone)]
 pub struct TokenConfig {
-    /// The join code in force.
-    pub codes: CodeBook,
+    /// The sessions, their codes and seats.
+    pub registry: Registry,
     /// Netcode private key shared with the game server.
     pub private_key: [u8; 32],
     /// The game server's public UDP address (must equal the server's `public_addresses`).
     pub server_addr: SocketAddr,
-    /// Session id written into every token.
-    pub session: u64,
-    /// The session's seats.
-    pub seats: Seats,
     /// Limits.
     pub limits: TokenLimits,
 }
@@ -149,8 +159,6 @@ impl Shared {
 pub struct TokenService {
     /// Address it listens on.
     pub addr: SocketAddr,
-    /// The join code in force (rotate it here).
-    pub codes: CodeBook,
     stop: Option<tokio::sync::oneshot::Sender<()>>,
     thread: Option<JoinHandle<()>>,
 }
@@ -169,7 +177,6 @@ impl TokenService {
             log: Mutex::new(RefusalLog::new("heist_server::net::tokens", "token endpoint")),
             config,
         });
-        let codes = shared.config.codes.clone();
         let (stop, stopped) = tokio::sync::oneshot::channel();
         let thread = std::thread::Builder::new().name("token-endpoint".into()).spawn(move || {
             runtime.block_on(async move {
@@ -179,7 +186,7 @@ impl TokenService {
                 }
             });
         })?;
-        Ok(Self { addr, codes, stop: Some(stop), thread: Some(thread) })
+        Ok(Self { addr, stop: Some(stop), thread: Some(thread) })
     }
 }
 
@@ -234,16 +241,24 @@ impl Drop for Closer {
     }
 }
 
-/// A short human-friendly join code like `K7QX-2M4P` (40 bits: 32⁸ codes).
-pub fn new_join_code() -> String {
-    const ALPHABET: &[u8] = b"ABCDEFGHJKLMNPQRSTUVWXYZ23456789";
-    let mut s = String::with_capacity(9);
-    for i in 0..8 {
-        if i == 4 {
-            s.push('-');
-        }
-        s.push(ALPHABET[rand::random_range(0..ALPHABET.len())] as char);
-    }
+/// Letters of join codes: no 0/O, 1/I to mix up.
+const ALPHABET: &[u8] = b"ABCDEFGHJKLMNPQRSTUVWXYZ23456789";
+
+fn letters(n: usize) -> impl Iterator<Item = char> {
+    (0..n).map(|_| ALPHABET[rand::random_range(0..ALPHABET.len())] as char)
+}
+
+/// A fresh room: the public first group of a session's codes, like `K7QX` (20 bits; unique among the
+/// open sessions).
+pub fn new_room() -> String {
+    letters(4).collect()
+}
+
+/// The secret part of a join code, like `2M4P-R9TC` (40 bits: 32⁸).
+fn new_secret() -> String {
+    let mut s: String = letters(4).collect();
+    s.push('-');
+    s.extend(letters(4));
     s
 }
 
@@ -253,20 +268,22 @@ mod tests {
 
     #[test]
     fn join_codes_look_right() {
-        let c = new_join_code();
-        assert_eq!(c.len(), 9);
-        assert_eq!(&c[4..5], "-");
+        let c = CodeBook::new("K7QX", Duration::from_secs(60)).current().code;
+        assert_eq!(c.len(), 14, "{c}");
+        assert!(c.starts_with("K7QX-") && &c[9..10] == "-", "{c}");
+        assert_eq!(heist_shared::protocol::join::room_of(&c).as_deref(), Ok("K7QX"));
     }
 
     #[test]
     fn a_rotated_code_replaces_the_old_one_and_expires_later() {
-        let book = CodeBook::new(Duration::from_secs(60));
+        let book = CodeBook::new("ROOM", Duration::from_secs(60));
         let first = book.current();
         assert!(!first.is_expired());
         assert!(first.describe().contains("in 1 min"), "{}", first.describe());
         let second = book.rotate();
         assert_ne!(second.code, first.code);
         assert_eq!(book.current(), second);
-        assert!(CodeBook::new(Duration::ZERO).current().is_expired());
+        assert!(second.code.starts_with("ROOM-"), "a rotated code stays in its room");
+        assert!(CodeBook::new("ROOM", Duration::ZERO).current().is_expired());
     }
 }

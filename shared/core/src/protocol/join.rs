@@ -8,7 +8,7 @@
 //!
 //! ```text
 //! client                                   server
-//!   Hello { version, role, pake_a }   ──▶
+//!   Hello { version, room, role, pake_a } ──▶
 //!                                     ◀──  Challenge { pake_b }
 //!   Confirm { mac(K, transcript) }    ──▶  (a wrong mac is a wrong code)
 //!                                     ◀──  Token { sealed(K, connect token) }
@@ -17,7 +17,15 @@
 //! A player coming back to a held seat opens with `Resume` instead of `Hello`: the same exchange, keyed by
 //! the seat ticket the server gave them at their first admission instead of the join code (so it works
 //! after the code expired or was rotated, and only for that seat's holder). The token it yields carries the
-//! ticket, which admission checks again.
+//! ticket, which admission checks again; it names the seat by the ticket's public id
+//! ([`SeatTicket::public_id`]), which says which session it is in without giving the ticket away.
+//!
+//! One server hosts many sessions. A join code is `ROOM-XXXX-XXXX`: the first group names the session
+//! (its *room*, sent in clear in the hello so the server knows which code to key the exchange with), the
+//! whole code is the secret (the last two groups, 40 bits, are never sent). A player *creates* a session
+//! with `Create`: the same exchange keyed by a fixed password (so the channel is encrypted against a
+//! passive observer; anyone may create, within the server's limits), ending in `Created` with the new
+//! session's code and the creator's token, sealed together ([`NewSession`]).
 
 use serde::{Deserialize, Serialize};
 use spake2::{Ed25519Group, Identity, Password, Spake2};
@@ -26,7 +34,7 @@ use super::ids::Role;
 use super::token::SeatTicket;
 
 /// Version of the join exchange; both sides must speak the same.
-pub const JOIN_VERSION: u8 = 3;
+pub const JOIN_VERSION: u8 = 4;
 /// Largest frame body either side accepts, bytes (a sealed token is ~2.1 KB).
 pub const MAX_FRAME: usize = 4096;
 
@@ -37,6 +45,8 @@ pub enum JoinMsg {
     Hello {
         /// [`JOIN_VERSION`] of the client.
         version: u8,
+        /// The session's room: the code's first group ([`room_of`]).
+        room: String,
         /// The role the player wants.
         role: Role,
         /// The client's SPAKE2 message.
@@ -54,9 +64,31 @@ pub enum JoinMsg {
         version: u8,
         /// The seat's role.
         role: Role,
+        /// The seat's public id ([`SeatTicket::public_id`]): which session's seat.
+        seat: [u8; 16],
         /// The client's SPAKE2 message.
         pake: Vec<u8>,
     },
+    /// Opens the exchange of a player creating a new session, in which they will play `role`: the
+    /// SPAKE2 message is keyed by a fixed password ([`Pake::client_create`]).
+    Create {
+        /// [`JOIN_VERSION`] of the client.
+        version: u8,
+        /// The role the creator plays.
+        role: Role,
+        /// The client's SPAKE2 message.
+        pake: Vec<u8>,
+    },
+}
+
+/// What a `Created` reply seals: the new session's join code (to give the partner) and the creator's
+/// connect token.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct NewSession {
+    /// The join code, like `K7QX-2M4P-R9TC`.
+    pub code: String,
+    /// The creator's connect token (netcode wire format).
+    pub token: Vec<u8>,
 }
 
 /// What the server answers.
@@ -69,6 +101,11 @@ pub enum JoinReply {
     },
     /// The connect token (netcode wire format), sealed with the exchange's key.
     Token {
+        /// ChaCha20-Poly1305 ciphertext and tag.
+        sealed: Vec<u8>,
+    },
+    /// A session was created: [`NewSession`] (postcard), sealed with the exchange's key.
+    Created {
         /// ChaCha20-Poly1305 ciphertext and tag.
         sealed: Vec<u8>,
     },
@@ -123,6 +160,18 @@ pub enum JoinRefusal {
         /// The client's version.
         client: u8,
     },
+    /// The server hosts as many sessions as it may.
+    #[error("the server hosts {max} sessions already, its most; try another server or later")]
+    Full {
+        /// The server's `--max-sessions`.
+        max: u32,
+    },
+    /// This address created sessions too fast.
+    #[error("too many new sessions from your address; try again in {retry_after_s} s")]
+    TooManySessions {
+        /// Seconds until this address may create another.
+        retry_after_s: u32,
+    },
     /// The request was not understood.
     #[error("bad join request: {0}")]
     BadRequest(String),
@@ -160,6 +209,28 @@ pub fn normalize_code(code: &str) -> String {
     code.chars().filter(|c| !c.is_whitespace() && *c != '-').map(|c| c.to_ascii_uppercase()).collect()
 }
 
+/// Letters in a normalized join code: a room of [`ROOM_LEN`] and a secret of 8.
+pub const CODE_LEN: usize = 12;
+/// Letters of the room, the code's first group.
+pub const ROOM_LEN: usize = 4;
+
+/// The room a join code names (its first group), or what is wrong with the code.
+pub fn room_of(code: &str) -> Result<String, String> {
+    let code = normalize_code(code);
+    if code.len() != CODE_LEN || !code.chars().all(|c| c.is_ascii_alphanumeric()) {
+        return Err(format!(
+            "a join code has {CODE_LEN} letters and digits, like K7QX-2M4P-R9TC (got {} characters)",
+            code.chars().count()
+        ));
+    }
+    Ok(code[..ROOM_LEN].to_owned())
+}
+
+/// The fixed password of the create exchange (no join code can equal it: codes have no colon).
+fn create_password() -> Password {
+    Password::new(b"create:phantom-heist session")
+}
+
 /// A ticket as a SPAKE2 password: prefixed, so no join code can ever equal one.
 fn ticket_password(ticket: &SeatTicket) -> Password {
     Password::new(format!("seat:{}", ticket.to_hex()))
@@ -191,6 +262,20 @@ impl Pake {
     pub fn client_ticket(ticket: &SeatTicket) -> (Self, Vec<u8>) {
         let (a, b) = identities();
         let (state, msg) = Spake2::<Ed25519Group>::start_a(&ticket_password(ticket), &a, &b);
+        (Self(state), msg)
+    }
+
+    /// The client's side of the create exchange.
+    pub fn client_create() -> (Self, Vec<u8>) {
+        let (a, b) = identities();
+        let (state, msg) = Spake2::<Ed25519Group>::start_a(&create_password(), &a, &b);
+        (Self(state), msg)
+    }
+
+    /// The server's side of the create exchange.
+    pub fn server_create() -> (Self, Vec<u8>) {
+        let (a, b) = identities();
+        let (state, msg) = Spake2::<Ed25519Group>::start_b(&create_password(), &a, &b);
         (Self(state), msg)
     }
 
@@ -249,15 +334,17 @@ mod tests {
     fn exchange(client_code: &str, server_code: &str) -> (JoinKeys, JoinKeys) {
         let (client, a) = Pake::client(client_code);
         let (server, b) = Pake::server(server_code);
-        let hello = postcard::to_allocvec(&JoinMsg::Hello { version: JOIN_VERSION, role: Role::Vive, pake: a.clone() })
-            .unwrap();
+        let room = room_of(client_code).unwrap();
+        let hello =
+            postcard::to_allocvec(&JoinMsg::Hello { version: JOIN_VERSION, room, role: Role::Vive, pake: a.clone() })
+                .unwrap();
         let challenge = postcard::to_allocvec(&JoinReply::Challenge { pake: b.clone() }).unwrap();
         (client.finish(&b, &hello, &challenge).unwrap(), server.finish(&a, &hello, &challenge).unwrap())
     }
 
     #[test]
     fn the_same_code_gives_the_same_keys_however_it_is_typed() {
-        let (c, s) = exchange("k7qx 2m4p", "K7QX-2M4P");
+        let (c, s) = exchange("k7qx 2m4p r9tc", "K7QX-2M4P-R9TC");
         assert_eq!(c.client_mac, s.client_mac);
         let sealed = s.seal(b"token bytes").unwrap();
         assert_eq!(c.open(&sealed).as_deref(), Some(&b"token bytes"[..]));
@@ -265,7 +352,7 @@ mod tests {
 
     #[test]
     fn a_wrong_code_gives_other_keys() {
-        let (c, s) = exchange("K7QX-2M4Q", "K7QX-2M4P");
+        let (c, s) = exchange("K7QX-2M4P-R9TD", "K7QX-2M4P-R9TC");
         assert_ne!(c.client_mac, s.client_mac);
         assert_eq!(c.open(&s.seal(b"token").unwrap()), None);
     }
@@ -282,6 +369,26 @@ mod tests {
         assert_eq!(c.client_mac, s.client_mac);
         let (c, s) = keys(&SeatTicket::random(), &ticket);
         assert_ne!(c.client_mac, s.client_mac);
+    }
+
+    #[test]
+    fn a_code_names_its_room_and_a_malformed_code_says_what_is_wrong() {
+        assert_eq!(room_of("k7qx-2m4p-r9tc").as_deref(), Ok("K7QX"));
+        assert_eq!(room_of(" K7QX 2M4P R9TC ").as_deref(), Ok("K7QX"));
+        for bad in ["K7QX-2M4P", "K7QX-2M4P-R9TC-1", "K7Q!-2M4P-R9TC", ""] {
+            let e = room_of(bad).unwrap_err();
+            assert!(e.contains("12 letters and digits"), "{bad}: {e}");
+        }
+    }
+
+    #[test]
+    fn the_create_exchange_agrees_on_a_key_without_any_code() {
+        let (c, a) = Pake::client_create();
+        let (s, b) = Pake::server_create();
+        let (c, s) = (c.finish(&b, b"create", b"challenge").unwrap(), s.finish(&a, b"create", b"challenge").unwrap());
+        assert_eq!(c.client_mac, s.client_mac);
+        let sealed = s.seal(b"code and token").unwrap();
+        assert_eq!(c.open(&sealed).as_deref(), Some(&b"code and token"[..]));
     }
 
     #[test]

@@ -1,7 +1,8 @@
 //! Every replicated component, and who may see it.
 //!
 //! Every replicated entity carries an [`Audience`]; replicon hides an entity from a client whose
-//! [`ClientRole`] is not in the audience, and hides entities with no `Audience` at all. No component here
+//! [`ClientRole`] is not in the audience, and hides entities with no `Audience` at all. (The server adds
+//! a second filter of its own, its session tag: a client sees only its own session's entities.) No component here
 //! carries (or can be used to infer) which copy is real: all copies of an artifact share one look.
 
 use bevy::prelude::*;
@@ -17,7 +18,7 @@ use crate::artifact::{ArtifactKind, ArtifactLook};
 pub const REPLICATED: &[(&str, &str)] = &[
     ("SessionView", "both"),
     ("ViveAvatar", "both"),
-    ("GuardView", "both"),
+    ("GuardView", "Phantom always; Vive only while he could see or hear the guard (the server's interest management)"),
     ("CaseView", "both"),
     ("ItemView", "both (copies share one look; no real/fake flag exists)"),
     ("PhantomTool", "both"),

@@ -23,6 +23,15 @@ impl SeatTicket {
         Self(rand::random())
     }
 
+    /// The seat's public name: a keyed hash of the ticket, sent in clear by a resume so the server finds
+    /// the session whose seat it is, and from which the ticket cannot be recovered.
+    pub fn public_id(&self) -> [u8; 16] {
+        let hash = blake3::keyed_hash(&blake3::derive_key("phantom-heist seat id", b""), &self.0);
+        let mut id = [0u8; 16];
+        id.copy_from_slice(&hash.as_bytes()[..16]);
+        id
+    }
+
     /// Lowercase hex, as the seat cache stores it and the resume exchange is keyed with.
     pub fn to_hex(&self) -> String {
         self.0.iter().map(|b| format!("{b:02x}")).collect()

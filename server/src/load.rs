@@ -1,0 +1,209 @@
+//! `heist-server load`: many bot pairs against one server process over loopback UDP, each pair in a
+//! session of its own that it created through the token endpoint, and what it costs the server.
+//!
+//! Everything is stepped in lockstep on one thread (the server, then every client, once a tick), so the
+//! server's cost per tick is its own thread's CPU time for that update, undisturbed by the bots; time
+//! is game time (a tick is 1/60 s), so bytes per second are per second of play whatever the machine's
+//! speed. Every bot pair asks for another round after each result, so the load is steady.
+
+use std::time::Duration;
+
+use anyhow::Context as _;
+use bevy::prelude::*;
+use heist_bots::{PhantomBotPlugin, Rounds, ViveBotPlugin, ViveStyle};
+use heist_shared::protocol::{Role, TICK_HZ};
+use heist_transport::IntakeLimits;
+use heist_transport::limit::Rate;
+
+use crate::net::admission_count;
+use crate::net::registry::CreateLimits;
+use crate::net::transport::GameTransport;
+use crate::{HostedServer, ServerOptions, build_server};
+
+/// How a load run goes.
+#[derive(Clone, Debug)]
+pub struct LoadOptions {
+    /// Sessions, each with a Vive bot and a Phantom bot.
+    pub sessions: usize,
+    /// Seconds of game time measured (after every client is in).
+    pub seconds: f32,
+    /// How the Vive bots play.
+    pub style: ViveStyle,
+}
+
+/// What a load run measured.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct LoadReport {
+    /// Sessions played.
+    pub sessions: usize,
+    /// Ticks measured.
+    pub ticks: u64,
+    /// Server CPU per tick divided by the sessions, µs: median.
+    pub session_tick_us_median: f64,
+    /// The same, 99th percentile.
+    pub session_tick_us_p99: f64,
+    /// Server CPU per tick, ms: median.
+    pub tick_ms_median: f64,
+    /// The same, 99th percentile.
+    pub tick_ms_p99: f64,
+    /// Bytes a second each client sent the server (UDP payloads), averaged over the clients.
+    pub client_bytes_per_s_up: f64,
+    /// Bytes a second the server sent each client.
+    pub client_bytes_per_s_down: f64,
+    /// Players admitted when the measurement began (2 per session when all are in).
+    pub players: usize,
+    /// Rounds begun during the measurement (the bots ask for another after each result).
+    pub rematches: u32,
+}
+
+impl std::fmt::Display for LoadReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(
+            f,
+            "{} sessions, {} players, {} ticks measured ({} rematches)",
+            self.sessions, self.players, self.ticks, self.rematches
+        )?;
+        writeln!(
+            f,
+            "server CPU per session-tick: median {:.1} µs, p99 {:.1} µs",
+            self.session_tick_us_median, self.session_tick_us_p99
+        )?;
+        writeln!(f, "server tick: median {:.3} ms, p99 {:.3} ms", self.tick_ms_median, self.tick_ms_p99)?;
+        write!(f, "per client: up {:.0} B/s, down {:.0} B/s", self.client_bytes_per_s_up, self.client_bytes_per_s_down)
+    }
+}
+
+/// The server of a load run: loopback, no host session, room for `sessions`, and limits raised for one
+/// address that creates every session and opens every connection (the bots all live on loopback).
+pub fn load_server_options(sessions: usize) -> ServerOptions {
+    let mut options = ServerOptions::local_test(0);
+    options.host_session = false;
+    options.max_sessions = sessions;
+    let plenty = Rate::new(10_000.0, 10_000.0);
+    options.token_limits.creates = CreateLimits { each: plenty, all: plenty };
+    options.intake_limits = IntakeLimits { requests_per_address: plenty, requests_total: plenty, ..Default::default() };
+    options
+}
+
+/// A bot pair in a session it created: Vive creates it, Phantom joins with its code; `probe` adds a
+/// test's systems to both apps.
+pub fn create_bot_pair(
+    server: &HostedServer,
+    style: ViveStyle,
+    rounds: u32,
+    probe: impl Fn(&mut App),
+) -> anyhow::Result<[App; 2]> {
+    let endpoint = server.tokens.as_ref().context("the server runs without a token endpoint")?.addr;
+    let timeout = Duration::from_secs(5);
+    let (code, token) = heist_client::create_session(endpoint, Role::Vive, timeout)?;
+    let vive = crate::demo::client_with_token(token, |app| {
+        app.add_plugins(ViveBotPlugin { style }).insert_resource(Rounds(rounds));
+        probe(app);
+    })?;
+    let token = heist_client::request_token(endpoint, &code, Role::Phantom, timeout)?;
+    let phantom = crate::demo::client_with_token(token, |app| {
+        app.add_plugins(PhantomBotPlugin::default()).insert_resource(Rounds(rounds));
+        probe(app);
+    })?;
+    Ok([vive, phantom])
+}
+
+/// CPU time of the calling thread.
+fn thread_cpu() -> Duration {
+    let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+    // SAFETY: `ts` is a valid, writable timespec; CLOCK_THREAD_CPUTIME_ID needs nothing else.
+    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    if rc != 0 {
+        return Duration::ZERO;
+    }
+    Duration::new(ts.tv_sec as u64, ts.tv_nsec as u32)
+}
+
+/// The `q` quantile (0..=1) of `values`, sorted in place.
+fn quantile(values: &mut [f64], q: f64) -> f64 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    values.sort_by(f64::total_cmp);
+    let i = ((values.len() - 1) as f64 * q).round() as usize;
+    values[i.min(values.len() - 1)]
+}
+
+/// Runs the load: `progress` hears what is happening (joins, then the measurement).
+pub fn run_load(options: &LoadOptions, mut progress: impl FnMut(&str)) -> anyhow::Result<LoadReport> {
+    anyhow::ensure!(
+        (1..=crate::net::MAX_SESSIONS).contains(&options.sessions),
+        "--sessions {} is outside 1..={}",
+        options.sessions,
+        crate::net::MAX_SESSIONS
+    );
+    anyhow::ensure!(options.seconds.is_finite() && options.seconds > 0.0, "--seconds must be above zero");
+    let mut server = build_server(load_server_options(options.sessions))?;
+    let mut clients: Vec<App> = Vec::with_capacity(options.sessions * 2);
+    for n in 0..options.sessions {
+        clients.extend(
+            create_bot_pair(&server, options.style, u32::MAX, |_| {}).with_context(|| format!("bot pair {}", n + 1))?,
+        );
+        // Let the server take each session and its players in before the next.
+        for _ in 0..2 {
+            server.app.update();
+            clients.iter_mut().for_each(App::update);
+        }
+    }
+    progress(&format!("{} sessions created; waiting for {} players", options.sessions, clients.len()));
+    let want = clients.len();
+    for _ in 0..(20.0 * TICK_HZ) as u64 {
+        if admission_count(server.app.world_mut()) >= want {
+            break;
+        }
+        server.app.update();
+        clients.iter_mut().for_each(App::update);
+    }
+    let players = admission_count(server.app.world_mut());
+    progress(&format!("{players} of {want} players in; measuring {} s of play", options.seconds));
+    let traffic = |s: &HostedServer| {
+        s.app.world().get_resource::<GameTransport>().map(GameTransport::traffic).unwrap_or_default()
+    };
+    let rounds = |s: &mut HostedServer| s.sessions().iter().map(|s| s.game.round).sum::<u32>();
+    let (before, rounds_before) = (traffic(&server), rounds(&mut server));
+    let ticks = (f64::from(options.seconds) * TICK_HZ).ceil() as u64;
+    let mut tick_us = Vec::with_capacity(ticks as usize);
+    for _ in 0..ticks {
+        let start = thread_cpu();
+        server.app.update();
+        tick_us.push((thread_cpu() - start).as_secs_f64() * 1e6);
+        clients.iter_mut().for_each(App::update);
+    }
+    let after = traffic(&server);
+    let seconds = ticks as f64 / TICK_HZ;
+    let per_client = (players.max(1) as f64) * seconds;
+    let sessions = options.sessions as f64;
+    let mut per_session: Vec<f64> = tick_us.iter().map(|us| us / sessions).collect();
+    let report = LoadReport {
+        sessions: options.sessions,
+        ticks,
+        session_tick_us_median: quantile(&mut per_session, 0.5),
+        session_tick_us_p99: quantile(&mut per_session, 0.99),
+        tick_ms_median: quantile(&mut tick_us, 0.5) / 1000.0,
+        tick_ms_p99: quantile(&mut tick_us, 0.99) / 1000.0,
+        client_bytes_per_s_up: (after.received - before.received) as f64 / per_client,
+        client_bytes_per_s_down: (after.sent - before.sent) as f64 / per_client,
+        players,
+        rematches: rounds(&mut server).saturating_sub(rounds_before),
+    };
+    Ok(report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quantiles_pick_the_ranked_value() {
+        let mut v: Vec<f64> = (1..=100).map(f64::from).collect();
+        v.reverse();
+        assert_eq!(quantile(&mut v, 0.5), 51.0);
+        assert_eq!(quantile(&mut v, 0.99), 99.0);
+        assert_eq!(quantile(&mut [], 0.5), 0.0);
+    }
+}
