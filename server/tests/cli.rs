@@ -316,3 +316,28 @@ fn a_served_server_hosts_two_sessions_bot_processes_created_and_each_ends_on_its
     let _ = serve.wait();
     let _ = std::fs::remove_dir_all(cache);
 }
+
+#[test]
+fn load_plays_bot_pairs_in_sessions_of_their_own_and_ends_with_one_json_line_of_figures() {
+    let out = Command::new(env!("CARGO_BIN_EXE_heist-server"))
+        .args(["load", "--sessions", "3", "--seconds", "2", "--json"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
+    let last: serde_json::Value = serde_json::from_str(text.lines().last().unwrap_or_default()).expect("JSON last");
+    assert_eq!(
+        (last["sessions"].as_u64(), last["players"].as_u64(), last["ticks"].as_u64()),
+        (Some(3), Some(6), Some(120))
+    );
+    let number = |k: &str| last[k].as_f64().unwrap_or_else(|| panic!("{k} in {last}"));
+    for k in ["session_tick_us_median", "session_tick_us_p99", "tick_ms_p99"] {
+        assert!(number(k) > 0.0, "{k}: {last}");
+    }
+    assert!(number("session_tick_us_median") <= number("session_tick_us_p99"), "{last}");
+    // Every client moves (Vive 60 moves a second) and is replicated to: bytes both ways, within reason.
+    for k in ["client_bytes_per_s_up", "client_bytes_per_s_down"] {
+        assert!((500.0..100_000.0).contains(&number(k)), "{k}: {last}");
+    }
+    assert!(text.contains("server CPU per session-tick"), "{text}");
+}

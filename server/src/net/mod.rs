@@ -258,9 +258,22 @@ fn log_disconnect(event: On<RenetServerEvent>) {
     }
 }
 
-/// Binds the game socket (loopback for tests, any address for hosting).
+/// Bytes the kernel may queue for the game socket between two reads: a tick's datagrams from every
+/// client of every session (at 500 sessions, about 2,000 datagrams, connection requests 1,078 bytes each).
+/// The kernel caps it at `net.core.rmem_max`.
+pub const GAME_SOCKET_BUFFER: usize = 4 << 20;
+
+/// Binds the game socket (loopback for tests, any address for hosting), with room for a tick's worth of
+/// datagrams from every client ([`GAME_SOCKET_BUFFER`]; the default, ~200 KB, holds ~190 connection
+/// requests: the rest are dropped before the server reads them).
 pub fn bind_game_socket(addr: SocketAddr) -> std::io::Result<UdpSocket> {
-    UdpSocket::bind(addr)
+    use socket2::{Domain, Protocol, Socket, Type};
+    let socket = Socket::new(Domain::for_address(addr), Type::DGRAM, Some(Protocol::UDP))?;
+    if let Err(e) = socket.set_recv_buffer_size(GAME_SOCKET_BUFFER) {
+        warn!("cannot enlarge the game socket's receive buffer: {e}");
+    }
+    socket.bind(&addr.into())?;
+    Ok(socket.into())
 }
 
 /// The address to tell players when the server listens on every interface (`bound` is unspecified, like
@@ -300,4 +313,21 @@ pub fn admission_count(world: &mut World) -> usize {
 /// The role a connected client entity plays, if admitted.
 pub fn role_of(players: &Query<'_, '_, &Player>, client: Entity) -> Option<Role> {
     players.get(client).ok().map(|p| p.role)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_game_socket_has_room_for_a_tick_of_every_clients_datagrams() {
+        let socket = bind_game_socket("127.0.0.1:0".parse().unwrap()).unwrap();
+        let size = socket2::SockRef::from(&socket).recv_buffer_size().unwrap();
+        // The kernel caps the request at net.core.rmem_max (and reports twice what it grants).
+        let cap = std::fs::read_to_string("/proc/sys/net/core/rmem_max")
+            .ok()
+            .and_then(|s| s.trim().parse::<usize>().ok())
+            .unwrap_or(GAME_SOCKET_BUFFER);
+        assert!(size >= GAME_SOCKET_BUFFER.min(cap), "{size} bytes (rmem_max {cap})");
+    }
 }

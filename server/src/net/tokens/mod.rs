@@ -106,7 +106,7 @@ pub struct TokenLimits {
 }
 
 /// How many sessions a `serve` hosts at once unless told otherwise.
-pub const DEFAULT_MAX_SESSIONS: usize = 64;
+pub const DEFAULT_MAX_SESSIONS: usize = 32;
 
 impl Default for TokenLimits {
     fn default() -> Self {
