@@ -212,7 +212,6 @@ pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
                 abuse_limit: options.abuse_limit,
                 advertise,
                 new_sessions: new_sessions.clone(),
-                exit_with_host: options.host_session,
             },
             intake: options.intake_limits,
         });

@@ -105,14 +105,18 @@ struct Host {
     code: String,
 }
 
-/// Starts `host --bind ADDR ARGS…` and waits (at most 20 s) for the join code it prints.
-fn host(args: &[&str]) -> Host {
+/// Starts `heist-server --log-format json COMMAND --bind ADDR ARGS…` on a free loopback port; returns
+/// the process, its address, port, stdout and stderr, line by line.
+#[allow(clippy::type_complexity)]
+fn serve_on_a_free_port(
+    command: &str,
+    args: &[&str],
+) -> (std::process::Child, String, u16, std::sync::mpsc::Receiver<String>, std::sync::mpsc::Receiver<String>) {
     use std::process::Stdio;
-    use std::time::{Duration, Instant};
     let port = std::net::UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
     let addr = format!("127.0.0.1:{port}");
     let mut child = Command::new(env!("CARGO_BIN_EXE_heist-server"))
-        .args(["--log-format", "json", "host", "--bind", &addr])
+        .args(["--log-format", "json", command, "--bind", &addr])
         .args(args)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -120,6 +124,13 @@ fn host(args: &[&str]) -> Host {
         .unwrap();
     let out = lines_of(child.stdout.take().unwrap());
     let log = lines_of(child.stderr.take().unwrap());
+    (child, addr, port, out, log)
+}
+
+/// Starts `host --bind ADDR ARGS…` and waits (at most 20 s) for the join code it prints.
+fn host(args: &[&str]) -> Host {
+    use std::time::{Duration, Instant};
+    let (child, addr, port, out, log) = serve_on_a_free_port("host", args);
     let deadline = Instant::now() + Duration::from_secs(20);
     let code = loop {
         let line =
@@ -244,16 +255,7 @@ fn a_served_server_hosts_two_sessions_bot_processes_created_and_each_ends_on_its
     use std::process::Stdio;
     use std::time::{Duration, Instant};
     let bin = env!("CARGO_BIN_EXE_heist-server");
-    let port = std::net::UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
-    let addr = format!("127.0.0.1:{port}");
-    let mut serve = Command::new(bin)
-        .args(["--log-format", "json", "serve", "--bind", &addr, "--max-sessions", "2", "--time-limit", "3"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let out = lines_of(serve.stdout.take().unwrap());
-    let log = lines_of(serve.stderr.take().unwrap());
+    let (mut serve, addr, _, out, log) = serve_on_a_free_port("serve", &["--max-sessions", "2", "--time-limit", "3"]);
     let deadline = Instant::now() + Duration::from_secs(20);
     while !out
         .recv_timeout(deadline.saturating_duration_since(Instant::now()))

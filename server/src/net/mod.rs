@@ -56,8 +56,6 @@ pub struct NetSettings {
     /// What every session created on request plays: the level, and options whose seed is replaced by a
     /// fresh random one.
     pub new_sessions: NewSessions,
-    /// End the app once the host's session is over (`host`); a `serve`d server runs on.
-    pub exit_with_host: bool,
 }
 
 /// What a session created on request plays.
@@ -201,7 +199,8 @@ const CLOSE_LINGER_S: f64 = 1.0;
 
 /// Once a game is closed (idle after a result, or deserted): closes its session in the registry (its code
 /// and seats stop working), tells each player why and lets them go, and a second later despawns it with
-/// its mirrors. With `exit_with_host`, the end of the host's session ends the app (`host` then exits 0).
+/// its mirrors. The end of the host's session (there is one unless `serve`d) ends the app instead (`host`
+/// then exits 0); a `serve`d server runs on.
 #[allow(clippy::too_many_arguments)]
 fn close_sessions(
     mut commands: Commands,
@@ -240,9 +239,9 @@ fn close_sessions(
                 }
             }
             Some(at) if now - at >= CLOSE_LINGER_S => {
-                if host.0 == Some(entity) && settings.exit_with_host {
+                if host.0 == Some(entity) {
                     exit.write(AppExit::Success);
-                } else if host.0 != Some(entity) {
+                } else {
                     commands.entity(entity).despawn();
                 }
             }
