@@ -271,7 +271,8 @@ fn events(
             | GameEvent::GaveUp(_)
             | GameEvent::RematchAsked(_)
             | GameEvent::RoundStarted(_)
-            | GameEvent::EndingSoon(_) => heist_client::notice::session_notice(&e, Role::Vive),
+            | GameEvent::EndingSoon(_)
+            | GameEvent::ServerClosing { .. } => heist_client::notice::session_notice(&e, Role::Vive),
         };
         if let GameEvent::Noise { kind: heist_shared::protocol::NoiseKind::Glass, position, .. } = &e
             && state.body().is_some_and(|b| b.distance(*position) < heist_shared::rules::REACH * 2.0)

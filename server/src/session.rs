@@ -145,6 +145,8 @@ pub enum Record<'a> {
     RematchAsked(Role),
     /// A round began.
     RoundStarted(u32),
+    /// The server began its drain: the session may finish its heist within this many seconds.
+    Draining(u32),
     /// The session closed.
     SessionEnded,
 }
@@ -204,6 +206,7 @@ impl SessionLog {
             }
             Record::RematchAsked(r) => ev!("rematch_asked", role = r.name()),
             Record::RoundStarted(n) => ev!("round_started", new_round = n),
+            Record::Draining(s) => ev!("draining", within_s = s),
             Record::SessionEnded => ev!("session_ended"),
         }
     }
@@ -268,6 +271,10 @@ impl SessionLog {
                 (Record::RoundStarted(*n), format!("round {n} begins"))
             }
             GameEvent::EndingSoon(s) => (Record::Note, format!("the session ends in {s} s unless a round begins")),
+            GameEvent::ServerClosing { within_s } => (
+                Record::Draining(*within_s),
+                format!("the server is shutting down: a heist under way may finish within {within_s} s"),
+            ),
         };
         self.record(t, record, text);
     }

@@ -192,6 +192,9 @@ pub struct Game {
     pub round: u32,
     /// Set once the session is over for good (idle after a result, or empty): the server closes it.
     pub closed: bool,
+    /// Set when the server drains ([`Game::drain`]): no new round, and the session closes once no heist
+    /// is under way.
+    pub draining: bool,
     options: GameOptions,
     ready: (bool, bool),
     rematch: (bool, bool),
@@ -384,14 +387,34 @@ impl Game {
         next.ready = (true, true);
         next.vive.last_input_seq = self.vive.last_input_seq;
         next.outgoing = std::mem::take(&mut self.outgoing);
+        next.draining = self.draining;
         *self = next;
         self.event(GameEvent::RoundStarted(self.round));
         self.start_if_ready();
     }
 
+    /// The server is shutting down: tells both players that a heist under way may go on for `within_s`
+    /// more seconds at most, and closes the session as soon as none is (at once in the lobby or after a
+    /// result). The server closes it at the limit itself. Once only.
+    pub fn drain(&mut self, within_s: u32) {
+        if self.draining {
+            return;
+        }
+        self.draining = true;
+        self.event(GameEvent::ServerClosing { within_s });
+    }
+
+    /// Seats kept for players who dropped (0 to 2).
+    pub fn kept_seats(&self) -> usize {
+        self.kept.iter().filter(|k| k.is_some()).count()
+    }
+
     /// Advances the session by `dt` seconds.
     pub fn step(&mut self, dt: f32) {
         self.keep_seats(dt);
+        if self.draining && self.phase != Phase::Heist {
+            self.closed = true;
+        }
         match self.phase {
             Phase::Lobby => {
                 self.start_if_ready();

@@ -89,6 +89,7 @@ pub(super) fn new_game(level: Level, options: &GameOptions) -> Game {
         seed: options.seed,
         round: 1,
         closed: false,
+        draining: false,
         options: options.clone(),
         rematch: (false, false),
         kept: [None, None],

@@ -640,3 +640,32 @@ fn a_vive_back_numbers_his_moves_afresh_and_they_count() {
     g.step(TICK_S);
     assert!(g.vive.position.x > at.x, "move 1 of the new connection moved him");
 }
+
+#[test]
+fn a_drain_lets_a_running_heist_finish_then_closes_and_closes_a_lobby_at_once() {
+    // A heist under way goes on, its players told once; its result closes the session (no rematch).
+    let options = GameOptions { seed: 3, time_limit_s: Some(2.0), ..Default::default() };
+    let mut g = Game::new(Level::museum(), &options);
+    g.join(Role::Vive);
+    g.join(Role::Phantom);
+    g.apply(Role::Vive, &ClientMsg::Lobby(LobbyMsg::Ready)).unwrap();
+    g.apply(Role::Phantom, &ClientMsg::Lobby(LobbyMsg::Ready)).unwrap();
+    g.vive.position = g.level.exit;
+    let _ = events(&mut g);
+    g.drain(600);
+    g.drain(600);
+    assert_eq!(events(&mut g), vec![GameEvent::ServerClosing { within_s: 600 }], "told once");
+    step_for(&mut g, 1.0);
+    assert_eq!(g.phase, Phase::Heist, "the heist goes on");
+    assert!(!g.closed);
+    step_for(&mut g, 1.5);
+    assert_eq!(g.phase, Phase::Lost(LossReason::Time));
+    assert!(g.closed, "after the result the draining session closes at once");
+
+    // A lobby closes at the next step.
+    let mut lobby = Game::new(Level::museum(), &GameOptions::default());
+    lobby.join(Role::Vive);
+    lobby.drain(600);
+    lobby.step(TICK_S);
+    assert!(lobby.closed);
+}

@@ -56,6 +56,8 @@ pub struct NetSettings {
     /// What every session created on request plays: the level, and options whose seed is replaced by a
     /// fresh random one.
     pub new_sessions: NewSessions,
+    /// Where refusals and resumes are counted.
+    pub metrics: crate::fleet::Metrics,
 }
 
 /// What a session created on request plays.
@@ -220,7 +222,9 @@ fn close_sessions(
         match session.closed_at {
             None => {
                 session.closed_at = Some(now);
-                let why = if session.game.present == (false, false) {
+                let why = if session.game.draining {
+                    "the server is shutting down"
+                } else if session.game.present == (false, false) {
                     "nobody is left in it"
                 } else {
                     "nobody asked for another round"
@@ -229,13 +233,13 @@ fn close_sessions(
                 settings.registry.close(session.id);
                 let t = session.game.elapsed_s;
                 session.log.record(t, crate::session::Record::SessionEnded, format!("session ended: {why}"));
+                let reason = if session.game.draining {
+                    heist_shared::protocol::DisconnectReason::ServerShutdown
+                } else {
+                    heist_shared::protocol::DisconnectReason::SessionEnded
+                };
                 for client in [session.roles.vive, session.roles.phantom].into_iter().flatten() {
-                    admission::refuse_and_disconnect(
-                        client,
-                        heist_shared::protocol::DisconnectReason::SessionEnded,
-                        &mut messages,
-                        &mut disconnects,
-                    );
+                    admission::refuse_and_disconnect(client, reason.clone(), &mut messages, &mut disconnects);
                 }
             }
             Some(at) if now - at >= CLOSE_LINGER_S => {

@@ -52,6 +52,7 @@ struct Inner {
     rooms: HashMap<String, u64>,
     opened: Vec<u64>,
     creates: KeyedLimiter<IpAddr>,
+    draining: bool,
 }
 
 /// Every session of the server (cheap to clone).
@@ -76,6 +77,7 @@ impl Registry {
             sessions: HashMap::new(),
             rooms: HashMap::new(),
             opened: Vec::new(),
+            draining: false,
             creates: KeyedLimiter::new(limits.each, limits.all, 16_384),
         };
         Self { inner: Arc::new(Mutex::new(inner)), max, code_ttl, started: Instant::now() }
@@ -104,6 +106,9 @@ impl Registry {
     /// room, code and free seats. The game loop spawns its game ([`Registry::take_opened`]).
     pub fn open(&self, from: Option<IpAddr>) -> Result<SessionEntry, JoinRefusal> {
         let mut inner = self.lock();
+        if inner.draining {
+            return Err(JoinRefusal::Draining);
+        }
         if inner.sessions.len() >= self.max {
             return Err(JoinRefusal::Full { max: self.max as u32 });
         }
@@ -135,6 +140,33 @@ impl Registry {
         inner.sessions.insert(id, entry.clone());
         inner.opened.push(id);
         Ok(entry)
+    }
+
+    /// The server is shutting down: from now on every request for a new session is refused
+    /// ([`JoinRefusal::Draining`]); joins and resumes of open sessions still work.
+    pub fn stop_opening(&self) {
+        self.lock().draining = true;
+    }
+
+    /// True once [`Registry::stop_opening`] was called.
+    pub fn is_draining(&self) -> bool {
+        self.lock().draining
+    }
+
+    /// The public ids of the seats of every open session that a player holds or that are kept for one
+    /// who dropped, as hex (what an orchestrator lists as the server's players).
+    pub fn seated_players(&self) -> Vec<String> {
+        let inner = self.lock();
+        let mut ids = Vec::with_capacity(inner.sessions.len() * 2);
+        for entry in inner.sessions.values() {
+            for role in [Role::Vive, Role::Phantom] {
+                if let Seat::Taken(ticket) | Seat::Kept { ticket, .. } = entry.seats.get(role) {
+                    ids.push(ticket.public_id().iter().map(|b| format!("{b:02x}")).collect());
+                }
+            }
+        }
+        ids.sort_unstable();
+        ids
     }
 
     /// The sessions opened since the last call, for the game loop to spawn.
@@ -184,6 +216,26 @@ mod tests {
 
     fn registry(max: usize) -> Registry {
         Registry::new(max, Duration::from_secs(60), CreateLimits::default())
+    }
+
+    #[test]
+    fn a_draining_registry_opens_no_session_but_keeps_the_open_ones_and_lists_their_seated_players() {
+        let r = registry(8);
+        let a = r.open(None).unwrap();
+        let (vive, phantom) = (SeatTicket::random(), SeatTicket::random());
+        a.seats.set(Role::Vive, Seat::Taken(vive));
+        a.seats.set(Role::Phantom, Seat::Kept { ticket: phantom, since: Instant::now() });
+        let hex = |t: SeatTicket| t.public_id().iter().map(|b| format!("{b:02x}")).collect::<String>();
+        let mut want = vec![hex(vive), hex(phantom)];
+        want.sort();
+        assert_eq!(r.seated_players(), want, "taken and kept seats are players; free ones are not");
+        r.stop_opening();
+        assert!(r.is_draining());
+        assert_eq!(r.open(Some("127.0.0.1".parse().unwrap())).map(|e| e.id), Err(JoinRefusal::Draining));
+        assert_eq!(r.open(None).map(|e| e.id), Err(JoinRefusal::Draining));
+        assert_eq!(r.by_room(&a.room).map(|e| e.id), Some(a.id), "an open session still takes its partner");
+        r.close(a.id);
+        assert!(r.seated_players().is_empty());
     }
 
     #[test]

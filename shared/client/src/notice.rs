@@ -20,6 +20,10 @@ pub fn session_notice(event: &GameEvent, me: Role) -> Option<String> {
         GameEvent::RematchAsked(_) => "You asked for another round.".to_owned(),
         GameEvent::RoundStarted(n) => format!("Round {n} begins, with new copies."),
         GameEvent::EndingSoon(s) => format!("The session ends in {s} seconds unless you both ask for another round."),
+        GameEvent::ServerClosing { within_s } => format!(
+            "The server is shutting down. A heist under way may finish, within {} at most; no new round after it.",
+            spoken_duration(within_s)
+        ),
         _ => return None,
     })
 }
@@ -114,6 +118,17 @@ pub fn disconnect_notice(reason: &DisconnectReason) -> String {
         }
         DisconnectReason::BadSeat => "The server refused our seat ticket: join again with the code.".to_owned(),
         DisconnectReason::Replaced => "This seat was taken back by our own new connection.".to_owned(),
+        DisconnectReason::ServerShutdown => "The server has shut down. Thank you for playing.".to_owned(),
+    }
+}
+
+/// Seconds as a player hears them: "90 seconds", "10 minutes", "1 minute 30 seconds".
+fn spoken_duration(s: u32) -> String {
+    let unit = |n: u32, one: &str| if n == 1 { format!("1 {one}") } else { format!("{n} {one}s") };
+    match (s / 60, s % 60) {
+        (0, secs) => unit(secs, "second"),
+        (mins, 0) => unit(mins, "minute"),
+        (mins, secs) => format!("{} {}", unit(mins, "minute"), unit(secs, "second")),
     }
 }
 
@@ -195,6 +210,10 @@ mod tests {
         assert_eq!(session_notice(&asked, Role::Phantom).as_deref(), Some("Vive asks for another round."));
         assert_eq!(session_notice(&asked, Role::Vive).as_deref(), Some("You asked for another round."));
         assert!(session_notice(&GameEvent::RoundStarted(2), Role::Vive).is_some_and(|l| l.starts_with("Round 2")));
+        let closing = session_notice(&GameEvent::ServerClosing { within_s: 630 }, Role::Phantom).unwrap();
+        assert!(closing.contains("shutting down") && closing.contains("10 minutes 30 seconds"), "{closing}");
+        assert_eq!(spoken_duration(1), "1 second");
+        assert_eq!(spoken_duration(60), "1 minute");
         assert_eq!(session_notice(&GameEvent::Alarm(1), Role::Vive), None);
     }
 }

@@ -34,7 +34,7 @@ use super::ids::Role;
 use super::token::SeatTicket;
 
 /// Version of the join exchange; both sides must speak the same.
-pub const JOIN_VERSION: u8 = 4;
+pub const JOIN_VERSION: u8 = 5;
 /// Largest frame body either side accepts, bytes (a sealed token is ~2.1 KB).
 pub const MAX_FRAME: usize = 4096;
 
@@ -178,6 +178,31 @@ pub enum JoinRefusal {
     /// The server could not make a token.
     #[error("the host could not make a token: {0}")]
     Internal(String),
+    /// The server is shutting down: it lets its running heists finish and creates no new session.
+    #[error("the server is shutting down and creates no new session; try another server or later")]
+    Draining,
+}
+
+impl JoinRefusal {
+    /// A short name of the kind of refusal, for metrics and logs (`wrong_code`, `full`, …).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            JoinRefusal::WrongCode => "wrong_code",
+            JoinRefusal::CodeExpired => "code_expired",
+            JoinRefusal::RoleTaken(_) => "role_taken",
+            JoinRefusal::SeatHeld { .. } => "seat_held",
+            JoinRefusal::NoSeat(_) => "no_seat",
+            JoinRefusal::WrongTicket => "wrong_ticket",
+            JoinRefusal::TooManyWrongCodes { .. } => "too_many_wrong_codes",
+            JoinRefusal::Busy { .. } => "busy",
+            JoinRefusal::Version { .. } => "version",
+            JoinRefusal::Full { .. } => "full",
+            JoinRefusal::TooManySessions { .. } => "too_many_sessions",
+            JoinRefusal::BadRequest(_) => "bad_request",
+            JoinRefusal::Internal(_) => "internal",
+            JoinRefusal::Draining => "draining",
+        }
+    }
 }
 
 /// Encodes `msg` as one frame.

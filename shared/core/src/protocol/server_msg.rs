@@ -133,6 +133,12 @@ pub enum GameEvent {
     RoundStarted(u32),
     /// The session ends in this many seconds unless someone asks for another round.
     EndingSoon(u32),
+    /// The server is shutting down: a running heist may finish, within this many seconds at most; no
+    /// new round begins after it.
+    ServerClosing {
+        /// Seconds the server waits for the heist at most.
+        within_s: u32,
+    },
     /// Vive picked an item up.
     PickedUp(ItemId),
 }
@@ -174,6 +180,30 @@ pub enum Refusal {
     Paused,
 }
 
+impl Refusal {
+    /// A short name of the kind of refusal, for metrics and logs (`too_fast`, `wrong_phase`, …).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Refusal::Malformed(_) => "malformed",
+            Refusal::WrongRole => "wrong_role",
+            Refusal::WrongPhase(_) => "wrong_phase",
+            Refusal::TooFast => "too_fast",
+            Refusal::NotFinite => "not_finite",
+            Refusal::OutOfReach => "out_of_reach",
+            Refusal::Unknown => "unknown",
+            Refusal::AlreadyBroken => "already_broken",
+            Refusal::CaseIntact => "case_intact",
+            Refusal::HandsFull => "hands_full",
+            Refusal::NotCarried => "not_carried",
+            Refusal::NotACopy => "not_a_copy",
+            Refusal::WorkbenchBusy => "workbench_busy",
+            Refusal::NotOnWorkbench => "not_on_workbench",
+            Refusal::RateLimited => "rate_limited",
+            Refusal::Paused => "paused",
+        }
+    }
+}
+
 /// Why the server disconnects a client.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum DisconnectReason {
@@ -191,4 +221,6 @@ pub enum DisconnectReason {
     BadSeat,
     /// The seat's holder came back on another connection, which replaces this one.
     Replaced,
+    /// The server is shutting down (its heists had their time to finish).
+    ServerShutdown,
 }
