@@ -5,6 +5,7 @@
 #![warn(missing_docs)]
 
 pub mod demo;
+pub mod fleet;
 pub mod game;
 pub mod load;
 pub mod net;
@@ -23,6 +24,7 @@ use bevy_replicon_renet::RepliconRenetPlugins;
 use heist_shared::level::Level;
 use heist_shared::protocol::{ProtocolPlugin, TICK_HZ};
 
+use fleet::{Fleet, FleetPlugin};
 use game::{Game, GameOptions};
 use heist_transport::IntakeLimits;
 use net::registry::Registry;
@@ -73,6 +75,10 @@ pub struct ServerOptions {
     pub token_limits: TokenLimits,
     /// The game socket's limits.
     pub intake_limits: IntakeLimits,
+    /// How long a drain waits for running heists ([`fleet::drain`]).
+    pub drain_limit: Duration,
+    /// How long without an update the game loop counts as stalled (health, Agones).
+    pub stall_after: Duration,
 }
 
 /// How long a join code works unless the host says otherwise.
@@ -97,6 +103,8 @@ impl ServerOptions {
             code_ttl: DEFAULT_CODE_TTL,
             token_limits: TokenLimits::default(),
             intake_limits: IntakeLimits::default(),
+            drain_limit: fleet::DEFAULT_DRAIN_LIMIT,
+            stall_after: fleet::STALL_AFTER,
         }
     }
 }
@@ -115,6 +123,8 @@ pub struct HostedServer {
     pub registry: Registry,
     /// The host's session's code book (secure mode, with a host session).
     pub codes: Option<CodeBook>,
+    /// Its heartbeat, metrics and drain (also a resource of the app).
+    pub fleet: Fleet,
 }
 
 impl HostedServer {
@@ -165,6 +175,7 @@ pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
     let advertised = advertise.unwrap_or(addr);
     let max_sessions = options.max_sessions.clamp(1, net::MAX_SESSIONS);
     let registry = Registry::new(max_sessions, options.code_ttl, options.token_limits.creates);
+    let fleet = Fleet::new(options.drain_limit, options.stall_after);
     let host_entry = if options.host_session {
         let entry = registry.open(None).map_err(|e| anyhow::anyhow!("cannot open the host's session: {e}"))?;
         registry.take_opened(); // spawned below, with the host's options
@@ -183,6 +194,7 @@ pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
                 private_key,
                 server_addr: advertised,
                 limits: options.token_limits,
+                metrics: fleet.metrics.clone(),
             },
         )
         .with_context(|| format!("cannot bind the token endpoint on TCP {}", options.token_bind))?;
@@ -204,6 +216,8 @@ pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
     app.insert_resource(Time::<Fixed>::from_hz(TICK_HZ))
         .add_plugins((StatesPlugin, RepliconPlugins, RepliconRenetPlugins, ProtocolPlugin))
         .add_plugins(SessionPlugin)
+        .insert_resource(fleet.clone())
+        .add_plugins(FleetPlugin)
         .add_plugins(ServerNetPlugin {
             socket: std::sync::Mutex::new(Some(socket)),
             settings: NetSettings {
@@ -212,6 +226,7 @@ pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
                 abuse_limit: options.abuse_limit,
                 advertise,
                 new_sessions: new_sessions.clone(),
+                metrics: fleet.metrics.clone(),
             },
             intake: options.intake_limits,
         });
@@ -227,5 +242,5 @@ pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
         app.finish();
         app.cleanup();
     }
-    Ok(HostedServer { app, addr, advertised, tokens, registry, codes })
+    Ok(HostedServer { app, addr, advertised, tokens, registry, codes, fleet })
 }

@@ -29,6 +29,8 @@ pub struct LoadOptions {
     pub seconds: f32,
     /// How the Vive bots play.
     pub style: ViveStyle,
+    /// Serve `/healthz` and `/metrics` here while the load runs.
+    pub metrics: Option<std::net::SocketAddr>,
 }
 
 /// What a load run measured.
@@ -139,6 +141,11 @@ pub fn run_load(options: &LoadOptions, mut progress: impl FnMut(&str)) -> anyhow
     );
     anyhow::ensure!(options.seconds.is_finite() && options.seconds > 0.0, "--seconds must be above zero");
     let mut server = build_server(load_server_options(options.sessions))?;
+    let fleet = crate::fleet::FleetOptions { metrics: options.metrics, agones: None };
+    let services = crate::fleet::FleetServices::start(&server, &fleet)?;
+    if let Some(http) = &services.http {
+        progress(&format!("health and metrics on http://{}/healthz and /metrics", http.addr));
+    }
     let mut clients: Vec<App> = Vec::with_capacity(options.sessions * 2);
     for n in 0..options.sessions {
         clients.extend(
@@ -191,6 +198,7 @@ pub fn run_load(options: &LoadOptions, mut progress: impl FnMut(&str)) -> anyhow
         players,
         rematches: rounds(&mut server).saturating_sub(rounds_before),
     };
+    services.shut_down();
     Ok(report)
 }
 

@@ -102,6 +102,12 @@ enum Command {
         /// Override the level's time limit, seconds.
         #[arg(long, value_parser = positive_seconds)]
         time_limit: Option<f32>,
+        #[command(flatten)]
+        fleet: FleetArgs,
+        /// Run as an Agones game server: Ready, health pings, the `sessions` Counter and `players` List,
+        /// Shutdown after a drain (the SDK sidecar at localhost:$AGONES_SDK_GRPC_PORT, default 9357).
+        #[arg(long)]
+        agones: bool,
     },
     /// Play N bot pairs, each in its own session, against one server over loopback, and print what the
     /// server spends: CPU per session-tick, tick time, bytes per client.
@@ -115,6 +121,9 @@ enum Command {
         /// Print one JSON object as the last line.
         #[arg(long)]
         json: bool,
+        /// Serve `/healthz` and `/metrics` on this TCP address while the load runs.
+        #[arg(long)]
+        metrics: Option<SocketAddr>,
     },
     /// Host a session for players: prints the address and the join code.
     Host {
@@ -148,6 +157,8 @@ enum Command {
         /// Sessions open at once: besides the host's, players may create this many less one.
         #[arg(long, default_value_t = 1, value_parser = max_sessions)]
         max_sessions: usize,
+        #[command(flatten)]
+        fleet: FleetArgs,
     },
     /// Join a hosted session as a bot (restarted within a minute of losing its connection, it takes its
     /// seat back through the seat cache, `$XDG_CACHE_HOME/phantom-heist/seats`).
@@ -171,6 +182,38 @@ enum Command {
         #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1000))]
         rounds: u32,
     },
+}
+
+/// Flags of the servers that run for others (`host`, `serve`): health, metrics and the drain.
+#[derive(clap::Args)]
+struct FleetArgs {
+    /// Serve `/healthz` (200 while the game loop runs, 503 when stalled or draining) and `/metrics`
+    /// (Prometheus text format) on this TCP address.
+    #[arg(long)]
+    metrics: Option<SocketAddr>,
+    /// Seconds a drain (the first SIGTERM or SIGINT; a second exits at once) waits for running heists
+    /// to reach their result before it closes them.
+    #[arg(long, default_value_t = heist_server::fleet::DEFAULT_DRAIN_LIMIT.as_secs_f32(), value_parser = positive_seconds)]
+    drain_limit: f32,
+}
+
+/// Runs a server for others until it is over or drained: the fleet services `fleet` and `agones` ask
+/// for, termination signals turned into a drain, Agones told `Shutdown` at the end.
+fn run_server(mut server: heist_server::HostedServer, fleet: &FleetArgs, agones: bool) -> anyhow::Result<()> {
+    use heist_server::fleet::{FleetOptions, FleetServices, agones::AgonesOptions, signals};
+    signals::drain_on_termination(server.fleet.drain.clone()).context("cannot handle SIGTERM")?;
+    let options = FleetOptions { metrics: fleet.metrics, agones: agones.then(AgonesOptions::default) };
+    let services = FleetServices::start(&server, &options)?;
+    if let Some(http) = &services.http {
+        println!("health and metrics on http://{}/healthz and /metrics", http.addr);
+    }
+    server.app.run();
+    let failure = server.fleet.failure();
+    services.shut_down();
+    match failure {
+        Some(why) => Err(anyhow::anyhow!(why)),
+        None => Ok(()),
+    }
 }
 
 /// The bot leaves a few seconds after the last round's result, or quits when the server lets it go or
@@ -239,6 +282,7 @@ struct Hosting {
     idle_end: f32,
     time_limit: Option<f32>,
     max_sessions: usize,
+    drain_limit: f32,
 }
 
 impl Hosting {
@@ -264,6 +308,8 @@ impl Hosting {
             code_ttl: Duration::from_secs(self.code_ttl.max(1) * 60),
             token_limits: Default::default(),
             intake_limits: Default::default(),
+            drain_limit: Duration::from_secs_f32(self.drain_limit),
+            stall_after: heist_server::fleet::STALL_AFTER,
         })
     }
 }
@@ -323,12 +369,24 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             println!("{tally}");
             Ok(())
         }
-        Command::Host { bind, advertise, seed, code_ttl, level, insecure, idle_end, time_limit, max_sessions } => {
+        Command::Host {
+            bind,
+            advertise,
+            seed,
+            code_ttl,
+            level,
+            insecure,
+            idle_end,
+            time_limit,
+            max_sessions,
+            fleet,
+        } => {
             if insecure {
                 eprintln!("WARNING: --insecure: anyone who reaches {bind} can join as any role. LAN development only!");
             }
-            let hosting = Hosting { bind, advertise, code_ttl, level, idle_end, time_limit, max_sessions };
-            let mut server = build_server(hosting.options(seed, insecure, true)?)?;
+            let drain_limit = fleet.drain_limit;
+            let hosting = Hosting { bind, advertise, code_ttl, level, idle_end, time_limit, max_sessions, drain_limit };
+            let server = build_server(hosting.options(seed, insecure, true)?)?;
             print_address(&server);
             if let Some(codes) = server.codes.clone() {
                 println!("join code: {}", codes.current().describe());
@@ -341,20 +399,41 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     }
                 })?;
             }
-            server.app.run();
+            run_server(server, &fleet, false)?;
             println!("the session is over");
             Ok(())
         }
-        Command::Serve { bind, advertise, max_sessions, code_ttl, level, idle_end, time_limit } => {
-            let hosting = Hosting { bind, advertise, code_ttl, level, idle_end, time_limit, max_sessions };
-            let mut server = build_server(hosting.options(None, false, false)?)?;
+        Command::Serve {
+            mut bind,
+            mut advertise,
+            max_sessions,
+            code_ttl,
+            level,
+            idle_end,
+            time_limit,
+            fleet,
+            agones,
+        } => {
+            if agones && advertise.is_none() {
+                // Players reach the pod at its node's address and host port, which only Agones knows.
+                use heist_server::fleet::agones::{AgonesOptions, GAME_PORT, public_address};
+                let (ip, host_port) = public_address(&AgonesOptions::default(), GAME_PORT)?;
+                if bind.port() == 0 {
+                    bind.set_port(host_port.context("--bind has port 0 and the GameServer has no `game` port")?);
+                }
+                advertise = Some(SocketAddr::new(ip, host_port.unwrap_or(bind.port())));
+            }
+            let drain_limit = fleet.drain_limit;
+            let hosting = Hosting { bind, advertise, code_ttl, level, idle_end, time_limit, max_sessions, drain_limit };
+            let server = build_server(hosting.options(None, false, false)?)?;
             print_address(&server);
             println!("serving up to {max_sessions} sessions: a player creates one and gets its join code");
-            server.app.run();
+            run_server(server, &fleet, agones)?;
+            println!("drained: every session is over");
             Ok(())
         }
-        Command::Load { sessions, seconds, json } => {
-            let options = heist_server::load::LoadOptions { sessions, seconds, style: ViveStyle::Careful };
+        Command::Load { sessions, seconds, json, metrics } => {
+            let options = heist_server::load::LoadOptions { sessions, seconds, style: ViveStyle::Careful, metrics };
             let report = heist_server::load::run_load(&options, |line| println!("{line}"))?;
             println!("{report}");
             if json {

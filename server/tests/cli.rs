@@ -112,12 +112,23 @@ fn serve_on_a_free_port(
     command: &str,
     args: &[&str],
 ) -> (std::process::Child, String, u16, std::sync::mpsc::Receiver<String>, std::sync::mpsc::Receiver<String>) {
+    serve_on_a_free_port_with(command, args, &[])
+}
+
+/// [`serve_on_a_free_port`] with environment variables.
+#[allow(clippy::type_complexity)]
+fn serve_on_a_free_port_with(
+    command: &str,
+    args: &[&str],
+    envs: &[(&str, String)],
+) -> (std::process::Child, String, u16, std::sync::mpsc::Receiver<String>, std::sync::mpsc::Receiver<String>) {
     use std::process::Stdio;
     let port = std::net::UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
     let addr = format!("127.0.0.1:{port}");
     let mut child = Command::new(env!("CARGO_BIN_EXE_heist-server"))
         .args(["--log-format", "json", command, "--bind", &addr])
         .args(args)
+        .envs(envs.iter().map(|(k, v)| (k, v)))
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -342,4 +353,314 @@ fn load_plays_bot_pairs_in_sessions_of_their_own_and_ends_with_one_json_line_of_
         assert!((500.0..100_000.0).contains(&number(k)), "{k}: {last}");
     }
     assert!(text.contains("server CPU per session-tick"), "{text}");
+}
+
+/// `GET path` on `addr` (HTTP/1.1, one request); the status code and the body.
+fn http_get(addr: &str, path: &str) -> (u16, String) {
+    use std::io::{Read as _, Write as _};
+    let mut stream = std::net::TcpStream::connect(addr).unwrap();
+    stream.set_read_timeout(Some(std::time::Duration::from_secs(5))).unwrap();
+    write!(stream, "GET {path} HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\n\r\n").unwrap();
+    let mut text = String::new();
+    stream.read_to_string(&mut text).unwrap();
+    let status = text.split_whitespace().nth(1).and_then(|s| s.parse().ok()).unwrap_or(0);
+    let body = text.split_once("\r\n\r\n").map(|(_, b)| b.to_owned()).unwrap_or_default();
+    (status, body)
+}
+
+/// Waits (at most `limit`) for a line of `lines` that contains `marker`; the part after it.
+fn line_after(lines: &std::sync::mpsc::Receiver<String>, marker: &str, limit: std::time::Duration) -> String {
+    let deadline = std::time::Instant::now() + limit;
+    loop {
+        let line = lines
+            .recv_timeout(deadline.saturating_duration_since(std::time::Instant::now()))
+            .unwrap_or_else(|_| panic!("no line with {marker:?} within {limit:?}"));
+        if let Some((_, rest)) = line.split_once(marker) {
+            return rest.to_owned();
+        }
+    }
+}
+
+#[test]
+fn health_and_metrics_scraped_while_load_runs_count_its_sessions_players_ticks_and_bytes() {
+    use heist_server::fleet::metrics::sample;
+    use std::process::Stdio;
+    use std::time::Duration;
+    let mut load = Command::new(env!("CARGO_BIN_EXE_heist-server"))
+        .args(["load", "--sessions", "3", "--seconds", "30", "--json", "--metrics", "127.0.0.1:0"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let out = lines_of(load.stdout.take().unwrap());
+    let addr = line_after(&out, "health and metrics on http://", Duration::from_secs(20));
+    let addr = addr.split('/').next().unwrap().to_owned();
+    line_after(&out, "measuring", Duration::from_secs(60));
+
+    let (status, health) = http_get(&addr, "/healthz");
+    assert_eq!((status, health.trim()), (200, "ok: 3 sessions, 6 players"));
+    let (status, first) = http_get(&addr, "/metrics");
+    assert_eq!(status, 200, "{first}");
+    let value = |text: &str, name: &str| sample(text, name).unwrap_or_else(|| panic!("{name} in {text}"));
+    assert_eq!(value(&first, "heist_sessions"), 3.0);
+    assert_eq!(value(&first, "heist_sessions_created_total"), 3.0);
+    assert_eq!(value(&first, "heist_players"), 6.0);
+    assert_eq!(value(&first, "heist_draining"), 0.0);
+    std::thread::sleep(Duration::from_millis(500));
+    let (_, second) = http_get(&addr, "/metrics");
+    for name in ["heist_tick_seconds_count", "heist_received_bytes_total", "heist_sent_bytes_total"] {
+        assert!(value(&second, name) > value(&first, name), "{name} grows while the load plays: {second}");
+    }
+    assert_eq!(http_get(&addr, "/nothing").0, 404);
+
+    assert!(wait_for(&mut load, Duration::from_secs(120)).is_some_and(|s| s.success()), "the load ends");
+    let last: Vec<String> = out.try_iter().collect();
+    let report: serde_json::Value = serde_json::from_str(last.last().unwrap()).unwrap();
+    assert_eq!((report["sessions"].as_f64(), report["players"].as_f64()), (Some(3.0), Some(6.0)), "{report}");
+}
+
+#[test]
+fn sigterm_drains_an_agones_served_server_two_heists_finish_new_sessions_are_refused_and_it_exits_0() {
+    use agones_fake::{Declared, FakeAgones};
+    use std::process::Stdio;
+    use std::time::{Duration, Instant};
+    let fake = FakeAgones::start(
+        "127.0.0.1:0".parse().unwrap(),
+        Declared {
+            counters: vec![("sessions".into(), 1000)],
+            lists: vec![("players".into(), 1000)],
+            ports: Vec::new(),
+        },
+    )
+    .unwrap();
+    let bin = env!("CARGO_BIN_EXE_heist-server");
+    let args =
+        ["--max-sessions", "4", "--time-limit", "15", "--drain-limit", "60", "--agones", "--metrics", "127.0.0.1:0"];
+    let envs = [("AGONES_SDK_GRPC_PORT", fake.addr.port().to_string())];
+    let (mut serve, addr, _, out, log) = serve_on_a_free_port_with("serve", &args, &envs);
+    line_after(&out, "serving", Duration::from_secs(20));
+    let metrics = line_after(&out, "health and metrics on http://", Duration::from_secs(20));
+    let metrics = metrics.split('/').next().unwrap().to_owned();
+    assert!(fake.wait_for(Duration::from_secs(20), |r| r.ready == 1), "Ready once serving");
+
+    let cache = std::env::temp_dir().join(format!("heist-cli-seats-{}-drain", std::process::id()));
+    let bot = |args: &[&str], role: &str, name: &str| {
+        Command::new(bin)
+            .args(["join", &addr])
+            .args(args)
+            .args(["--role", role, "--vive", "idle"])
+            .env("XDG_CACHE_HOME", cache.join(name))
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap()
+    };
+    let mut bots = Vec::new();
+    for n in 0..2 {
+        let mut creator = bot(&["--create"], "vive", &format!("creator{n}"));
+        let printed = lines_of(creator.stdout.take().unwrap());
+        let code = line_after(&printed, "join code: ", Duration::from_secs(20)).trim().to_owned();
+        let mut partner = bot(&["--code", &code], "phantom", &format!("partner{n}"));
+        let partner_out = lines_of(partner.stdout.take().unwrap());
+        bots.push((creator, printed));
+        bots.push((partner, partner_out));
+    }
+    // Both heists under way (and Agones counting both sessions), then the game server is allocated.
+    let mut events: Vec<serde_json::Value> = Vec::new();
+    let mut read_log = |until: &dyn Fn(&[serde_json::Value]) -> bool, limit: Duration| {
+        let deadline = Instant::now() + limit;
+        while !until(&events) && Instant::now() < deadline {
+            if let Ok(line) = log.recv_timeout(Duration::from_millis(100))
+                && let Ok(v) = serde_json::from_str::<serde_json::Value>(&line)
+            {
+                events.push(v);
+            }
+        }
+        until(&events)
+    };
+    let count = |events: &[serde_json::Value], name: &str| events.iter().filter(|e| e["event"] == name).count();
+    let heists = |e: &[serde_json::Value]| e.iter().filter(|e| e["event"] == "phase" && e["phase"] == "heist").count();
+    assert!(read_log(&|e| heists(e) == 2, Duration::from_secs(30)), "two heists begin: {events:?}");
+    assert!(
+        fake.wait_for(Duration::from_secs(10), |r| r.counters["sessions"].0 == 2 && r.lists["players"].1.len() == 4)
+    );
+    fake.allocate();
+    assert!(read_log(&|e| count(e, "allocated") == 1, Duration::from_secs(10)), "the allocation is logged");
+
+    // SIGTERM: no new session, a clear refusal; health says draining.
+    // SAFETY: kill(2) on our own child's pid with a valid signal number.
+    assert_eq!(unsafe { libc::kill(serve.id() as i32, libc::SIGTERM) }, 0);
+    assert!(read_log(&|e| count(e, "drain_started") == 1, Duration::from_secs(10)), "{events:?}");
+    let refused = Command::new(bin).args(["join", &addr, "--create", "--role", "vive"]).output().unwrap();
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert!(!refused.status.success() && err.contains("shutting down"), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "one line: {err}");
+    let (status, health) = http_get(&metrics, "/healthz");
+    assert_eq!((status, health.trim()), (503, "draining: 2 sessions left"));
+
+    // Both heists reach their result, the sessions end, the server exits 0 and told Agones Shutdown.
+    let status = wait_for(&mut serve, Duration::from_secs(60));
+    assert!(status.is_some_and(|s| s.success()), "the drained server exits 0: {status:?}");
+    read_log(&|_| false, Duration::from_millis(300));
+    assert_eq!(count(&events, "result"), 2, "{events:?}");
+    assert_eq!(count(&events, "session_ended"), 2, "{events:?}");
+    assert_eq!(count(&events, "drained"), 1, "{events:?}");
+    assert!(events.iter().filter(|e| e["event"] == "result").all(|e| e["reason"] == "time"), "played to the end");
+    let r = fake.recorded();
+    assert_eq!(r.shutdown, 1, "{:?}", r.calls);
+    assert!(r.lists["players"].1.is_empty() && r.counters["sessions"].0 == 0, "{:?}", r.calls);
+    let mut told = 0;
+    for (b, printed) in &mut bots {
+        let _ = wait_for(b, Duration::from_secs(10));
+        told += usize::from(printed.try_iter().any(|l| l.contains("The server has shut down")));
+    }
+    assert_eq!(told, 4, "every player is told the server shut down");
+    let _ = std::fs::remove_dir_all(cache);
+}
+
+/// The lines of `text` from the one that is `header` (trimmed) up to the next line indented as little.
+fn yaml_block<'a>(text: &'a str, header: &str) -> Vec<&'a str> {
+    let lines: Vec<&str> = text.lines().collect();
+    let at = lines.iter().position(|l| l.trim() == header).unwrap_or_else(|| panic!("{header} in the YAML"));
+    let indent = |l: &str| l.len() - l.trim_start().len();
+    let own = indent(lines[at]);
+    lines[at + 1..].iter().take_while(|l| l.trim().is_empty() || indent(l) > own).copied().collect()
+}
+
+/// The number after `key:` in `lines`, the first one.
+fn yaml_number(lines: &[&str], key: &str) -> f64 {
+    lines
+        .iter()
+        .find_map(|l| l.trim().strip_prefix(key)?.strip_prefix(':')?.trim().trim_matches('"').parse().ok())
+        .unwrap_or_else(|| panic!("{key} in {lines:?}"))
+}
+
+/// The server container's arguments in deploy/fleet.yaml.
+fn fleet_args(fleet: &str) -> Vec<String> {
+    yaml_block(fleet, "args:")
+        .iter()
+        .map_while(|l| l.trim().strip_prefix("- ").map(|a| a.trim_matches('"').to_owned()))
+        .collect()
+}
+
+fn arg_after(args: &[String], flag: &str) -> f64 {
+    let at = args.iter().position(|a| a == flag).unwrap_or_else(|| panic!("{flag} in {args:?}"));
+    args[at + 1].parse().unwrap()
+}
+
+#[test]
+fn the_dockerfile_builds_with_the_commands_ci_runs_and_ships_only_the_server_as_a_user() {
+    let dockerfile = include_str!("../../deploy/Dockerfile");
+    let ci = include_str!("../../.ci/run");
+    let stages: Vec<&str> = dockerfile.split("\nFROM ").skip(1).collect();
+    assert_eq!(stages.len(), 2, "two stages: build and runtime");
+    let runs: Vec<&str> = stages[0].lines().filter_map(|l| l.strip_prefix("RUN ")).collect();
+    assert!(!runs.is_empty());
+    for run in &runs {
+        assert!(ci.lines().any(|l| l.trim() == *run), "the build stage's `{run}` is not a line of .ci/run");
+    }
+    assert!(runs.iter().any(|r| r.contains("cargo build --release --locked -p heist_server")), "{runs:?}");
+    let runtime = stages[1];
+    let copies: Vec<&str> = runtime.lines().filter(|l| l.starts_with("COPY")).collect();
+    assert_eq!(copies.len(), 2, "the binary and the levels: {copies:?}");
+    assert!(copies[0].contains("target/release/heist-server") && copies[1].contains("assets/levels"), "{copies:?}");
+    let user = runtime.lines().find_map(|l| l.strip_prefix("USER ")).expect("a USER line");
+    assert!(!user.starts_with("root") && !user.starts_with("0"), "runs as {user}");
+}
+
+#[test]
+fn the_fleet_sizes_agree_with_the_server_it_runs_and_the_levels_it_plays() {
+    use heist_server::fleet::agones::{GAME_PORT, PLAYERS_LIST, SESSIONS_COUNTER};
+    let fleet = include_str!("../../deploy/fleet.yaml");
+    let args = fleet_args(fleet);
+    let max = arg_after(&args, "--max-sessions");
+    let drain = arg_after(&args, "--drain-limit");
+    assert!(args.iter().any(|a| a == "--agones"), "{args:?}");
+    let counter = yaml_block(fleet, &format!("{SESSIONS_COUNTER}:"));
+    assert_eq!(yaml_number(&counter, "capacity"), max, "the Counter's capacity is --max-sessions");
+    let list = yaml_block(fleet, &format!("{PLAYERS_LIST}:"));
+    assert_eq!(yaml_number(&list, "capacity"), 2.0 * max, "two seats a session");
+    let grace = yaml_number(&fleet.lines().collect::<Vec<_>>(), "terminationGracePeriodSeconds");
+    let heist = f64::from(heist_shared::level::Level::museum().time_limit_s);
+    assert!(grace > drain && drain > heist, "grace {grace} > drain {drain} > a heist {heist}");
+    let health = yaml_block(fleet, "health:");
+    let window = yaml_number(&health, "periodSeconds") * yaml_number(&health, "failureThreshold");
+    assert!(window > heist_server::fleet::STALL_AFTER.as_secs_f64(), "Agones waits longer than the watchdog");
+    let ports = yaml_block(fleet, "ports:");
+    assert!(ports.iter().any(|l| l.trim() == format!("- name: {GAME_PORT}")), "{ports:?}");
+    let autoscaler = yaml_block(fleet, "counter:");
+    assert!(autoscaler.iter().any(|l| l.trim() == format!("key: {SESSIONS_COUNTER}")), "{autoscaler:?}");
+    assert_eq!(yaml_number(&autoscaler, "bufferSize") % max, 0.0, "the buffer is whole servers");
+}
+
+#[test]
+fn the_fleets_arguments_run_a_server_on_the_passthrough_port_and_a_second_sigterm_exits_at_once() {
+    use agones_fake::{Declared, FakeAgones};
+    use std::process::Stdio;
+    use std::time::Duration;
+    let port = std::net::UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
+    let fake = FakeAgones::start(
+        "127.0.0.1:0".parse().unwrap(),
+        Declared {
+            counters: vec![("sessions".into(), 32)],
+            lists: vec![("players".into(), 64)],
+            // As Agones' port allocator lists a TCPUDP port.
+            ports: vec![("game-tcp".into(), port), ("game-udp".into(), port)],
+        },
+    )
+    .unwrap();
+    // The container's arguments, on loopback (tests bind nothing else) with a free metrics port.
+    let args: Vec<String> = fleet_args(include_str!("../../deploy/fleet.yaml"))
+        .into_iter()
+        .map(|a| if a.starts_with("0.0.0.0:") { a.replace("0.0.0.0", "127.0.0.1") } else { a })
+        .map(|a| if a == "127.0.0.1:9090" { "127.0.0.1:0".to_owned() } else { a })
+        .collect();
+    let bin = env!("CARGO_BIN_EXE_heist-server");
+    let mut serve = Command::new(bin)
+        .args(["--log-format", "json", "serve"])
+        .args(&args)
+        .env("AGONES_SDK_GRPC_PORT", fake.addr.port().to_string())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let out = lines_of(serve.stdout.take().unwrap());
+    let log = lines_of(serve.stderr.take().unwrap());
+    let hosting = line_after(&out, "hosting on ", Duration::from_secs(40));
+    assert_eq!(hosting, format!("127.0.0.1:{port} (UDP game, TCP tokens)"), "the Passthrough port, Agones' address");
+    assert!(fake.wait_for(Duration::from_secs(10), |r| r.ready == 1));
+    assert_eq!(fake.recorded().annotations.get("phantom-heist.address"), Some(&format!("127.0.0.1:{port}")));
+
+    // A heist under way; SIGTERM starts a drain, a second SIGTERM exits at once with 128 + 15.
+    let addr = format!("127.0.0.1:{port}");
+    let cache = std::env::temp_dir().join(format!("heist-cli-seats-{}-fleet", std::process::id()));
+    let bot = |args: &[&str], role: &str| {
+        Command::new(bin)
+            .args(["join", &addr])
+            .args(args)
+            .args(["--role", role, "--vive", "idle"])
+            .env("XDG_CACHE_HOME", cache.join(role))
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap()
+    };
+    let mut creator = bot(&["--create"], "vive");
+    let printed = lines_of(creator.stdout.take().unwrap());
+    let code = line_after(&printed, "join code: ", Duration::from_secs(20)).trim().to_owned();
+    let mut partner = bot(&["--code", &code], "phantom");
+    line_after(&log, r#""phase":"heist""#, Duration::from_secs(30));
+    // SAFETY: kill(2) on our own child's pid with a valid signal number.
+    assert_eq!(unsafe { libc::kill(serve.id() as i32, libc::SIGTERM) }, 0);
+    line_after(&log, "drain_started", Duration::from_secs(10));
+    assert!(serve.try_wait().unwrap().is_none(), "the first SIGTERM waits for the heist");
+    // SAFETY: as above.
+    assert_eq!(unsafe { libc::kill(serve.id() as i32, libc::SIGTERM) }, 0);
+    let status = wait_for(&mut serve, Duration::from_secs(5));
+    assert_eq!(status.and_then(|s| s.code()), Some(143), "the second SIGTERM exits at once");
+    for b in [&mut creator, &mut partner] {
+        let _ = b.kill();
+        let _ = b.wait();
+    }
+    let _ = std::fs::remove_dir_all(cache);
 }

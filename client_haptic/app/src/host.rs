@@ -100,6 +100,8 @@ fn host_here(args: &HostArgs) -> anyhow::Result<(SocketAddr, SocketAddr, String,
         code_ttl: DEFAULT_CODE_TTL,
         token_limits: Default::default(),
         intake_limits: Default::default(),
+        drain_limit: heist_server::fleet::DEFAULT_DRAIN_LIMIT,
+        stall_after: heist_server::fleet::STALL_AFTER,
     };
     let (tx, rx) = std::sync::mpsc::channel();
     // The server's app is built and run on its own thread (a Bevy app stays on the thread that made it).

@@ -151,6 +151,7 @@ pub(super) fn admit(
         message: ServerMsg::Welcome { role, level: Box::new(session.game.level.clone()), seat: ticket, resumed },
     });
     if resumed {
+        settings.metrics.resumes.inc();
         info!("{role} took the seat back from {peer}");
         session.game.resume(role);
     } else {

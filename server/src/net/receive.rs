@@ -70,6 +70,7 @@ pub fn apply_client_messages(
             disconnects.write(DisconnectRequest { client });
         }
         if let Err(refusal) = applied {
+            settings.metrics.refuse("message", refusal.kind());
             if !after_a_stall {
                 player.strikes += 1.0;
             }

@@ -48,10 +48,14 @@ pub(super) async fn serve(mut stream: TcpStream, peer: SocketAddr, shared: Arc<S
     match result {
         Ok(role) => log::info!("token endpoint: gave a {role} token to {peer}"),
         Err(Failure::Refused(refusal)) => {
+            shared.config.metrics.refuse("join", refusal.kind());
             shared.refused(peer, &refusal);
             let _ = tokio::time::timeout(deadline, stream.write_all(&join::frame(&JoinReply::Refused(refusal)))).await;
         }
-        Err(Failure::Broken(why)) => shared.refused(peer, &why),
+        Err(Failure::Broken(why)) => {
+            shared.config.metrics.refuse("exchange", "broken");
+            shared.refused(peer, &why);
+        }
     }
 }
 

@@ -131,6 +131,8 @@ pub struct TokenConfig {
     pub server_addr: SocketAddr,
     /// Limits.
     pub limits: TokenLimits,
+    /// Where refusals are counted.
+    pub metrics: crate::fleet::Metrics,
 }
 
 /// Everything the connection tasks share.
