@@ -7,6 +7,8 @@
 //! Lists, with Agones' rules: only declared ones exist, counts stay within capacity, list values are
 //! unique) and records every call, so tests can check what the game server said and when.
 #![warn(missing_docs)]
+// tonic's service traits return `tonic::Status` as the error: the fake must too.
+#![allow(clippy::result_large_err)]
 
 use std::collections::BTreeMap;
 use std::net::SocketAddr;

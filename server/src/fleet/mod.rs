@@ -113,6 +113,7 @@ fn exit_on_failure(fleet: Res<Fleet>, mut exit: MessageWriter<AppExit>) {
 }
 
 /// Observes the update's time, beats, and brings the gauges and counters up to date.
+#[allow(clippy::too_many_arguments)]
 fn end_update(
     start: Res<UpdateStart>,
     fleet: Res<Fleet>,
