@@ -9,14 +9,4 @@ bash "$(dirname "$0")/server-deps.sh"
 packages=(pkg-config libudev-dev libfontconfig1-dev libfreetype-dev fonts-dejavu-core
     espeak-ng libasound2-dev libxkbcommon-x11-0 libvulkan1 mesa-vulkan-drivers xvfb xauth
     libopenxr-loader1 libopenxr-dev)
-missing=()
-for p in "${packages[@]}"; do
-    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-    echo "installing system packages: ${missing[*]}"
-    sudo_cmd=""
-    [ "$(id -u)" -eq 0 ] || sudo_cmd="sudo"
-    $sudo_cmd apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq "${missing[@]}"
-fi
+bash "$(dirname "$0")/apt-install.sh" "${packages[@]}"

@@ -175,7 +175,7 @@ pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
     let advertised = advertise.unwrap_or(addr);
     let max_sessions = options.max_sessions.clamp(1, net::MAX_SESSIONS);
     let registry = Registry::new(max_sessions, options.code_ttl, options.token_limits.creates);
-    let fleet = Fleet::new(options.drain_limit, options.stall_after);
+    let fleet = Fleet::new(max_sessions, options.drain_limit, options.stall_after);
     let host_entry = if options.host_session {
         let entry = registry.open(None).map_err(|e| anyhow::anyhow!("cannot open the host's session: {e}"))?;
         registry.take_opened(); // spawned below, with the host's options

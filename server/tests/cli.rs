@@ -261,9 +261,42 @@ fn a_bot_process_killed_mid_heist_and_started_again_takes_its_seat_back() {
     }
 }
 
+/// One session per pair of idle bot processes: a Vive bot creates it (`join --create`) and a Phantom bot
+/// joins with the code it prints, each bot with a seat cache of its own under `cache`. The bots, each
+/// with its stdout line by line, and the codes.
+#[allow(clippy::type_complexity)]
+fn bot_pairs(
+    addr: &str,
+    cache: &std::path::Path,
+    sessions: usize,
+) -> (Vec<(std::process::Child, std::sync::mpsc::Receiver<String>)>, Vec<String>) {
+    use std::process::Stdio;
+    let bot = |args: &[&str], role: &str, name: &str| {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_heist-server"))
+            .args(["join", addr])
+            .args(args)
+            .args(["--role", role, "--vive", "idle"])
+            .env("XDG_CACHE_HOME", cache.join(name))
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        let out = lines_of(child.stdout.take().unwrap());
+        (child, out)
+    };
+    let (mut bots, mut codes) = (Vec::new(), Vec::new());
+    for n in 0..sessions {
+        let creator = bot(&["--create"], "vive", &format!("creator{n}"));
+        let code = line_after(&creator.1, "join code: ", std::time::Duration::from_secs(20)).trim().to_owned();
+        bots.push(bot(&["--code", &code], "phantom", &format!("partner{n}")));
+        bots.push(creator);
+        codes.push(code);
+    }
+    (bots, codes)
+}
+
 #[test]
 fn a_served_server_hosts_two_sessions_bot_processes_created_and_each_ends_on_its_own() {
-    use std::process::Stdio;
     use std::time::{Duration, Instant};
     let bin = env!("CARGO_BIN_EXE_heist-server");
     let (mut serve, addr, _, out, log) = serve_on_a_free_port("serve", &["--max-sessions", "2", "--time-limit", "3"]);
@@ -274,36 +307,15 @@ fn a_served_server_hosts_two_sessions_bot_processes_created_and_each_ends_on_its
         .contains("serving")
     {}
     let cache = std::env::temp_dir().join(format!("heist-cli-seats-{}-serve", std::process::id()));
-    let bot = |args: &[&str], role: &str, name: &str| {
-        Command::new(bin)
-            .args(["join", &addr])
-            .args(args)
-            .args(["--role", role, "--vive", "idle"])
-            .env("XDG_CACHE_HOME", cache.join(name))
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap()
-    };
     // Two Vive bots each create a session and print its code; a Phantom bot joins each with it.
-    let mut bots = Vec::new();
-    let mut codes = Vec::new();
-    for n in 0..2 {
-        let mut creator = bot(&["--create"], "vive", &format!("creator{n}"));
-        let printed = lines_of(creator.stdout.take().unwrap());
-        let line = printed.recv_timeout(Duration::from_secs(20)).expect("the creator prints the code");
-        let code = line.split("join code: ").nth(1).expect("a code").trim().to_owned();
-        bots.push(bot(&["--code", &code], "phantom", &format!("partner{n}")));
-        bots.push(creator);
-        codes.push(code);
-    }
+    let (mut bots, codes) = bot_pairs(&addr, &cache, 2);
     assert_ne!(codes[0], codes[1], "each session has its own code");
     // A third creator finds the server full, on one line.
     let full = Command::new(bin).args(["join", &addr, "--create", "--role", "vive"]).output().unwrap();
     let err = String::from_utf8_lossy(&full.stderr);
     assert!(!full.status.success() && err.contains("hosts 2 sessions already"), "{err}");
     // Each 3 s heist ends on time, the bots leave, each session ends; the server runs on.
-    for b in &mut bots {
+    for (b, _) in &mut bots {
         assert!(wait_for(b, Duration::from_secs(60)).is_some(), "a bot leaves after its heist");
     }
     let mut names = Vec::new();
@@ -422,7 +434,6 @@ fn health_and_metrics_scraped_while_load_runs_count_its_sessions_players_ticks_a
 #[test]
 fn sigterm_drains_an_agones_served_server_two_heists_finish_new_sessions_are_refused_and_it_exits_0() {
     use agones_fake::{Declared, FakeAgones};
-    use std::process::Stdio;
     use std::time::{Duration, Instant};
     let fake = FakeAgones::start(
         "127.0.0.1:0".parse().unwrap(),
@@ -444,27 +455,7 @@ fn sigterm_drains_an_agones_served_server_two_heists_finish_new_sessions_are_ref
     assert!(fake.wait_for(Duration::from_secs(20), |r| r.ready == 1), "Ready once serving");
 
     let cache = std::env::temp_dir().join(format!("heist-cli-seats-{}-drain", std::process::id()));
-    let bot = |args: &[&str], role: &str, name: &str| {
-        Command::new(bin)
-            .args(["join", &addr])
-            .args(args)
-            .args(["--role", role, "--vive", "idle"])
-            .env("XDG_CACHE_HOME", cache.join(name))
-            .stdout(Stdio::piped())
-            .stderr(Stdio::null())
-            .spawn()
-            .unwrap()
-    };
-    let mut bots = Vec::new();
-    for n in 0..2 {
-        let mut creator = bot(&["--create"], "vive", &format!("creator{n}"));
-        let printed = lines_of(creator.stdout.take().unwrap());
-        let code = line_after(&printed, "join code: ", Duration::from_secs(20)).trim().to_owned();
-        let mut partner = bot(&["--code", &code], "phantom", &format!("partner{n}"));
-        let partner_out = lines_of(partner.stdout.take().unwrap());
-        bots.push((creator, printed));
-        bots.push((partner, partner_out));
-    }
+    let (mut bots, _) = bot_pairs(&addr, &cache, 2);
     // Both heists under way (and Agones counting both sessions), then the game server is allocated.
     let mut events: Vec<serde_json::Value> = Vec::new();
     let mut read_log = |until: &dyn Fn(&[serde_json::Value]) -> bool, limit: Duration| {
@@ -634,21 +625,7 @@ fn the_fleets_arguments_run_a_server_on_the_passthrough_port_and_a_second_sigter
     // A heist under way; SIGTERM starts a drain, a second SIGTERM exits at once with 128 + 15.
     let addr = format!("127.0.0.1:{port}");
     let cache = std::env::temp_dir().join(format!("heist-cli-seats-{}-fleet", std::process::id()));
-    let bot = |args: &[&str], role: &str| {
-        Command::new(bin)
-            .args(["join", &addr])
-            .args(args)
-            .args(["--role", role, "--vive", "idle"])
-            .env("XDG_CACHE_HOME", cache.join(role))
-            .stdout(Stdio::piped())
-            .stderr(Stdio::null())
-            .spawn()
-            .unwrap()
-    };
-    let mut creator = bot(&["--create"], "vive");
-    let printed = lines_of(creator.stdout.take().unwrap());
-    let code = line_after(&printed, "join code: ", Duration::from_secs(20)).trim().to_owned();
-    let mut partner = bot(&["--code", &code], "phantom");
+    let (mut bots, _) = bot_pairs(&addr, &cache, 1);
     line_after(&log, r#""phase":"heist""#, Duration::from_secs(30));
     // SAFETY: kill(2) on our own child's pid with a valid signal number.
     assert_eq!(unsafe { libc::kill(serve.id() as i32, libc::SIGTERM) }, 0);
@@ -658,7 +635,7 @@ fn the_fleets_arguments_run_a_server_on_the_passthrough_port_and_a_second_sigter
     assert_eq!(unsafe { libc::kill(serve.id() as i32, libc::SIGTERM) }, 0);
     let status = wait_for(&mut serve, Duration::from_secs(5));
     assert_eq!(status.and_then(|s| s.code()), Some(143), "the second SIGTERM exits at once");
-    for b in [&mut creator, &mut partner] {
+    for (b, _) in &mut bots {
         let _ = b.kill();
         let _ = b.wait();
     }

@@ -43,12 +43,14 @@ pub struct Fleet {
 }
 
 impl Fleet {
-    /// A fleet side with fresh metrics and no drain asked for.
-    pub fn new(drain_limit: Duration, stall_after: Duration) -> Self {
+    /// A fleet side for a server of at most `max_sessions`, with fresh metrics and no drain asked for.
+    pub fn new(max_sessions: usize, drain_limit: Duration, stall_after: Duration) -> Self {
+        let metrics = Metrics::new();
+        metrics.sessions_max.set(max_sessions as i64);
         Self {
             heartbeat: Heartbeat::default(),
             stall_after,
-            metrics: Metrics::new(),
+            metrics,
             drain: Drain::default(),
             drain_limit,
             fatal: Arc::default(),
@@ -128,7 +130,6 @@ fn end_update(
     m.tick_seconds.observe(start.0.elapsed().as_secs_f64());
     fleet.heartbeat.beat();
     m.sessions.set(settings.registry.len() as i64);
-    m.sessions_max.set(settings.registry.max() as i64);
     m.sessions_created.inc_by(added.iter().count() as u64);
     m.sessions_ended.inc_by(removed.read().count() as u64);
     let (mut players, mut kept) = (0, 0);

@@ -346,15 +346,20 @@ fn a_warning_reaches_vive_and_phantom_hears_it_went_out() {
     );
 }
 
-/// A heist started with a short clock and run out on time (Vive waits at the exit).
-fn lost_on_time(seed: u64, idle_end_s: Option<f32>) -> Game {
-    let options = GameOptions { seed, time_limit_s: Some(1.0), idle_end_s, ..Default::default() };
-    let mut g = Game::new(Level::museum(), &options);
+/// A heist under way with `options`, Vive waiting at the exit (out of the guards' way).
+fn waiting_at_the_exit(options: &GameOptions) -> Game {
+    let mut g = Game::new(Level::museum(), options);
     g.join(Role::Vive);
     g.join(Role::Phantom);
     g.apply(Role::Vive, &ClientMsg::Lobby(LobbyMsg::Ready)).unwrap();
     g.apply(Role::Phantom, &ClientMsg::Lobby(LobbyMsg::Ready)).unwrap();
     g.vive.position = g.level.exit;
+    g
+}
+
+/// A heist started with a short clock and run out on time (Vive waits at the exit).
+fn lost_on_time(seed: u64, idle_end_s: Option<f32>) -> Game {
+    let mut g = waiting_at_the_exit(&GameOptions { seed, time_limit_s: Some(1.0), idle_end_s, ..Default::default() });
     for _ in 0..90 {
         g.step(TICK_S);
     }
@@ -644,13 +649,7 @@ fn a_vive_back_numbers_his_moves_afresh_and_they_count() {
 #[test]
 fn a_drain_lets_a_running_heist_finish_then_closes_and_closes_a_lobby_at_once() {
     // A heist under way goes on, its players told once; its result closes the session (no rematch).
-    let options = GameOptions { seed: 3, time_limit_s: Some(2.0), ..Default::default() };
-    let mut g = Game::new(Level::museum(), &options);
-    g.join(Role::Vive);
-    g.join(Role::Phantom);
-    g.apply(Role::Vive, &ClientMsg::Lobby(LobbyMsg::Ready)).unwrap();
-    g.apply(Role::Phantom, &ClientMsg::Lobby(LobbyMsg::Ready)).unwrap();
-    g.vive.position = g.level.exit;
+    let mut g = waiting_at_the_exit(&GameOptions { seed: 3, time_limit_s: Some(2.0), ..Default::default() });
     let _ = events(&mut g);
     g.drain(600);
     g.drain(600);
