@@ -51,7 +51,7 @@ impl Action {
     /// The intent a bot's (or a test's) `ViveMsg` stands for; `Move` is not an action.
     pub fn from_message(msg: &ViveMsg) -> Option<Self> {
         Some(match *msg {
-            ViveMsg::Move { .. } => return None,
+            ViveMsg::Move { .. } | ViveMsg::WarningSeen(_) => return None,
             ViveMsg::Break(c) => Action::Break(c),
             ViveMsg::PickUp(i) => Action::PickUp(i),
             ViveMsg::Drop(i) => Action::Drop(i),

@@ -5,6 +5,7 @@
 #![warn(missing_docs)]
 
 pub mod demo;
+pub mod embedded;
 pub mod fleet;
 pub mod game;
 pub mod load;

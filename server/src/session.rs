@@ -256,6 +256,7 @@ impl SessionLog {
             }
             GameEvent::Alarm(level) => (Record::Note, format!("alarm level {level}")),
             GameEvent::Warning(w) => (Record::Note, format!("Phantom warns Vive: {w:?}")),
+            GameEvent::WarningSeen(w) => (Record::Note, format!("Vive's client shows the warning: {w:?}")),
             GameEvent::Joined(role) => (Record::PlayerJoined(*role), format!("{role} joined")),
             GameEvent::Left { role, dropped: false } => (Record::PlayerLeft(*role), format!("{role} left")),
             GameEvent::Left { role, dropped: true } => {

@@ -29,6 +29,10 @@ impl Game {
                 self.vive.inputs.push_back(super::MoveInput { seq, direction, speed, stance, facing });
                 Ok(())
             }
+            ViveMsg::WarningSeen(kind) => {
+                self.outgoing.push(Outgoing::To(Role::Phantom, ServerMsg::Event(GameEvent::WarningSeen(kind))));
+                Ok(())
+            }
             _ if self.phase != Phase::Heist => self.apply_vive_action(msg),
             _ => {
                 self.fast_forward_inputs(super::TICK_S);
@@ -39,7 +43,7 @@ impl Game {
 
     fn apply_vive_action(&mut self, msg: &ViveMsg) -> Result<(), Refusal> {
         match *msg {
-            ViveMsg::Move { .. } => Ok(()),
+            ViveMsg::Move { .. } | ViveMsg::WarningSeen(_) => Ok(()),
             ViveMsg::Break(case) => self.break_case(case),
             ViveMsg::PickUp(item) => self.pick_up(item),
             ViveMsg::Drop(item) => {

@@ -337,6 +337,7 @@ impl Game {
                     }
                     return Ok(());
                 }
+                ClientMsg::Vive(ViveMsg::WarningSeen(_)) => {}
                 ClientMsg::Vive(_) | ClientMsg::Phantom(PhantomMsg::Verdict { .. }) => return Err(Refusal::Paused),
                 _ => {}
             }

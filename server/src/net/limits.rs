@@ -18,7 +18,7 @@ pub enum MsgKind {
     Verdict,
     /// Phantom's tool pose: 20 a second from the client.
     ToolPose,
-    /// Phantom's warnings to Vive.
+    /// Phantom's warnings to Vive, and Vive's client's acknowledgements of them.
     Warn,
 }
 
@@ -32,6 +32,8 @@ impl MsgKind {
         Some(match msg {
             ClientMsg::Lobby(_) => MsgKind::Ready,
             ClientMsg::Vive(ViveMsg::Move { .. }) => MsgKind::Move,
+            // As many as Phantom's warnings (the same rate).
+            ClientMsg::Vive(ViveMsg::WarningSeen(_)) => MsgKind::Warn,
             ClientMsg::Vive(_) => MsgKind::Action,
             ClientMsg::Phantom(PhantomMsg::Verdict { .. }) => MsgKind::Verdict,
             ClientMsg::Phantom(PhantomMsg::ToolPose { .. }) => MsgKind::ToolPose,
@@ -55,20 +57,35 @@ impl MsgKind {
     }
 }
 
-/// One client's buckets, one per kind.
+/// Voice frames: one per 20 ms from an honest client (50 a second), with room for a stall's backlog.
+pub const VOICE: Rate = Rate::new(60.0, 30.0);
+
+/// The share of a refusal (one strike) a voice frame over [`VOICE`] counts: a client slightly over
+/// the rate loses frames, one flooding is disconnected within seconds.
+pub const VOICE_STRIKE: f32 = 0.1;
+
+/// One client's buckets, one per kind, and one for voice frames.
 #[derive(Clone, Copy, Debug)]
-pub struct MessageLimits([Bucket; 6]);
+pub struct MessageLimits {
+    kinds: [Bucket; 6],
+    voice: Bucket,
+}
 
 impl MessageLimits {
     /// Full buckets at `now_s`.
     pub fn new(now_s: f64) -> Self {
-        Self(MsgKind::ALL.map(|k| Bucket::full(k.rate(), now_s)))
+        Self { kinds: MsgKind::ALL.map(|k| Bucket::full(k.rate(), now_s)), voice: Bucket::full(VOICE, now_s) }
     }
 
     /// `Ok` when `msg` is within its kind's rate (it takes a token), else the refusal.
     pub fn check(&mut self, msg: &ClientMsg, now_s: f64) -> Result<(), Refusal> {
         let Some(kind) = MsgKind::of(msg) else { return Ok(()) };
-        if self.0[kind as usize].take(kind.rate(), now_s) { Ok(()) } else { Err(Refusal::RateLimited) }
+        if self.kinds[kind as usize].take(kind.rate(), now_s) { Ok(()) } else { Err(Refusal::RateLimited) }
+    }
+
+    /// True when a voice frame is within [`VOICE`] (it takes a token).
+    pub fn check_voice(&mut self, now_s: f64) -> bool {
+        self.voice.take(VOICE, now_s)
     }
 }
 
@@ -101,6 +118,23 @@ mod tests {
         while l.check(&warn, 0.0).is_ok() {}
         let verdict = ClientMsg::Phantom(PhantomMsg::Verdict { item: heist_shared::protocol::ItemId(0), real: true });
         assert_eq!(l.check(&verdict, 0.0), Ok(()));
+    }
+
+    #[test]
+    fn a_talking_client_is_never_limited_and_a_voice_flood_is() {
+        let mut l = MessageLimits::new(0.0);
+        // Fifty frames a second for a minute; now and then half a second's worth arrives at once (a stall).
+        for second in 0..60 {
+            for i in 0..50 {
+                let bunched = f64::from(second) + if i < 25 { 0.0 } else { 0.5 };
+                let at = if second % 10 == 9 { bunched } else { f64::from(second) + f64::from(i) * 0.02 };
+                assert!(l.check_voice(at), "frame {i} of second {second}");
+            }
+        }
+        let passed = (0..1000).filter(|i| l.check_voice(60.0 + f64::from(*i) * 0.001)).count();
+        assert!(passed < 100, "a thousand frames a second: {passed} passed");
+        let warn = ClientMsg::Phantom(PhantomMsg::Warn(WarningKind::Go));
+        assert_eq!(l.check(&warn, 61.0), Ok(()), "voice has a budget of its own");
     }
 
     #[test]

@@ -12,6 +12,7 @@ pub mod seats;
 pub mod send;
 pub mod tokens;
 pub mod transport;
+pub mod voice;
 
 use std::net::{SocketAddr, UdpSocket};
 use std::time::{SystemTime, UNIX_EPOCH};
@@ -138,7 +139,10 @@ impl Plugin for ServerNetPlugin {
             .add_observer(log_disconnect)
             .configure_sets(PreUpdate, NetSystems::Receive.after(ServerSystems::Receive))
             .configure_sets(PostUpdate, NetSystems::Send.before(ServerSystems::Send))
-            .add_systems(PreUpdate, receive::apply_client_messages.in_set(NetSystems::Receive))
+            .add_systems(
+                PreUpdate,
+                (receive::apply_client_messages, voice::relay_voice).chain().in_set(NetSystems::Receive),
+            )
             .add_systems(
                 PostUpdate,
                 (send::send_outgoing, admission::give_up_seats, close_sessions).chain().in_set(NetSystems::Send),

@@ -79,6 +79,8 @@ pub enum ViveMsg {
     },
     /// Place a carried copy on Phantom's workbench (within reach of it).
     PlaceOnWorkbench(ItemId),
+    /// Vive's client has shown Phantom's warning (sent by the client itself, so Phantom knows it arrived).
+    WarningSeen(WarningKind),
 }
 
 /// What Phantom warns Vive about.

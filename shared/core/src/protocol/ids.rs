@@ -12,6 +12,14 @@ pub enum Role {
 }
 
 impl Role {
+    /// The other role: the partner's.
+    pub const fn partner(self) -> Role {
+        match self {
+            Role::Vive => Role::Phantom,
+            Role::Phantom => Role::Vive,
+        }
+    }
+
     /// Byte stored in the connect token.
     pub const fn to_byte(self) -> u8 {
         match self {

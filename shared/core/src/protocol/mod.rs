@@ -10,6 +10,7 @@ mod replicated;
 mod server_msg;
 mod token;
 mod verify;
+pub mod voice;
 
 pub use client_msg::{ClientMsg, Gait, LobbyMsg, PhantomMsg, ViveMsg, WarningKind, decode as decode_client_msg};
 pub use ids::{CaseId, GuardId, ItemId, Role};
@@ -20,6 +21,7 @@ pub use replicated::{
 pub use server_msg::{DisconnectReason, GameEvent, NoiseKind, Refusal, ServerMsg, VerdictOutcome, WorkbenchCopy};
 pub use token::{SeatTicket, TokenUserData, USER_DATA_MAGIC};
 pub use verify::verify;
+pub use voice::{ClientVoice, PartnerVoice, VoiceFrame};
 
 use bevy::prelude::*;
 use bevy_replicon::prelude::*;
@@ -36,6 +38,9 @@ pub enum GameChannel {
     /// Client intents and actions, server replies and events: reliable and ordered, so an action is
     /// never lost or applied before the movement that brought the player in reach.
     Commands,
+    /// The walkie-talkie's voice frames (one channel each way): unreliable, so a lost frame is
+    /// concealed by the receiver instead of resent late, and nothing on it waits for anything else.
+    Voice,
 }
 
 impl GameChannel {
@@ -43,6 +48,7 @@ impl GameChannel {
     pub const fn replicon(self) -> Channel {
         match self {
             GameChannel::Commands => Channel::Ordered,
+            GameChannel::Voice => Channel::Unreliable,
         }
     }
 }
@@ -59,6 +65,9 @@ impl Plugin for ProtocolPlugin {
             client_msg::deserialize,
         )
         .add_server_message::<ServerMsg>(GameChannel::Commands.replicon())
-        .make_message_independent::<ServerMsg>();
+        .make_message_independent::<ServerMsg>()
+        .add_client_message_with::<ClientVoice>(GameChannel::Voice.replicon(), voice::serialize, voice::deserialize)
+        .add_server_message::<PartnerVoice>(GameChannel::Voice.replicon())
+        .make_message_independent::<PartnerVoice>();
     }
 }

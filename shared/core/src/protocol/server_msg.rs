@@ -110,8 +110,10 @@ pub enum GameEvent {
     },
     /// The alarm level changed.
     Alarm(u8),
-    /// Phantom warns Vive.
+    /// Phantom warns Vive (sent to both: to Phantom it confirms the warning went out).
     Warning(WarningKind),
+    /// Vive's client has shown Phantom's warning (sent to Phantom only).
+    WarningSeen(WarningKind),
     /// A player came into the session (the first time or again).
     Joined(Role),
     /// A player whose connection was lost took their seat back.

@@ -15,6 +15,8 @@ pub fn verify(role: Role, phase: Phase, msg: &ClientMsg) -> Result<(), Refusal> 
         ClientMsg::Lobby(LobbyMsg::Rematch) if matches!(phase, Phase::Won | Phase::Lost(_)) => Ok(()),
         ClientMsg::Lobby(LobbyMsg::Rematch) => Err(Refusal::WrongPhase(phase)),
         ClientMsg::Vive(_) if role != Role::Vive => Err(Refusal::WrongRole),
+        // Phantom may warn in the lobby too, so the acknowledgement is welcome in every phase.
+        ClientMsg::Vive(V::WarningSeen(_)) => Ok(()),
         ClientMsg::Phantom(_) if role != Role::Phantom => Err(Refusal::WrongRole),
         ClientMsg::Phantom(PhantomMsg::Warn(_) | PhantomMsg::ToolPose { .. }) if phase == Phase::Lobby => {
             // Harmless before the heist: lets Phantom try the device in the lobby.
