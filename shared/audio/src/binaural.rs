@@ -8,6 +8,7 @@
 
 use std::collections::VecDeque;
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use glam::Vec3;
 use kira::Frame;
@@ -43,13 +44,35 @@ impl Placement {
     }
 }
 
-/// How the effect renders.
+/// How the effects render: convolution with an HRIR sphere while HRTF is on (and a sphere is there),
+/// interaural time and level differences otherwise. Clones share the switch, so one
+/// [`Spatializer::set_hrtf`] turns every voice over at its next block.
 #[derive(Clone)]
-pub enum Spatializer {
-    /// Convolution with an HRIR sphere.
-    Hrtf(Arc<hrtf::HrirSphere>),
-    /// Interaural time and level differences only.
-    TimeLevel,
+pub struct Spatializer {
+    sphere: Option<Arc<hrtf::HrirSphere>>,
+    hrtf_on: Arc<AtomicBool>,
+}
+
+impl Spatializer {
+    /// Renders with `sphere`, HRTF on at first when `on`.
+    pub fn hrtf(sphere: hrtf::HrirSphere, on: bool) -> Self {
+        Self { sphere: Some(Arc::new(sphere)), hrtf_on: Arc::new(AtomicBool::new(on)) }
+    }
+
+    /// Time and level differences only (no sphere: HRTF cannot be turned on).
+    pub fn time_level() -> Self {
+        Self { sphere: None, hrtf_on: Arc::new(AtomicBool::new(false)) }
+    }
+
+    /// Turns HRTF on or off for every voice (no effect without a sphere).
+    pub fn set_hrtf(&self, on: bool) {
+        self.hrtf_on.store(on, Ordering::Relaxed);
+    }
+
+    /// True when the voices render with the HRTF.
+    pub fn uses_hrtf(&self) -> bool {
+        self.sphere.is_some() && self.hrtf_on.load(Ordering::Relaxed)
+    }
 }
 
 /// Builds a [`BinauralHandle`]'s effect.
@@ -130,7 +153,7 @@ impl Effect for BinauralEffect {
         // Longest interaural delay plus the common one, with margin.
         let max_delay = ((2.0 * HEAD_RADIUS_M / SPEED_OF_SOUND_M_PER_S + 0.002) * sample_rate as f32) as usize + 2;
         self.delay_line = VecDeque::from(vec![0.0; max_delay]);
-        if let Spatializer::Hrtf(sphere) = &self.spatializer {
+        if let Some(sphere) = &self.spatializer.sphere {
             self.processor = Some(hrtf::HrtfProcessor::new((**sphere).clone(), 1, BLOCK));
         }
     }
@@ -140,7 +163,13 @@ impl Effect for BinauralEffect {
     }
 
     fn process(&mut self, input: &mut [Frame], _dt: f64, _info: &Info) {
-        match self.processor.as_mut() {
+        let hrtf_on = self.spatializer.hrtf_on.load(Ordering::Relaxed);
+        if !hrtf_on && !self.fifo_in.is_empty() {
+            // Switched off: what the convolution still held is dropped, not played late.
+            self.fifo_in.clear();
+            self.fifo_out.clear();
+        }
+        match self.processor.as_mut().filter(|_| hrtf_on) {
             Some(processor) => {
                 for f in input.iter() {
                     self.fifo_in.push_back(0.5 * (f.left + f.right));

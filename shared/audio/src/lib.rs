@@ -87,17 +87,6 @@ impl Manager {
         };
         r.map_err(|e| AudioError(format!("no room for a track: {e}")))
     }
-
-    fn play_main(&mut self, sound: StaticSoundData) {
-        let r = match self {
-            Self::Memory(m) => m.main_track().play(sound).map(drop),
-            #[cfg(feature = "sound-card")]
-            Self::Card(m) => m.main_track().play(sound).map(drop),
-        };
-        if let Err(e) = r {
-            log::warn!("audio: {e}");
-        }
-    }
 }
 
 struct Voice {
@@ -168,12 +157,32 @@ impl Drop for Pump {
     }
 }
 
+/// The volumes of the engine's groups, decibels (0 = as synthesized; [`kira::Decibels::SILENCE`] mutes).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Volumes {
+    /// Speech.
+    pub speech_db: f32,
+    /// The museum's sounds and the contact sound.
+    pub sound_db: f32,
+    /// Earcons.
+    pub earcon_db: f32,
+    /// The partner's voice (walkie-talkie).
+    pub voice_db: f32,
+}
+
 /// The audio engine (see the module docs).
 pub struct AudioEngine {
-    manager: Manager,
+    /// Kept for its life: dropping the manager stops the sound.
+    _manager: Manager,
+    spatializer: Spatializer,
     voices: Vec<Voice>,
     next: usize,
     speech: Voice,
+    earcons: TrackHandle,
+    partner: Voice,
+    /// Speech waiting to be said, and the line being said.
+    speech_queue: std::collections::VecDeque<StaticSoundData>,
+    saying: Option<kira::sound::static_sound::StaticSoundHandle>,
     contact: Option<ContactHandle>,
     capture: Option<Capture>,
     _pump: Option<Pump>,
@@ -187,24 +196,24 @@ pub struct AudioEngine {
 
 /// Where the speech voice sits: just ahead of the listener.
 pub const SPEECH_OFFSET: Vec3 = Vec3::new(0.0, 0.0, -0.8);
+/// Lines of speech that may wait to be said; past this the oldest is dropped.
+pub const MAX_QUEUED_SPEECH: usize = 32;
+/// Where the partner's voice sits until it is placed: a radio just below and ahead.
+pub const PARTNER_OFFSET: Vec3 = Vec3::new(0.1, -0.2, -0.3);
 /// Where the contact sound sits: the copy on the workbench, ahead and below.
 pub const CONTACT_OFFSET: Vec3 = Vec3::new(0.0, -0.3, -0.45);
 
 impl AudioEngine {
     /// Starts the engine.
     pub fn new(settings: &AudioSettings) -> Result<Self, AudioError> {
-        let spatializer = match settings.spatial {
-            SpatialMode::Hrtf => {
-                let bytes = hrir::sphere_bytes(settings.sample_rate);
-                match hrtf::HrirSphere::new(std::io::Cursor::new(bytes), settings.sample_rate) {
-                    Ok(s) => Spatializer::Hrtf(Arc::new(s)),
-                    Err(e) => {
-                        log::warn!("audio: HRIR sphere unusable ({e:?}); using time and level differences");
-                        Spatializer::TimeLevel
-                    }
-                }
+        // The sphere is loaded either way, so HRTF can be turned on and off while playing.
+        let bytes = hrir::sphere_bytes(settings.sample_rate);
+        let spatializer = match hrtf::HrirSphere::new(std::io::Cursor::new(bytes), settings.sample_rate) {
+            Ok(s) => Spatializer::hrtf(s, settings.spatial == SpatialMode::Hrtf),
+            Err(e) => {
+                log::warn!("audio: HRIR sphere unusable ({e:?}); using time and level differences");
+                Spatializer::time_level()
             }
-            SpatialMode::TimeLevel => Spatializer::TimeLevel,
         };
         let (mut manager, capture, pump) = Self::open(settings)?;
         let voice = |manager: &mut Manager, at: Vec3| -> Result<Voice, AudioError> {
@@ -215,16 +224,23 @@ impl AudioEngine {
         let voices =
             (0..settings.voices.max(1)).map(|_| voice(&mut manager, Vec3::NEG_Z)).collect::<Result<Vec<_>, _>>()?;
         let speech = voice(&mut manager, SPEECH_OFFSET)?;
+        let partner = voice(&mut manager, PARTNER_OFFSET)?;
+        let earcons = manager.add_sub_track(TrackBuilder::new())?;
         let mut contact_voice = voice(&mut manager, CONTACT_OFFSET)?;
         let contact = contact_voice.track.play(ContactSoundData).ok();
         // The contact voice's track lives as long as its handle: it is kept last among the voices.
         let mut voices = voices;
         voices.push(contact_voice);
         Ok(Self {
-            manager,
+            _manager: manager,
+            spatializer,
             voices,
             next: 0,
             speech,
+            earcons,
+            partner,
+            speech_queue: std::collections::VecDeque::new(),
+            saying: None,
             contact,
             capture,
             _pump: pump,
@@ -316,17 +332,79 @@ impl AudioEngine {
 
     /// An earcon, centred in the head.
     pub fn earcon(&mut self, e: Earcon) {
-        self.manager.play_main(synth::earcon(e));
+        if let Err(err) = self.earcons.play(synth::earcon(e)) {
+            log::warn!("audio: {err}");
+        }
         self.note(&format!("earcon {e:?}"), Vec3::ZERO);
     }
 
+    /// Sets the groups' volumes (they glide there in 50 ms).
+    pub fn set_volumes(&mut self, v: Volumes) {
+        let tween = kira::Tween { duration: Duration::from_millis(50), ..Default::default() };
+        let db = |x: f32| kira::Decibels(x.max(kira::Decibels::SILENCE.0));
+        self.speech.track.set_volume(db(v.speech_db), tween);
+        for voice in &mut self.voices {
+            voice.track.set_volume(db(v.sound_db), tween);
+        }
+        self.earcons.set_volume(db(v.earcon_db), tween);
+        self.partner.track.set_volume(db(v.voice_db), tween);
+    }
+
+    /// Turns HRTF placement on (or back to time and level differences) for every voice.
+    pub fn set_hrtf(&mut self, on: bool) {
+        self.spatializer.set_hrtf(on);
+    }
+
+    /// True when sources are placed with the HRTF.
+    pub fn uses_hrtf(&self) -> bool {
+        self.spatializer.uses_hrtf()
+    }
+
+    /// Plays a stream (the partner's voice) on the partner's voice, placed by [`AudioEngine::place_partner`].
+    pub fn play_partner<D: kira::sound::SoundData>(&mut self, data: D) -> Result<D::Handle, AudioError> {
+        self.note("partner voice", PARTNER_OFFSET);
+        self.partner.track.play(data).map_err(|e| AudioError(format!("the partner's voice: {e}")))
+    }
+
+    /// Moves the partner's voice to `offset` (listener frame, m).
+    pub fn place_partner(&mut self, offset: Vec3) {
+        self.partner.place.set(Placement { offset });
+    }
+
     /// Speech, from just ahead, 6 dB down (espeak-ng speaks at full scale; earcons and the museum mix in).
+    /// Lines are said one after the other, never over each other: each waits for the one before to end
+    /// (call [`AudioEngine::update`] every frame to start the next).
     pub fn speak(&mut self, mut sound: StaticSoundData) {
         sound.settings.volume = kira::Value::Fixed(kira::Decibels(-6.0));
-        if let Err(e) = self.speech.track.play(sound) {
-            log::warn!("audio: {e}");
+        if self.speech_queue.len() >= MAX_QUEUED_SPEECH {
+            log::warn!("audio: {MAX_QUEUED_SPEECH} lines wait to be said; the oldest is dropped");
+            self.speech_queue.pop_front();
         }
-        self.note("speech", SPEECH_OFFSET);
+        self.speech_queue.push_back(sound);
+        self.update();
+    }
+
+    /// Starts the next line of speech when the one being said has ended.
+    pub fn update(&mut self) {
+        use kira::sound::PlaybackState;
+        let busy = self.saying.as_ref().is_some_and(|h| h.state() != PlaybackState::Stopped);
+        if busy {
+            return;
+        }
+        self.saying = None;
+        if let Some(next) = self.speech_queue.pop_front() {
+            match self.speech.track.play(next) {
+                Ok(handle) => self.saying = Some(handle),
+                Err(e) => log::warn!("audio: {e}"),
+            }
+            self.note("speech", SPEECH_OFFSET);
+        }
+    }
+
+    /// True while speech is being said or waits to be.
+    pub fn is_speaking(&self) -> bool {
+        !self.speech_queue.is_empty()
+            || self.saying.as_ref().is_some_and(|h| h.state() != kira::sound::PlaybackState::Stopped)
     }
 
     /// Follows the haptic contact with the contact sound.

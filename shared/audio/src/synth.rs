@@ -105,10 +105,29 @@ pub enum Earcon {
     Won,
     /// The heist is lost (falling arpeggio).
     Lost,
+    /// The partner joined or came back (two rising notes, a third apart).
+    PartnerIn,
+    /// The partner left or dropped (two falling notes, a third apart).
+    PartnerOut,
+    /// The connection to the server is lost (two low notes).
+    LinkDown,
+    /// The connection is back (two quick low-to-high notes).
+    LinkUp,
+    /// The partner's client has the warning (a short high chirp).
+    WarningHeard,
+    /// A walkie-talkie transmission starts (a squelch burst and a click).
+    SquelchOpen,
+    /// A walkie-talkie transmission ends (a squelch tail and a low beep).
+    SquelchClose,
 }
 
 /// The earcon's sound.
 pub fn earcon(e: Earcon) -> StaticSoundData {
+    match e {
+        Earcon::SquelchOpen => return squelch(0.08, 1800.0),
+        Earcon::SquelchClose => return squelch(0.16, 900.0),
+        _ => {}
+    }
     let notes: &[(f32, f32)] = match e {
         Earcon::CopyArrived => &[(660.0, 0.12)],
         Earcon::ReadyToFeel => &[(880.0, 0.07), (880.0, 0.07)],
@@ -117,12 +136,33 @@ pub fn earcon(e: Earcon) -> StaticSoundData {
         Earcon::AlarmUp => &[(1400.0, 0.06), (1400.0, 0.06), (1400.0, 0.06)],
         Earcon::Won => &[(523.0, 0.12), (659.0, 0.12), (784.0, 0.12), (1047.0, 0.3)],
         Earcon::Lost => &[(784.0, 0.15), (622.0, 0.15), (523.0, 0.15), (392.0, 0.4)],
+        Earcon::PartnerIn => &[(587.0, 0.1), (740.0, 0.16)],
+        Earcon::PartnerOut => &[(740.0, 0.1), (587.0, 0.16)],
+        Earcon::LinkDown => &[(262.0, 0.15), (262.0, 0.25)],
+        Earcon::LinkUp => &[(262.0, 0.08), (392.0, 0.12)],
+        Earcon::WarningHeard => &[(1760.0, 0.05)],
+        Earcon::SquelchOpen | Earcon::SquelchClose => &[],
     };
     let mut out = Vec::new();
     for &(f, d) in notes {
         out.extend(samples(d, |t| 0.3 * (TAU * f * t).sin() * (t / 0.005).min(1.0) * (-(t / d) * 3.0).exp()));
         out.extend(samples(0.03, |_| 0.0));
     }
+    mono(&out)
+}
+
+/// A radio's squelch: band-passed noise for `len` seconds ending in a short beep at `beep_hz`.
+fn squelch(len: f32, beep_hz: f32) -> StaticSoundData {
+    let mut noise = Noise::new(23);
+    let (mut lp, mut hp) = (0.0, 0.0);
+    let mut out = samples(len, |t| {
+        // A crude band-pass (about 300 Hz to 3 kHz), the band a walkie-talkie carries.
+        let n = noise.next_sample();
+        lp += 0.3 * (n - lp);
+        hp += 0.04 * (lp - hp);
+        0.35 * (lp - hp) * (t / 0.003).min(1.0) * (1.0 - t / len).max(0.0).sqrt()
+    });
+    out.extend(samples(0.04, |t| 0.2 * (TAU * beep_hz * t).sin() * (1.0 - t / 0.04)));
     mono(&out)
 }
 

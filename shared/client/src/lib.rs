@@ -10,6 +10,7 @@ mod error;
 pub mod notice;
 pub mod rejoin;
 pub mod seats;
+pub mod signals;
 mod token;
 pub mod transport;
 
@@ -106,8 +107,19 @@ impl Plugin for ClientNetPlugin {
     }
 }
 
-fn fill_inbox(mut messages: MessageReader<ServerMsg>, mut inbox: ResMut<Inbox>) {
+/// Server messages into [`Inbox`]; as Vive, a warning from Phantom is acknowledged at once (Phantom hears
+/// that it arrived).
+fn fill_inbox(
+    mut messages: MessageReader<ServerMsg>,
+    mut inbox: ResMut<Inbox>,
+    mut out: MessageWriter<heist_shared::protocol::ClientMsg>,
+) {
     for msg in messages.read() {
+        if let ServerMsg::Event(GameEvent::Warning(w)) = msg
+            && inbox.role == Some(Role::Vive)
+        {
+            out.write(heist_shared::protocol::ClientMsg::Vive(heist_shared::protocol::ViveMsg::WarningSeen(*w)));
+        }
         match msg.clone() {
             ServerMsg::Welcome { role, level, seat, resumed } => {
                 inbox.role = Some(role);
