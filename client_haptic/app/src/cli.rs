@@ -90,11 +90,11 @@ pub struct PracticeArgs {
 /// Arguments of `join`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct JoinArgs {
-    /// The server's address (its join endpoint), e.g. 127.0.0.1:5757.
-    pub addr: SocketAddr,
-    /// The join code the host printed.
+    /// The server's address (its join endpoint), e.g. 127.0.0.1:5757; asked for by speech when left out.
+    pub addr: Option<SocketAddr>,
+    /// The join code the host gave; asked for by speech when left out (then a wrong code is asked again).
     #[arg(long)]
-    pub code: String,
+    pub code: Option<String>,
     /// Device, window, audio and bot settings.
     #[command(flatten)]
     pub client: ClientArgs,
@@ -127,9 +127,40 @@ pub struct ClientArgs {
     /// Also write what was heard to this WAV file (with `--audio memory`).
     #[arg(long)]
     pub wav: Option<PathBuf>,
-    /// Place sounds with interaural time and level differences instead of the HRTF.
+    /// Place sounds with interaural time and level differences instead of the HRTF (this run only).
     #[arg(long)]
     pub no_hrtf: bool,
+    /// The settings file (default: settings.toml in the platform's config directory, e.g.
+    /// ~/.config/phantom-heist/); the settings menu saves there.
+    #[arg(long)]
+    pub settings: Option<PathBuf>,
+    /// Speech rate for this run, words per minute (80–400).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(80..=400))]
+    pub speech_rate: Option<u32>,
+    /// Speech volume for this run, percent.
+    #[arg(long, value_parser = clap::value_parser!(u8).range(0..=100))]
+    pub speech_volume: Option<u8>,
+    /// Museum and contact sound volume for this run, percent.
+    #[arg(long, value_parser = clap::value_parser!(u8).range(0..=100))]
+    pub sound_volume: Option<u8>,
+    /// Earcon volume for this run, percent.
+    #[arg(long, value_parser = clap::value_parser!(u8).range(0..=100))]
+    pub earcon_volume: Option<u8>,
+    /// The partner's voice volume for this run, percent.
+    #[arg(long, value_parser = clap::value_parser!(u8).range(0..=100))]
+    pub voice_volume: Option<u8>,
+    /// The push-to-talk key for this run.
+    #[arg(long, value_enum)]
+    pub talk_key: Option<crate::settings::TalkKey>,
+    /// A WAV file as the walkie-talkie's microphone: each transmission says it from its start.
+    #[arg(long, conflicts_with = "no_mic")]
+    pub mic_wav: Option<PathBuf>,
+    /// No microphone: the walkie-talkie only listens (also with `--audio memory` and no --mic-wav).
+    #[arg(long)]
+    pub no_mic: bool,
+    /// Transmit from the start without push-to-talk (with --mic-wav: say the file once, then stop).
+    #[arg(long)]
+    pub open_mic: bool,
     /// Real-time priority (1–99) for the haptic thread, if the system allows it.
     #[arg(long)]
     pub realtime: Option<i32>,
@@ -148,6 +179,19 @@ impl ClientArgs {
             return Err("--bot moves the hand itself: it needs --device sim".into());
         }
         let cache = self.cache.clone().or_else(default_cache);
+        let overrides = crate::settings::Overrides {
+            speech_rate: self.speech_rate,
+            speech_volume: self.speech_volume,
+            sound_volume: self.sound_volume,
+            earcon_volume: self.earcon_volume,
+            voice_volume: self.voice_volume,
+            hrtf: self.no_hrtf.then_some(false),
+            talk_key: self.talk_key,
+        };
+        let prefs = crate::settings::plugin::Settings::load(
+            self.settings.clone().or_else(crate::settings::default_path),
+            &overrides,
+        );
         Ok(PhantomSettings {
             bot: self.bot,
             haptics: HapticsSettings {
@@ -162,8 +206,18 @@ impl ClientArgs {
                     AudioChoice::Card => AudioOutput::SoundCard,
                     AudioChoice::Memory => AudioOutput::Background(self.wav.clone()),
                 },
-                spatial: if self.no_hrtf { SpatialMode::TimeLevel } else { SpatialMode::Hrtf },
+                spatial: if prefs.run.hrtf { SpatialMode::Hrtf } else { SpatialMode::TimeLevel },
                 ..Default::default()
+            },
+            prefs,
+            voice: heist_voice::VoiceSettings {
+                // Rendering into memory means no sound device: no microphone either, unless a file is it.
+                mic: match (&self.mic_wav, self.no_mic || self.audio == AudioChoice::Memory) {
+                    (Some(path), _) => heist_voice::MicChoice::Wav(path.clone()),
+                    (None, true) => heist_voice::MicChoice::Off,
+                    (None, false) => heist_voice::MicChoice::Device,
+                },
+                mode: if self.open_mic { heist_voice::TalkMode::Open } else { heist_voice::TalkMode::PushToTalk },
             },
         })
     }
@@ -183,6 +237,7 @@ pub fn app(
     settings: PhantomSettings,
     headless: bool,
     practice: Option<crate::practice::Practice>,
+    voices: Option<(crate::audio::AudioEngine, crate::speech::Speaker)>,
 ) -> Result<App, crate::ClientError> {
     let mut app = App::new();
     if headless {
@@ -200,7 +255,15 @@ pub fn app(
         Some(p) => app.insert_resource(p).add_plugins(crate::practice::PracticePlugin),
     };
     let bot = settings.bot;
-    crate::client::start(&mut app, settings)?;
+    let voice = settings.voice.clone();
+    match voices {
+        Some((audio, speaker)) => crate::client::start_with(&mut app, settings, audio, speaker)?,
+        None => crate::client::start(&mut app, settings)?,
+    }
+    app.add_plugins(heist_client::signals::SignalsPlugin);
+    if !practising {
+        app.insert_resource(voice).add_plugins((heist_voice::VoicePlugin, crate::walkie::WalkiePlugin));
+    }
     if headless && !bot {
         app.add_plugins(crate::terminal::TerminalKeysPlugin);
     }
@@ -293,10 +356,29 @@ fn tell_the_link(
     mut ended_at: Local<Option<f32>>,
     leaving: Res<heist_client::Leaving>,
     mut speaker: NonSendMut<crate::speech::Speaker>,
+    (mut audio, mut was, mut told_gave_up): (
+        NonSendMut<crate::audio::AudioEngine>,
+        Local<heist_client::Link>,
+        Local<bool>,
+    ),
     mut exit: MessageWriter<AppExit>,
 ) {
+    use heist_client::Link;
     let now = time.elapsed_secs();
-    for line in news.news(*link, &inbox, &leaving, &reconnect) {
+    let lines = news.news(*link, &inbox, &leaving, &reconnect);
+    // Earcons with the words: lost (and given up) low, back rising.
+    let gave_up = matches!(*reconnect, heist_client::Reconnect::GaveUp(_));
+    match (*was, *link) {
+        (Link::Up, Link::Silent | Link::Gone) if leaving.since.is_none() => {
+            audio.earcon(crate::audio::synth::Earcon::LinkDown)
+        }
+        (Link::Silent, Link::Up) => audio.earcon(crate::audio::synth::Earcon::LinkUp),
+        _ if gave_up && !*told_gave_up => audio.earcon(crate::audio::synth::Earcon::LinkDown),
+        _ => {}
+    }
+    *told_gave_up = gave_up;
+    *was = *link;
+    for line in lines {
         speaker.say(line);
     }
     if heist_client::connection_over(*link, &inbox, &reconnect) {
@@ -307,29 +389,91 @@ fn tell_the_link(
     }
 }
 
-/// Runs `join`: gets a token, connects, plays until the session ends.
+/// Runs `join`: asks by speech for what the command line left out, gets a token (saying every failure
+/// and what to do next, and asking again where that helps), connects, plays until the session ends.
 pub fn join(args: &JoinArgs) -> anyhow::Result<()> {
-    use anyhow::Context as _;
-    let settings = args.client.settings().map_err(anyhow::Error::msg)?;
+    let mut settings = args.client.settings().map_err(anyhow::Error::msg)?;
+    let mut prompter = crate::prompt::Prompter::new(&mut settings)?;
     let cache = heist_client::SeatCache::in_default_dir();
-    let joining =
-        heist_client::join_or_resume(args.addr, &args.code, Role::Phantom, cache.as_ref(), Duration::from_secs(5))
-            .with_context(|| format!("joining {} as Phantom", args.addr))?;
-    let mut app = app(settings, args.client.headless, None)?;
+    let joined = get_a_seat(&mut prompter, args, cache.as_ref());
+    let (addr, joining) = match joined {
+        Ok(j) => j,
+        Err(e) => {
+            prompter.finish_speaking(Duration::from_secs(30));
+            return Err(e);
+        }
+    };
+    let (audio, speaker) = prompter.into_parts();
+    let mut app = app(settings, args.client.headless, None, Some((audio, speaker)))?;
     args.client.request_shot(&mut app);
     app.finish();
     app.cleanup();
     heist_client::connect(&mut app, joining.token)?;
-    heist_client::hold_seat(&mut app, cache, args.addr, Role::Phantom);
+    heist_client::hold_seat(&mut app, cache, addr, Role::Phantom);
     app.run();
     Ok(())
+}
+
+/// The token for a seat: from the command line's address and code, or from spoken questions.
+fn get_a_seat(
+    prompter: &mut crate::prompt::Prompter,
+    args: &JoinArgs,
+    cache: Option<&heist_client::SeatCache>,
+) -> anyhow::Result<(SocketAddr, heist_client::Joining)> {
+    use crate::prompt::Next;
+    let asking = args.code.is_none();
+    let no_answer = || anyhow::anyhow!("joining: no answer was typed");
+    let mut addr = args.addr;
+    let mut code = args.code.clone();
+    loop {
+        let at = match addr {
+            Some(a) => a,
+            None => *addr.insert(prompter.ask_address().ok_or_else(no_answer)?),
+        };
+        // A kept seat is taken back without the code.
+        let kept = cache.is_some_and(|c| c.load(at, Role::Phantom).is_some());
+        let typed = match (&code, kept) {
+            (Some(c), _) => c.clone(),
+            (None, true) => String::new(),
+            (None, false) => code.insert(prompter.ask_code().ok_or_else(no_answer)?).clone(),
+        };
+        if kept {
+            prompter.say("Taking your seat back.");
+        }
+        let result = match heist_client::join_or_resume(at, &typed, Role::Phantom, cache, Duration::from_secs(5)) {
+            // The kept seat is gone and no code was typed yet: ask for it.
+            Err(heist_client::JoinError::BadCode(_)) if typed.is_empty() => {
+                code = None;
+                continue;
+            }
+            other => other,
+        };
+        let e = match result {
+            Ok(joining) => return Ok((at, joining)),
+            Err(e) => e,
+        };
+        let (said, next) = crate::prompt::advice(&e);
+        prompter.say(said);
+        let error = anyhow::Error::new(e).context(format!("joining {at} as Phantom"));
+        match next {
+            _ if !asking => return Err(error),
+            Next::Address => addr = None,
+            Next::Code => code = None,
+            Next::Wait(s) => {
+                prompter.finish_speaking(Duration::from_secs(30));
+                std::thread::sleep(Duration::from_secs(u64::from(s.min(300))));
+                code = None;
+            }
+            Next::Stop => return Err(error),
+        }
+    }
 }
 
 /// Runs `practice`.
 pub fn practice(args: &PracticeArgs) -> anyhow::Result<()> {
     let settings = args.client.settings().map_err(anyhow::Error::msg)?;
     let kind = args.kind.into();
-    let mut app = app(settings, args.client.headless, Some(crate::practice::Practice::new(kind, args.seed)))?;
+    let mut app = app(settings, args.client.headless, Some(crate::practice::Practice::new(kind, args.seed)), None)?;
     args.client.request_shot(&mut app);
     app.run();
     Ok(())

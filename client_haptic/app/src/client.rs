@@ -37,6 +37,10 @@ pub struct PhantomSettings {
     pub haptics: HapticsSettings,
     /// The audio side.
     pub audio: AudioSettings,
+    /// The player's settings (file and command line) and where the menu saves them.
+    pub prefs: crate::settings::plugin::Settings,
+    /// The walkie-talkie's microphone and mode.
+    pub voice: heist_voice::VoiceSettings,
 }
 
 /// What is on the workbench, for the spectator window: the copy, its mesh and its (public) colour.
@@ -72,10 +76,18 @@ pub struct VerdictRecord {
     pub findings: Option<Findings>,
 }
 
-/// When this client hosts: the lines that give the partner the address and the join code, said after the
-/// welcome.
+/// When this client hosts: where the partner joins and with which code (said after the welcome), and
+/// the code spelled in the NATO alphabet (said slowly, last, so R repeats it).
 #[derive(Resource, Clone, Debug)]
-pub struct HostedCode(pub Vec<String>);
+pub struct HostedCode {
+    /// "You host the heist. Your partner joins at … with the code …."
+    pub intro: String,
+    /// "The code, spelled: kilo, seven, …. R repeats it."
+    pub spelled: String,
+}
+
+/// The speech rate the spelled code is said at most, words per minute.
+pub const SPELLING_WPM: u32 = 120;
 
 /// The Phantom client's memory.
 #[derive(Resource, Default, Debug)]
@@ -122,10 +134,23 @@ impl PhantomState {
 /// Adds the Phantom client to `app` (after the client core): opens the device, starts the haptic loop
 /// and audio, and adds the plugin.
 pub fn start(app: &mut App, settings: PhantomSettings) -> Result<(), ClientError> {
-    let haptics = Haptics::start(settings.haptics.clone())?;
     let audio = AudioEngine::new(&settings.audio)?;
-    app.insert_non_send(haptics).insert_non_send(audio).insert_non_send(Speaker::new());
-    app.add_plugins(PhantomClientPlugin { settings });
+    start_with(app, settings, audio, Speaker::new())
+}
+
+/// [`start`] with the audio engine and speaker already running (the spoken prompts before joining
+/// used them, and what they said stays in the same recording).
+pub fn start_with(
+    app: &mut App,
+    settings: PhantomSettings,
+    mut audio: AudioEngine,
+    mut speaker: Speaker,
+) -> Result<(), ClientError> {
+    let haptics = Haptics::start(settings.haptics.clone())?;
+    crate::settings::plugin::apply(&settings.prefs.run, &mut speaker, &mut audio);
+    app.insert_non_send(haptics).insert_non_send(audio).insert_non_send(speaker);
+    app.insert_resource(settings.prefs.clone());
+    app.add_plugins((PhantomClientPlugin { settings }, crate::settings::plugin::SettingsPlugin));
     Ok(())
 }
 
@@ -271,8 +296,9 @@ fn lobby(
             }
         });
         // Last, so R repeats the spelled code.
-        for line in hosted.iter().flat_map(|h| h.0.iter()) {
-            speaker.say(line.clone());
+        if let Some(h) = hosted {
+            speaker.say(h.intro.clone());
+            speaker.say_slowly(h.spelled.clone(), SPELLING_WPM);
         }
     }
     if settings.bot && s.phase == Phase::Lobby && !state.ready_sent {
@@ -302,9 +328,16 @@ fn keys(
     mut out: MessageWriter<ClientMsg>,
     mut leaving: Option<ResMut<heist_client::Leaving>>,
     mut exit: MessageWriter<AppExit>,
+    (prefs, mut open_settings): (
+        Res<crate::settings::plugin::Settings>,
+        MessageWriter<crate::settings::plugin::OpenSettings>,
+    ),
 ) {
     let Some(keys) = keys else { return };
     let Some(s) = session(&q) else { return };
+    if prefs.is_open() {
+        return; // the settings menu has the keys
+    }
     let status_line = |_: &PhantomState| {
         let g: Vec<&GuardView> = guards.iter().collect();
         status::status(&s, &g, vive.iter().next().map(|v| v.position))
@@ -330,7 +363,10 @@ fn keys(
                 MenuItem::Ready => speaker.say("You are ready. Waiting for Vive."),
                 MenuItem::Briefing => speaker.say("The briefing comes when the heist begins."),
                 MenuItem::Status => speaker.say(status_line(&state)),
-                MenuItem::Help => speaker.say(status::HELP),
+                MenuItem::Settings => {
+                    open_settings.write(crate::settings::plugin::OpenSettings);
+                }
+                MenuItem::Help => speaker.say(status::help(prefs.run.talk_key.name())),
             }
         }
     }
@@ -539,6 +575,11 @@ fn announce_events(
             speaker.say("Enter asks for another round; Q leaves.");
         }
         match e {
+            GameEvent::Joined(r) | GameEvent::Resumed(r) if *r == Role::Vive => audio.earcon(Earcon::PartnerIn),
+            GameEvent::Left { role: Role::Vive, .. } | GameEvent::GaveUp(Role::Vive) => {
+                audio.earcon(Earcon::PartnerOut)
+            }
+            GameEvent::WarningSeen(_) => audio.earcon(Earcon::WarningHeard),
             GameEvent::Verdict { outcome: VerdictOutcome::Wrong, .. } => audio.earcon(Earcon::Wrong),
             GameEvent::Verdict { .. } => audio.earcon(Earcon::Right),
             GameEvent::Alarm(_) => audio.earcon(Earcon::AlarmUp),
@@ -669,11 +710,12 @@ pub fn contact_params(
     }
 }
 
-/// Plays speech as it becomes ready.
+/// Plays speech as it becomes ready, one line after the other.
 fn speak(mut speaker: NonSendMut<Speaker>, mut audio: NonSendMut<AudioEngine>) {
     for s in speaker.ready() {
         audio.speak(s);
     }
+    audio.update();
 }
 
 /// Tells the server where the stylus is (20 times a second, during the heist) so Vive sees it move.

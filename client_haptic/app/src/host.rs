@@ -7,8 +7,6 @@ use std::net::SocketAddr;
 use std::time::Duration;
 
 use anyhow::Context as _;
-use heist_server::{Clock, DEFAULT_CODE_TTL, ServerOptions, build_server};
-use heist_shared::level::Level;
 use heist_shared::protocol::Role;
 
 use crate::cli::ClientArgs;
@@ -25,8 +23,11 @@ pub struct HostArgs {
     /// Seed of the first round (default: random, so nobody knows which copies are real).
     #[arg(long)]
     pub seed: Option<u64>,
+    /// Seconds a heist lasts (default: the museum's 600).
+    #[arg(long)]
+    pub time_limit: Option<f32>,
     /// Create the session on this running server (`heist-server serve`) instead of hosting one here.
-    #[arg(long, conflicts_with_all = ["bind", "advertise", "seed"])]
+    #[arg(long, conflicts_with_all = ["bind", "advertise", "seed", "time_limit"])]
     pub server: Option<SocketAddr>,
     /// Device, window, audio and bot settings, as for `join`.
     #[command(flatten)]
@@ -53,25 +54,42 @@ pub fn spell(code: &str) -> String {
     words.join(", ")
 }
 
-/// Runs `host`: starts the server, joins it as Phantom, says the code, plays until the session ends.
+/// Runs `host`: starts the server, joins it as Phantom, says the code, plays until the session ends; a
+/// failure to start is said as well as printed.
 pub fn host(args: &HostArgs) -> anyhow::Result<()> {
-    let settings = args.client.settings().map_err(anyhow::Error::msg)?;
-    let (advertised, endpoint, code, token) = match args.server {
-        Some(server) => {
-            let (code, token) = heist_client::create_session(server, Role::Phantom, Duration::from_secs(5))
-                .with_context(|| format!("creating a session on {server}"))?;
-            (server, server, code, token)
-        }
-        None => host_here(args)?,
+    let mut settings = args.client.settings().map_err(anyhow::Error::msg)?;
+    let mut prompter = crate::prompt::Prompter::new(&mut settings)?;
+    let started = match args.server {
+        Some(server) => match heist_client::create_session(server, Role::Phantom, Duration::from_secs(5)) {
+            Ok((code, token)) => Ok((server, server, code, token)),
+            Err(e) => {
+                prompter.say(format!("Could not create a heist on {server}. {}", crate::prompt::advice(&e).0));
+                Err(anyhow::Error::new(e).context(format!("creating a session on {server}")))
+            }
+        },
+        None => host_here(args).inspect_err(|e| {
+            prompter.say(format!(
+                "Could not host the heist: {e:#}. If another program uses port {}, choose another with --bind.",
+                args.bind.port()
+            ))
+        }),
     };
-    let mut app = crate::cli::app(settings, args.client.headless, None)?;
+    let (advertised, endpoint, code, token) = match started {
+        Ok(s) => s,
+        Err(e) => {
+            prompter.finish_speaking(Duration::from_secs(30));
+            return Err(e);
+        }
+    };
+    let voices = prompter.into_parts();
+    let mut app = crate::cli::app(settings, args.client.headless, None, Some(voices))?;
     args.client.request_shot(&mut app);
     app.finish();
     app.cleanup();
-    app.insert_resource(crate::client::HostedCode(vec![
-        format!("You host the heist. Your partner joins at {advertised} with the code {code}."),
-        format!("The code, spelled: {}. R repeats it.", spell(&code)),
-    ]));
+    app.insert_resource(crate::client::HostedCode {
+        intro: format!("You host the heist. Your partner joins at {advertised} with the code {code}."),
+        spelled: format!("The code, spelled: {}. R repeats it.", spell(&code)),
+    });
     heist_client::connect(&mut app, token)?;
     heist_client::hold_seat(&mut app, heist_client::SeatCache::in_default_dir(), endpoint, Role::Phantom);
     app.run();
@@ -81,46 +99,15 @@ pub fn host(args: &HostArgs) -> anyhow::Result<()> {
 /// Starts the server in this process; returns its advertised address, its endpoint, the code and
 /// Phantom's token.
 fn host_here(args: &HostArgs) -> anyhow::Result<(SocketAddr, SocketAddr, String, heist_client::ConnectToken)> {
-    let options = ServerOptions {
-        level: Level::museum(),
-        game: heist_server::game::GameOptions {
-            seed: args.seed.unwrap_or_else(rand::random),
-            random_rounds: args.seed.is_none(),
-            ..Default::default()
-        },
-        host_session: true,
-        max_sessions: 1,
+    let here = heist_server::embedded::start(heist_server::embedded::HostOptions {
         bind: args.bind,
-        token_bind: args.bind,
-        insecure: false,
-        clock: Clock::RealTime,
-        echo_log: heist_server::session::LogEcho::Tracing,
-        abuse_limit: 50,
         advertise: args.advertise,
-        code_ttl: DEFAULT_CODE_TTL,
-        token_limits: Default::default(),
-        intake_limits: Default::default(),
-        drain_limit: heist_server::fleet::DEFAULT_DRAIN_LIMIT,
-        stall_after: heist_server::fleet::STALL_AFTER,
-    };
-    let (tx, rx) = std::sync::mpsc::channel();
-    // The server's app is built and run on its own thread (a Bevy app stays on the thread that made it).
-    std::thread::Builder::new().name("server".into()).spawn(move || match build_server(options) {
-        Ok(mut server) => {
-            let code = server.join_code().map(|c| c.code);
-            let _ = tx.send(Ok((server.advertised, server.tokens.as_ref().map(|t| t.addr), code)));
-            server.app.run();
-        }
-        Err(e) => {
-            let _ = tx.send(Err(e));
-        }
+        seed: args.seed,
+        time_limit_s: args.time_limit,
     })?;
-    let (advertised, endpoint, code) =
-        rx.recv_timeout(Duration::from_secs(10)).context("the server did not start within 10 s")??;
-    let (endpoint, code) = endpoint.zip(code).context("the server runs without a join endpoint")?;
-    let token = heist_client::request_token(endpoint, &code, Role::Phantom, Duration::from_secs(5))
-        .with_context(|| format!("joining the session hosted on {endpoint}"))?;
-    Ok((advertised, endpoint, code, token))
+    let token = heist_client::request_token(here.endpoint, &here.code, Role::Phantom, Duration::from_secs(5))
+        .with_context(|| format!("joining the session hosted on {}", here.endpoint))?;
+    Ok((here.advertised, here.endpoint, here.code, token))
 }
 
 #[cfg(test)]

@@ -15,11 +15,14 @@ pub mod explore;
 pub mod haptics;
 pub mod host;
 pub mod practice;
+pub mod prompt;
+pub mod settings;
 #[cfg(feature = "spectator")]
 pub mod spectator;
 pub mod speech;
 pub mod status;
 pub mod terminal;
+pub mod walkie;
 
 pub use client::{PhantomClientPlugin, PhantomSettings, PhantomState, start};
 pub use error::ClientError;

@@ -16,6 +16,7 @@ fn main() -> std::process::ExitCode {
 }
 
 fn run() -> anyhow::Result<()> {
+    heist_client::signals::install();
     match Cli::parse().command {
         Command::Join(args) => join(&args),
         Command::Host(args) => client_haptic::host::host(&args),

@@ -6,6 +6,8 @@
 //! when espeak-ng is missing; the first failure says how to install it.
 
 use std::process::Command;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::mpsc::{Receiver, Sender};
 
 use kira::sound::static_sound::StaticSoundData;
@@ -47,9 +49,13 @@ pub fn decode_wav(bytes: &[u8]) -> Result<(u32, Vec<f32>), ClientError> {
     Err(bad("no data chunk"))
 }
 
-/// Runs espeak-ng on `text` and returns the speech.
-pub fn synthesize(text: &str) -> Result<StaticSoundData, ClientError> {
-    let out = Command::new("espeak-ng").args(["--stdout", "-s", "175", "--", text]).output().map_err(|e| {
+/// espeak-ng's default speech rate, words per minute.
+pub const DEFAULT_RATE: u32 = 175;
+
+/// Runs espeak-ng on `text` at `rate` words per minute and returns the speech.
+pub fn synthesize(text: &str, rate: u32) -> Result<StaticSoundData, ClientError> {
+    let rate = rate.to_string();
+    let out = Command::new("espeak-ng").args(["--stdout", "-s", &rate, "--", text]).output().map_err(|e| {
         ClientError::Speech(format!("could not run espeak-ng ({e}); install it with `apt-get install espeak-ng`"))
     })?;
     if !out.status.success() {
@@ -71,10 +77,13 @@ pub struct Utterance {
 
 /// The speech worker: lines in, utterances out, in order.
 pub struct Speaker {
-    to_worker: Sender<String>,
+    to_worker: Sender<(String, Option<u32>)>,
+    rate: Arc<AtomicU32>,
     from_worker: Receiver<Utterance>,
-    last: Option<String>,
+    last: Option<(String, Option<u32>)>,
     warned: bool,
+    /// Lines sent to the worker, and lines back from it.
+    queued: (u64, u64),
     /// Every line said, oldest first.
     pub said: Vec<String>,
 }
@@ -88,11 +97,14 @@ impl Default for Speaker {
 impl Speaker {
     /// Starts the worker thread.
     pub fn new() -> Self {
-        let (to_worker, rx) = std::sync::mpsc::channel::<String>();
+        let (to_worker, rx) = std::sync::mpsc::channel::<(String, Option<u32>)>();
         let (tx, from_worker) = std::sync::mpsc::channel();
+        let rate = Arc::new(AtomicU32::new(DEFAULT_RATE));
+        let worker_rate = rate.clone();
         let spawned = std::thread::Builder::new().name("speech".into()).spawn(move || {
-            for text in rx {
-                let audio = synthesize(&text);
+            for (text, slower) in rx {
+                let rate = worker_rate.load(Ordering::Relaxed);
+                let audio = synthesize(&text, slower.map_or(rate, |s| s.min(rate)));
                 if tx.send(Utterance { text, audio }).is_err() {
                     break;
                 }
@@ -101,24 +113,63 @@ impl Speaker {
         if let Err(e) = spawned {
             log::error!("speech: could not start its thread: {e}");
         }
-        Self { to_worker, from_worker, last: None, warned: false, said: Vec::new() }
+        Self { to_worker, rate, from_worker, last: None, warned: false, queued: (0, 0), said: Vec::new() }
+    }
+
+    /// Speaks the lines said from now on at `wpm` words per minute.
+    pub fn set_rate(&mut self, wpm: u32) {
+        self.rate.store(wpm, Ordering::Relaxed);
     }
 
     /// Says `text` (queued behind earlier lines).
     pub fn say(&mut self, text: impl Into<String>) {
+        self.say_at(text, None);
+    }
+
+    /// Says `text` at most at `wpm` words per minute (a join code, spelled slowly).
+    pub fn say_slowly(&mut self, text: impl Into<String>, wpm: u32) {
+        self.say_at(text, Some(wpm));
+    }
+
+    fn say_at(&mut self, text: impl Into<String>, slower: Option<u32>) {
         let text = text.into();
         // Printed once, as it is said (a screen reader reads the terminal); the log has it only on request.
         log::debug!("said: {text}");
         println!("{text}");
         self.said.push(text.clone());
-        self.last = Some(text.clone());
-        let _ = self.to_worker.send(text);
+        self.last = Some((text.clone(), slower));
+        self.queue(text, slower);
+    }
+
+    /// Says `text` without printing it (a typed character said back: the terminal shows it already).
+    pub fn speak_only(&mut self, text: impl Into<String>) {
+        let text = text.into();
+        log::debug!("said (not printed): {text}");
+        self.queue(text, None);
+    }
+
+    fn queue(&mut self, text: String, slower: Option<u32>) {
+        if self.to_worker.send((text, slower)).is_ok() {
+            self.queued.0 += 1;
+        }
+    }
+
+    /// Lines not yet synthesized.
+    pub fn pending(&self) -> u64 {
+        self.queued.0 - self.queued.1
+    }
+
+    /// Prints `text` for a screen reader without saying it (what the player hears already, or what
+    /// speaking would drown: "Talking to Vive" while the microphone is open).
+    pub fn print(&mut self, text: &str) {
+        log::debug!("printed: {text}");
+        println!("{text}");
     }
 
     /// Says the last line again.
     pub fn repeat(&mut self) {
         match self.last.clone() {
-            Some(t) => self.say(t),
+            Some((t, slower)) => self.say_at(t, slower),
             None => self.say("Nothing has been said yet."),
         }
     }
@@ -127,6 +178,7 @@ impl Speaker {
     pub fn ready(&mut self) -> Vec<StaticSoundData> {
         let mut out = Vec::new();
         while let Ok(u) = self.from_worker.try_recv() {
+            self.queued.1 += 1;
             match u.audio {
                 Ok(a) => out.push(a),
                 Err(e) if !self.warned => {

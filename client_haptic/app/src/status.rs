@@ -18,13 +18,16 @@ pub enum MenuItem {
     Briefing,
     /// Hear the status.
     Status,
+    /// Open the settings menu.
+    Settings,
     /// Hear the keys.
     Help,
 }
 
 impl MenuItem {
     /// The items in order.
-    pub const ALL: [MenuItem; 4] = [MenuItem::Ready, MenuItem::Briefing, MenuItem::Status, MenuItem::Help];
+    pub const ALL: [MenuItem; 5] =
+        [MenuItem::Ready, MenuItem::Briefing, MenuItem::Status, MenuItem::Settings, MenuItem::Help];
 
     /// What is said when the item is focused.
     pub fn label(self) -> &'static str {
@@ -32,16 +35,22 @@ impl MenuItem {
             MenuItem::Ready => "Ready. Press Enter when you are ready to start the heist.",
             MenuItem::Briefing => "Briefing. Press Enter to hear what the real pieces feel like.",
             MenuItem::Status => "Status. Press Enter to hear the time, the targets and the guards.",
+            MenuItem::Settings => "Settings. Press Enter for speech, volumes, sound placement and the talk key.",
             MenuItem::Help => "Keys. Press Enter to hear the keys.",
         }
     }
 }
 
-/// The keys, spoken.
-pub const HELP: &str = "Keys: Y, the copy is real. N, it is fake. S, status. B, briefing. R, repeat the last message. \
-H, tell Vive to hide. G, tell Vive to go. C, tell Vive to come back. After a heist, Enter asks for another round. \
-Q leaves the session. Arrow keys, page up and page down move your hand; \
-or use your device and its buttons: first button real, second button fake.";
+/// The keys, spoken; `talk` names the push-to-talk key.
+pub fn help(talk: &str) -> String {
+    format!(
+        "Keys: Y, the copy is real. N, it is fake. S, status. B, briefing. R, repeat the last message. \
+H, tell Vive to hide. G, tell Vive to go. C, tell Vive to come back. Hold {talk} to talk to Vive on the walkie-talkie; \
+typed in the terminal, talk starts and over ends. O, settings. After a heist, Enter asks for another round. \
+Q leaves the session. Arrow keys, page up and page down move your hand; or use your device and its buttons: \
+first button real, second button fake, third button talk."
+    )
+}
 
 /// "two minutes and five seconds".
 pub fn duration_words(seconds: f32) -> String {
@@ -146,16 +155,19 @@ pub fn announce(event: &GameEvent, guard_name: impl Fn(u16) -> Option<String>) -
             (VerdictOutcome::Wrong, true) => "Wrong: that one is a fake. The alarm goes up.".to_owned(),
             (VerdictOutcome::Wrong, false) => "Wrong: that one was real. The alarm goes up.".to_owned(),
         },
-        GameEvent::Warning(w) => format!(
-            "You told Vive to {}.",
-            match w {
-                WarningKind::Hide => "hide",
-                WarningKind::Go => "go",
-                WarningKind::ComeBack => "come back",
-            }
-        ),
+        GameEvent::Warning(w) => format!("You told Vive to {}.", warning_words(*w)),
+        GameEvent::WarningSeen(w) => format!("Vive has your warning to {}.", warning_words(*w)),
         _ => return None,
     })
+}
+
+/// What a warning tells Vive to do.
+fn warning_words(w: WarningKind) -> &'static str {
+    match w {
+        WarningKind::Hide => "hide",
+        WarningKind::Go => "go",
+        WarningKind::ComeBack => "come back",
+    }
 }
 
 /// "A copy of the crown is on the bench."

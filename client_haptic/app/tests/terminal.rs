@@ -2,41 +2,13 @@
 //! nothing else (no `SAY:` tags, no log lines, no telemetry), and the log on stderr stays quiet unless
 //! `RUST_LOG` asks for more. Played as a screen-reader user would: answering by typed lines.
 
-use std::io::{BufRead, BufReader, Read, Write};
-use std::process::{Child, ChildStdin, Command, Stdio};
+use std::io::{Read, Write};
+use std::process::Command;
 use std::sync::mpsc::{self, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
-/// The client as a screen-reader user runs it: `args` then `--headless --audio memory`, `RUST_LOG` unset;
-/// its stdin to type into and its stdout read line by line on a thread (stderr stays piped for the caller).
-fn headless(args: &[&str]) -> (Child, ChildStdin, mpsc::Receiver<String>) {
-    headless_with_cache(args, &std::env::temp_dir().join(format!("phantom-terminal-{}", std::process::id())))
-}
-
-/// [`headless`] with its seat cache (`XDG_CACHE_HOME`) in `cache`.
-fn headless_with_cache(args: &[&str], cache: &std::path::Path) -> (Child, ChildStdin, mpsc::Receiver<String>) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_client_haptic"))
-        .args(args)
-        .args(["--headless", "--audio", "memory"])
-        .env_remove("RUST_LOG")
-        .env("XDG_CACHE_HOME", cache)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("client_haptic runs");
-    let stdin = child.stdin.take().expect("stdin");
-    let stdout = child.stdout.take().expect("stdout");
-    let (tx, rx) = mpsc::channel();
-    std::thread::spawn(move || {
-        for line in BufReader::new(stdout).lines().map_while(Result::ok) {
-            if tx.send(line).is_err() {
-                break;
-            }
-        }
-    });
-    (child, stdin, rx)
-}
+mod common;
+use common::{headless, headless_with_cache, hear, host_with_a_vive_bot, wait};
 
 #[test]
 fn headless_practice_prints_each_spoken_line_once_and_nothing_else() {
@@ -79,7 +51,7 @@ fn headless_practice_prints_each_spoken_line_once_and_nothing_else() {
     assert_eq!(count("You can feel it now."), 3, "{lines:#?}");
     assert_eq!(count("You say: "), 3, "{lines:#?}");
     assert_eq!(
-        count("Type y, n, s, b, r, h, g, c, q, up, down, or just Enter."),
+        count("Type y, n, s, b, r, h, g, c, o, q, talk, over, up, down, left, right, or just Enter."),
         1,
         "the word that is no key: {lines:#?}"
     );
@@ -123,52 +95,6 @@ fn a_join_that_cannot_reach_the_host_fails_on_one_line_without_a_backtrace() {
     assert_eq!(lines.len(), 1, "one line: {err}");
     assert!(lines[0].starts_with("error: joining 127.0.0.1:1 as Phantom: cannot reach the token endpoint"), "{err}");
     assert_eq!(lines[0].matches("refused").count(), 1, "the cause once: {err}");
-}
-
-/// A host on its own thread: a loopback server (heists of `time_limit_s`) and, once Phantom is in, a Vive
-/// bot that asks for another round after the first. Stepped at about 60 Hz of wall-clock time until
-/// `stop` is set, its game loop standing still while `stall` is set (the token endpoint, on its own
-/// thread, still answers: a hung server process or a dead network); sends the join code, then the
-/// server's log at the end.
-fn host_with_a_vive_bot(
-    stop: std::sync::Arc<std::sync::atomic::AtomicBool>,
-    stall: std::sync::Arc<std::sync::atomic::AtomicBool>,
-    time_limit_s: f32,
-) -> (std::net::SocketAddr, String, std::thread::JoinHandle<Vec<String>>) {
-    use heist_server::{ServerOptions, build_server};
-    use heist_shared::protocol::Role;
-    use std::sync::atomic::Ordering;
-    let (tx, rx) = mpsc::channel();
-    let host = std::thread::spawn(move || {
-        let mut options = ServerOptions::local_test(12);
-        options.game.time_limit_s = Some(time_limit_s);
-        let mut server = build_server(options).expect("server starts");
-        let tokens = server.tokens.as_ref().expect("secure");
-        tx.send((tokens.addr, server.join_code().expect("a host session").code)).expect("the test waits");
-        let mut vive: Option<bevy::app::App> = None;
-        let deadline = Instant::now() + Duration::from_secs(150);
-        while !stop.load(Ordering::Relaxed) && Instant::now() < deadline {
-            std::thread::sleep(Duration::from_millis(16));
-            if stall.load(Ordering::Relaxed) {
-                continue;
-            }
-            server.app.update();
-            if vive.is_none() && server.game().is_present(Role::Phantom) {
-                let app = heist_server::demo::join(&server, Role::Vive, |app| {
-                    app.add_plugins(heist_bots::ViveBotPlugin { style: heist_bots::ViveStyle::Idle })
-                        .insert_resource(heist_bots::Rounds(2));
-                })
-                .expect("the Vive bot joins");
-                vive = Some(app);
-            }
-            if let Some(v) = vive.as_mut() {
-                v.update();
-            }
-        }
-        server.log().to_vec()
-    });
-    let (addr, code) = rx.recv_timeout(Duration::from_secs(30)).expect("the host starts");
-    (addr, code, host)
 }
 
 #[test]
@@ -306,21 +232,6 @@ fn host_and_hear_a_partner_join(args: &[&str], addr: &str) {
     assert!(!lines.iter().any(|l| l.contains("server is gone")), "leaving on purpose is no lost server: {lines:#?}");
 }
 
-/// Waits up to `within` for a line starting with `text`, keeping every line in `lines`.
-fn hear(rx: &mpsc::Receiver<String>, lines: &mut Vec<String>, text: &str, within: Duration) -> bool {
-    let deadline = Instant::now() + within;
-    while Instant::now() < deadline {
-        if let Ok(line) = rx.recv_timeout(Duration::from_millis(100)) {
-            let found = line.starts_with(text);
-            lines.push(line);
-            if found {
-                return true;
-            }
-        }
-    }
-    false
-}
-
 #[test]
 fn a_blind_player_hears_the_link_lost_gets_back_in_by_itself_and_after_a_restart() {
     use std::sync::Arc;
@@ -365,17 +276,4 @@ fn a_blind_player_hears_the_link_lost_gets_back_in_by_itself_and_after_a_restart
     assert_eq!(log.iter().filter(|l| l.contains("Phantom is back")).count(), 2, "{log:#?}");
     assert!(!lines.iter().any(|l| l.starts_with("Could not get back")), "{lines:#?}");
     let _ = std::fs::remove_dir_all(cache);
-}
-
-/// Waits for `child` to exit, killing it after `limit`.
-fn wait(child: &mut Child, limit: Duration) -> Option<std::process::ExitStatus> {
-    let deadline = Instant::now() + limit;
-    while Instant::now() < deadline {
-        if let Ok(Some(status)) = child.try_wait() {
-            return Some(status);
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    let _ = child.kill();
-    None
 }

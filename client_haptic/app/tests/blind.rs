@@ -1,0 +1,346 @@
+//! A blind player needs no sighted help: hosting (the code is spoken, and the recording decodes back to
+//! it), joining by spoken prompts and typed answers, every failure before the session spoken with what
+//! to do next, the settings menu, the walkie-talkie and a rematch — all through the terminal as a
+//! screen-reader user drives it (docs/phantom-client.md, "A blind player's walkthrough").
+
+use std::io::Write;
+use std::time::{Duration, Instant};
+
+use heist_shared::protocol::Role;
+
+mod common;
+mod listen;
+use common::{headless_with_cache, hear, host_with_a_vive_bot, wait};
+
+/// A fresh directory for one test's seat cache and settings.
+fn home(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("phantom-blind-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("a temp dir");
+    dir
+}
+
+fn free_port() -> u16 {
+    std::net::UdpSocket::bind("127.0.0.1:0").expect("a free port").local_addr().expect("addr").port()
+}
+
+fn sigterm(child: &std::process::Child) {
+    // SAFETY: kill() sends a signal to the child's pid; nothing else is touched.
+    unsafe {
+        libc::kill(child.id() as libc::pid_t, libc::SIGTERM);
+    }
+}
+
+/// The NATO words and digit names the code is spelled with, and "then" for its dashes.
+fn code_words() -> Vec<&'static str> {
+    let mut w = vec![
+        "alfa", "bravo", "charlie", "delta", "echo", "foxtrot", "golf", "hotel", "india", "juliett", "kilo", "lima",
+        "mike", "november", "oscar", "papa", "quebec", "romeo", "sierra", "tango", "uniform", "victor", "whiskey",
+        "x-ray", "yankee", "zulu",
+    ];
+    w.extend(["zero", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine", "then"]);
+    w
+}
+
+/// The code a run of recognized words spells ("kilo, seven, then, …" → "K7-…").
+fn unspell(words: &[String]) -> String {
+    words
+        .iter()
+        .map(|w| match w.as_str() {
+            "then" => '-',
+            "zero" => '0',
+            "one" => '1',
+            "two" => '2',
+            "three" => '3',
+            "four" => '4',
+            "five" => '5',
+            "six" => '6',
+            "seven" => '7',
+            "eight" => '8',
+            "nine" => '9',
+            nato => nato.chars().next().map_or('?', |c| c.to_ascii_uppercase()),
+        })
+        .collect()
+}
+
+/// The longest run of recognized code words in `words`, spelled back into a code.
+fn longest_code(words: &[Option<String>]) -> String {
+    let mut best: Vec<String> = Vec::new();
+    let mut run: Vec<String> = Vec::new();
+    for w in words.iter().chain([None].iter()) {
+        match w {
+            Some(w) => run.push(w.clone()),
+            None => {
+                if run.len() > best.len() {
+                    best = std::mem::take(&mut run);
+                }
+                run.clear();
+            }
+        }
+    }
+    unspell(&best)
+}
+
+#[test]
+fn the_recognizer_hears_a_spelled_code_and_not_the_sentence_around_it() {
+    // Checked on its own so a failure of the hosting test below is the client's, not the recognizer's.
+    let code = "QX7M-K2PR-9TCA";
+    let line = format!("The code, spelled: {}. R repeats it.", client_haptic::host::spell(code));
+    let said = listen::espeak(&line, client_haptic::client::SPELLING_WPM);
+    let vocabulary = listen::Vocabulary::new(&code_words(), client_haptic::client::SPELLING_WPM);
+    let words = vocabulary.transcribe(&said);
+    for (s, e) in listen::utterances(&said) {
+        println!("{:.2}-{:.2} s: {:?}", s as f32 / 48_000.0, e as f32 / 48_000.0, vocabulary.scores(&said[s..e]));
+    }
+    println!("heard: {words:?}");
+    assert_eq!(longest_code(&words), code);
+}
+
+#[test]
+fn hosting_speaks_the_join_code_and_the_recording_decodes_back_to_the_printed_code() {
+    let dir = home("host-speech");
+    let wav = dir.join("heard.wav");
+    let bind = format!("127.0.0.1:{}", free_port());
+    // The lines before the code are said fast; the spelling is said at 120 words a minute whatever the rate.
+    let args = ["host", "--bind", &bind, "--speech-rate", "300", "--wav", wav.to_str().expect("utf-8")];
+    let (mut child, _stdin, rx) = headless_with_cache(&args, &dir);
+    let mut lines = Vec::new();
+    assert!(hear(&rx, &mut lines, "The code, spelled:", Duration::from_secs(60)), "{lines:#?}");
+    let printed = lines
+        .iter()
+        .find_map(|l| l.split("with the code ").nth(1))
+        .expect("the code is printed on one line")
+        .trim_end_matches('.')
+        .to_owned();
+    // Everything is queued at once: the welcome, the menu's first item and where to join (about ten
+    // seconds at 300 words a minute), then the spelled code (about twelve at 120). Then the player is
+    // stopped from outside (SIGTERM), and the recording must still be whole.
+    std::thread::sleep(Duration::from_secs(40));
+    sigterm(&child);
+    let status = wait(&mut child, Duration::from_secs(15));
+    assert!(status.is_some(), "SIGTERM ended the client");
+    let heard = heist_voice::mic::read_wav(&wav).expect("the recording was written whole");
+    assert!(heard.len() > 48_000 * 39, "{} s recorded", heard.len() / 48_000);
+
+    let vocabulary = listen::Vocabulary::new(&code_words(), client_haptic::client::SPELLING_WPM);
+    let words = vocabulary.transcribe(&heard);
+    for (s, e) in listen::utterances(&heard) {
+        println!("{:.2}-{:.2} s: {:?}", s as f32 / 48_000.0, e as f32 / 48_000.0, vocabulary.scores(&heard[s..e]));
+    }
+    println!("heard: {words:?}");
+    // The longest run of recognized code words is the spelled code.
+    assert_eq!(longest_code(&words), printed, "the spoken words decode back to the printed code");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn joining_by_spoken_prompts_asks_again_after_each_mistake_until_the_player_is_in() {
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let (addr, code, host) = host_with_a_vive_bot(stop.clone(), Default::default(), 300.0);
+    let dir = home("join-prompts");
+    let (mut child, mut stdin, rx) = headless_with_cache(&["join"], &dir);
+    let mut lines = Vec::new();
+    let t = Duration::from_secs(20);
+    let mut wrong = code.clone();
+    let last = wrong.pop().expect("a code");
+    wrong.push(if last == 'A' { 'B' } else { 'A' });
+    assert!(hear(&rx, &mut lines, "Which server?", t), "{lines:#?}");
+    // Nobody listens on port 1; the typo is deleted with a backspace.
+    writeln!(stdin, "127.0.0.1:1x\x7f").expect("types");
+    assert!(hear(&rx, &mut lines, "Server 127.0.0.1:1.", t), "the answer is said back: {lines:#?}");
+    assert!(hear(&rx, &mut lines, "The join code?", t), "{lines:#?}");
+    writeln!(stdin, "{}", wrong.to_lowercase()).expect("types a wrong code, in lower case");
+    assert!(hear(&rx, &mut lines, "Nobody answers at 127.0.0.1:1.", t), "{lines:#?}");
+    assert!(hear(&rx, &mut lines, "Which server?", t), "the address is asked again: {lines:#?}");
+    writeln!(stdin, "{addr}").expect("types");
+    // The code typed before is tried at the new address: the host says it is wrong.
+    assert!(hear(&rx, &mut lines, "The host says that code is wrong.", t), "{lines:#?}");
+    assert!(hear(&rx, &mut lines, "The join code?", t), "{lines:#?}");
+    writeln!(stdin, "not a code").expect("types");
+    assert!(hear(&rx, &mut lines, "That is not a join code:", t), "{lines:#?}");
+    writeln!(stdin, "{code}").expect("types");
+    assert!(hear(&rx, &mut lines, "Welcome to Phantom Heist.", t), "in: {lines:#?}");
+    assert!(hear(&rx, &mut lines, "Vive joined.", t), "{lines:#?}");
+    writeln!(stdin, "q").expect("types q");
+    assert!(hear(&rx, &mut lines, "Leaving the session.", t), "{lines:#?}");
+    let status = wait(&mut child, Duration::from_secs(10));
+    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+    let _ = host.join();
+    assert!(status.is_some_and(|s| s.success()), "{status:?}: {lines:#?}");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn every_failure_before_the_session_is_spoken_with_what_to_do_next() {
+    let dir = home("failures");
+    let wav = dir.join("failure.wav");
+    let run = |args: &[&str]| {
+        let (mut child, _stdin, rx) = headless_with_cache(args, &dir);
+        let status = wait(&mut child, Duration::from_secs(60)).expect("ends by itself");
+        let mut err = String::new();
+        if let Some(mut e) = child.stderr.take() {
+            let _ = std::io::Read::read_to_string(&mut e, &mut err);
+        }
+        (status, rx.try_iter().collect::<Vec<String>>(), err)
+    };
+    // Nobody at the address.
+    let (status, said, err) =
+        run(&["join", "127.0.0.1:1", "--code", "ABCD-EFGH-JKLM", "--wav", wav.to_str().expect("utf-8")]);
+    assert!(!status.success());
+    assert!(said.iter().any(|l| l.starts_with("Nobody answers at 127.0.0.1:1. Check the address")), "{said:#?}");
+    assert_eq!(err.lines().count(), 1, "one line on stderr: {err}");
+    // It was said aloud, not only printed: a second and more of speech in the recording.
+    let heard = heist_voice::mic::read_wav(&wav).expect("the recording");
+    let loud = heard.iter().filter(|s| s.abs() > 0.02).count();
+    assert!(loud > 48_000, "{loud} loud samples");
+
+    // A wrong code, given on the command line: said, and the program ends (nothing to ask again).
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let (addr, code, host) = host_with_a_vive_bot(stop.clone(), Default::default(), 300.0);
+    let wrong = format!("{}-ZZZZ-ZZZZ", code.split('-').next().expect("a room"));
+    let (status, said, _) = run(&["join", &addr.to_string(), "--code", &wrong]);
+    assert!(!status.success());
+    assert!(said.iter().any(|l| l == "The host says that code is wrong. Check it with your partner."), "{said:#?}");
+    // Hosting on a port that is taken.
+    let (status, said, err) = run(&["host", "--bind", &addr.to_string()]);
+    assert!(!status.success(), "{err}");
+    assert!(said.iter().any(|l| l.starts_with("Could not host the heist:") && l.contains("--bind")), "{said:#?}");
+    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+    let _ = host.join();
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn the_settings_menu_is_spoken_a_change_is_heard_and_saved_and_a_bad_file_falls_back_with_a_warning() {
+    let dir = home("settings");
+    let file = dir.join("config").join("phantom-heist").join("settings.toml");
+    let (mut child, mut stdin, rx) = headless_with_cache(&["practice", "--kind", "idol"], &dir);
+    let mut lines = Vec::new();
+    let t = Duration::from_secs(20);
+    assert!(hear(&rx, &mut lines, "Welcome to Phantom Heist.", t), "{lines:#?}");
+    writeln!(stdin, "o").expect("types o");
+    assert!(hear(&rx, &mut lines, "Settings. Up and down choose a setting", t), "{lines:#?}");
+    assert!(hear(&rx, &mut lines, "Speech rate, 175 words a minute.", t), "{lines:#?}");
+    writeln!(stdin, "right").expect("types");
+    assert!(hear(&rx, &mut lines, "Speech rate, 200 words a minute.", t), "{lines:#?}");
+    for line in ["down", "down", "left", "left"] {
+        writeln!(stdin, "{line}").expect("types");
+    }
+    assert!(hear(&rx, &mut lines, "Sound volume, 80 percent.", t), "{lines:#?}");
+    writeln!(stdin).expect("types Enter: close");
+    assert!(hear(&rx, &mut lines, "Settings saved. Back to the game.", t), "{lines:#?}");
+    writeln!(stdin, "q").expect("types q");
+    let _ = wait(&mut child, Duration::from_secs(10));
+    let saved = std::fs::read_to_string(&file).expect("the file was written");
+    assert!(saved.contains("speech_rate = 200") && saved.contains("sound_volume = 80"), "{saved}");
+
+    // Started again: the saved settings are in force. Then the file is broken by hand.
+    std::fs::write(&file, "speech_rate = \"fast\"\n").expect("writes");
+    let (mut child, mut stdin, rx) = headless_with_cache(&["practice", "--kind", "idol"], &dir);
+    let mut lines = Vec::new();
+    assert!(hear(&rx, &mut lines, "The settings file", t), "{lines:#?}");
+    let warning = lines.last().expect("a line").clone();
+    assert!(warning.contains("line 1") && warning.ends_with("using the defaults."), "{warning}");
+    assert!(hear(&rx, &mut lines, "Welcome to Phantom Heist.", t), "the client carries on: {lines:#?}");
+    writeln!(stdin, "o").expect("types o");
+    assert!(hear(&rx, &mut lines, "Speech rate, 175 words a minute.", t), "the defaults: {lines:#?}");
+    writeln!(stdin, "q").expect("types");
+    writeln!(stdin, "q").expect("types");
+    let _ = wait(&mut child, Duration::from_secs(10));
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// What the partner's client heard of Phantom's walkie-talkie.
+#[derive(bevy::prelude::Resource, Default)]
+struct PartnerHeard(usize);
+
+fn count_voice(
+    mut frames: bevy::prelude::MessageReader<heist_shared::protocol::PartnerVoice>,
+    mut heard: bevy::prelude::ResMut<PartnerHeard>,
+) {
+    heard.0 += frames.read().count();
+}
+
+#[test]
+fn a_blind_players_walkthrough_host_share_the_code_talk_warn_change_a_setting_play_and_play_again() {
+    use bevy::prelude::*;
+    let dir = home("walkthrough");
+    let mic = dir.join("phantom-says.wav");
+    let ok = std::process::Command::new("espeak-ng").arg("-w").arg(&mic).arg("Vive, the east door.").status();
+    assert!(ok.is_ok_and(|s| s.success()), "espeak-ng writes the microphone's file");
+    let bind = format!("127.0.0.1:{}", free_port());
+    let args = ["host", "--bind", &bind, "--time-limit", "6", "--mic-wav", mic.to_str().expect("utf-8")];
+    let (mut child, mut stdin, rx) = headless_with_cache(&args, &dir);
+    let mut lines = Vec::new();
+    let t = Duration::from_secs(30);
+    assert!(hear(&rx, &mut lines, "You host the heist.", t), "{lines:#?}");
+    let code = lines.last().and_then(|l| l.split("with the code ").nth(1)).expect("a code").trim_end_matches('.');
+    // The partner (an idle Vive bot for two rounds) joins with the code as heard.
+    let token = heist_client::request_token(bind.parse().expect("addr"), code, Role::Vive, Duration::from_secs(5))
+        .expect("the code admits the partner");
+    let mut vive = heist_server::demo::stepped_client_app();
+    vive.add_plugins(heist_bots::ViveBotPlugin { style: heist_bots::ViveStyle::Idle })
+        .insert_resource(heist_bots::Rounds(2))
+        .init_resource::<PartnerHeard>()
+        .add_systems(PreUpdate, count_voice);
+    vive.finish();
+    vive.cleanup();
+    heist_client::connect(&mut vive, token).expect("connects");
+    // Everything below is typed as lines; the partner's client runs at 60 Hz meanwhile.
+    let script: Vec<(&str, Option<&str>)> = vec![
+        ("Vive joined.", Some("talk")),
+        ("Talking to Vive.", None),
+        ("Over.", None),
+        ("Settings. Up and down", None),
+        ("Speech rate, 200 words a minute.", Some("")),
+        ("Settings saved.", Some("")),
+        ("Ready. Waiting for Vive.", None),
+        ("The heist has begun.", Some("h")),
+        ("You told Vive to hide.", None),
+        ("Vive has your warning to hide.", None),
+        ("Time is up. The heist is lost.", None),
+        ("Enter asks for another round", Some("again")),
+        ("Round 2 begins", None),
+        ("Time is up. The heist is lost.", None),
+        ("Enter asks for another round", Some("q")),
+        ("Leaving the session.", None),
+    ];
+    let deadline = Instant::now() + Duration::from_secs(120);
+    let mut step = 0;
+    let mut talking_since: Option<Instant> = None;
+    while step < script.len() {
+        assert!(Instant::now() < deadline, "stuck waiting for {:?}; heard {lines:#?}", script[step].0);
+        vive.update();
+        std::thread::sleep(Duration::from_millis(16));
+        // Over after two seconds of talk; then the settings: one step faster.
+        if talking_since.is_some_and(|s| s.elapsed() > Duration::from_secs(2)) {
+            talking_since = None;
+            writeln!(stdin, "over").expect("types");
+        }
+        while let Ok(line) = rx.try_recv() {
+            let (expect, then) = script[step.min(script.len() - 1)];
+            if step < script.len() && line.starts_with(expect) {
+                if let Some(typed) = then {
+                    writeln!(stdin, "{typed}").expect("types");
+                }
+                if expect == "Talking to Vive." {
+                    talking_since = Some(Instant::now());
+                }
+                if expect == "Over." {
+                    writeln!(stdin, "o").expect("types");
+                    writeln!(stdin, "right").expect("types");
+                }
+                step += 1;
+            }
+            lines.push(line);
+        }
+    }
+    let status = wait(&mut child, Duration::from_secs(10));
+    println!("Phantom heard:\n{}", lines.join("\n"));
+    assert!(status.is_some_and(|s| s.success()), "{status:?}");
+    let frames = vive.world().resource::<PartnerHeard>().0;
+    assert!(frames >= 50, "Vive's client got Phantom's two seconds of voice: {frames} frames");
+    let saved = std::fs::read_to_string(dir.join("config/phantom-heist/settings.toml")).expect("saved");
+    assert!(saved.contains("speech_rate = 200"), "{saved}");
+    let _ = std::fs::remove_dir_all(dir);
+}
