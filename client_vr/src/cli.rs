@@ -35,6 +35,9 @@ pub struct Cli {
 pub enum Command {
     /// Join a session as Vive.
     Join(JoinArgs),
+    /// Host a session (the server runs in this client, or on a `heist-server serve` with --server) and
+    /// join it as Vive; the join code for Phantom is printed and shown on the HUD.
+    Host(HostArgs),
     /// Say whether XR mode would start here, and why not.
     XrCheck,
 }
@@ -78,6 +81,37 @@ pub struct JoinArgs {
     /// The join code the host printed.
     #[arg(long)]
     pub code: String,
+    /// How to play.
+    #[command(flatten)]
+    pub vive: ViveArgs,
+}
+
+/// Arguments of `host`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct HostArgs {
+    /// Where the server listens (UDP game, TCP join endpoint); 0.0.0.0 for players on other machines.
+    #[arg(long, default_value = "127.0.0.1:5757")]
+    pub bind: SocketAddr,
+    /// The address the partner reaches (behind a NAT or relay).
+    #[arg(long)]
+    pub advertise: Option<SocketAddr>,
+    /// Seed of the first round (default: random, so nobody knows which copies are real).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Seconds a heist lasts (default: the museum's 600).
+    #[arg(long)]
+    pub time_limit: Option<f32>,
+    /// Create the session on this running server (`heist-server serve`) instead of hosting one here.
+    #[arg(long, conflicts_with_all = ["bind", "advertise", "seed", "time_limit"])]
+    pub server: Option<SocketAddr>,
+    /// How to play.
+    #[command(flatten)]
+    pub vive: ViveArgs,
+}
+
+/// How Vive plays: mode, bot, XR, sound, walkie-talkie (shared by `join` and `host`).
+#[derive(clap::Args, Debug, Clone)]
+pub struct ViveArgs {
     /// No window and no XR: the game logic only (with --bot, a bot plays).
     #[arg(long)]
     pub headless: bool,
@@ -123,6 +157,15 @@ pub struct JoinArgs {
     /// Quit this many seconds after the heist ends.
     #[arg(long, default_value_t = 5.0)]
     pub quit_after: f32,
+    /// A WAV file as the walkie-talkie's microphone: each transmission says it from its start.
+    #[arg(long, conflicts_with = "no_mic")]
+    pub mic_wav: Option<PathBuf>,
+    /// No microphone: the walkie-talkie only listens (also without a sound card, unless --mic-wav).
+    #[arg(long)]
+    pub no_mic: bool,
+    /// Transmit from the start without push-to-talk (with --mic-wav: say the file once, then stop).
+    #[arg(long)]
+    pub open_mic: bool,
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -146,7 +189,7 @@ pub enum Mode {
 }
 
 /// Decides the mode; the line says which and why (logged once at start-up).
-pub fn decide_mode(args: &JoinArgs, probe: impl FnOnce() -> XrProbe) -> (Mode, String) {
+pub fn decide_mode(args: &ViveArgs, probe: impl FnOnce() -> XrProbe) -> (Mode, String) {
     if args.headless {
         return (Mode::Headless, "headless mode: no window, no XR".into());
     }
@@ -157,7 +200,20 @@ pub fn decide_mode(args: &JoinArgs, probe: impl FnOnce() -> XrProbe) -> (Mode, S
     (if p.ready() { Mode::Xr } else { Mode::Desktop }, p.line())
 }
 
-impl JoinArgs {
+impl ViveArgs {
+    /// The walkie-talkie's settings these arguments ask for.
+    pub fn voice(&self) -> heist_voice::VoiceSettings {
+        heist_voice::VoiceSettings {
+            // Without a sound card (headless's default, or memory) there is no microphone either.
+            mic: match (&self.mic_wav, self.no_mic || !matches!(self.audio_choice(), AudioChoice::Card)) {
+                (Some(path), _) => heist_voice::MicChoice::Wav(path.clone()),
+                (None, true) => heist_voice::MicChoice::Off,
+                (None, false) => heist_voice::MicChoice::Device,
+            },
+            mode: if self.open_mic { heist_voice::TalkMode::Open } else { heist_voice::TalkMode::PushToTalk },
+        }
+    }
+
     /// The client settings these arguments ask for.
     pub fn settings(&self, mode: &Mode) -> ViveSettings {
         let input = match (self.bot, mode) {
@@ -168,9 +224,12 @@ impl JoinArgs {
         ViveSettings { input, ready_at_once: self.ready, quit_after_end_s: Some(self.quit_after) }
     }
 
+    fn audio_choice(&self) -> AudioChoice {
+        self.audio.unwrap_or(if self.headless { AudioChoice::Off } else { AudioChoice::Card })
+    }
+
     fn audio(&self) -> Option<AudioSettings> {
-        let choice = self.audio.unwrap_or(if self.headless { AudioChoice::Off } else { AudioChoice::Card });
-        let output = match choice {
+        let output = match self.audio_choice() {
             AudioChoice::Off => return None,
             AudioChoice::Card => AudioOutput::SoundCard,
             AudioChoice::Memory => AudioOutput::Background(self.wav.clone()),
@@ -190,7 +249,7 @@ pub struct ShotRequest {
 }
 
 /// The Vive client's Bevy app, not yet connected.
-pub fn app(args: &JoinArgs, mode: &Mode) -> anyhow::Result<App> {
+pub fn app(args: &ViveArgs, mode: &Mode) -> anyhow::Result<App> {
     let mut app = App::new();
     let settings = args.settings(mode);
     let style = match args.style {
@@ -232,7 +291,9 @@ pub fn app(args: &JoinArgs, mode: &Mode) -> anyhow::Result<App> {
             );
         }
     }
-    app.add_plugins(ClientNetPlugin).add_plugins(ViveClientPlugin { settings });
+    app.add_plugins(ClientNetPlugin)
+        .add_plugins(ViveClientPlugin { settings })
+        .add_plugins(heist_client::signals::SignalsPlugin);
     if *mode != Mode::Headless {
         app.add_plugins((crate::world::WorldPlugin, crate::hud::HudPlugin { wrist: *mode == Mode::Xr }));
     }
@@ -252,6 +313,7 @@ pub fn app(args: &JoinArgs, mode: &Mode) -> anyhow::Result<App> {
     if let Some(audio) = args.audio() {
         crate::sound::add(&mut app, &audio)?;
     }
+    app.insert_resource(args.voice()).add_plugins((heist_voice::VoicePlugin, crate::walkie::WalkiePlugin));
     if let Some(path) = &args.screenshot {
         app.insert_resource(ShotRequest { path: path.clone(), after_frames: args.shot_after })
             .add_systems(Update, shoot);
@@ -285,18 +347,66 @@ fn shoot(
 /// Runs `join`: decides the mode, gets a token, connects, plays until the session ends.
 pub fn join(args: &JoinArgs) -> anyhow::Result<()> {
     use anyhow::Context as _;
-    let (mode, line) = decide_mode(args, crate::xr::probe_from_env);
-    // Logging is not up before the app exists: this line goes to stderr directly, once.
-    eprintln!("client_vr: {line}");
+    let mode = announce_mode(&args.vive);
     let cache = heist_client::SeatCache::in_default_dir();
     let joining =
         heist_client::join_or_resume(args.addr, &args.code, Role::Vive, cache.as_ref(), Duration::from_secs(5))
             .with_context(|| format!("joining {} as Vive", args.addr))?;
-    let mut app = app(args, &mode)?;
+    play(&args.vive, &mode, joining.token, cache, args.addr, None)
+}
+
+/// Runs `host`: starts a server here (or creates a session on `--server`), prints the join code for
+/// Phantom, joins as Vive and plays until the session ends.
+pub fn host(args: &HostArgs) -> anyhow::Result<()> {
+    use anyhow::Context as _;
+    let mode = announce_mode(&args.vive);
+    let (advertised, endpoint, code, token) = match args.server {
+        Some(server) => {
+            let (code, token) = heist_client::create_session(server, Role::Vive, Duration::from_secs(5))
+                .with_context(|| format!("creating a session on {server}"))?;
+            (server, server, code, token)
+        }
+        None => {
+            let here = heist_server::embedded::start(heist_server::embedded::HostOptions {
+                bind: args.bind,
+                advertise: args.advertise,
+                seed: args.seed,
+                time_limit_s: args.time_limit,
+            })?;
+            let token = heist_client::request_token(here.endpoint, &here.code, Role::Vive, Duration::from_secs(5))
+                .with_context(|| format!("joining the session hosted on {}", here.endpoint))?;
+            (here.advertised, here.endpoint, here.code, token)
+        }
+    };
+    let line = format!("You host the heist. Phantom joins at {advertised} with the code {code}.");
+    println!("{line}");
+    let cache = heist_client::SeatCache::in_default_dir();
+    play(&args.vive, &mode, token, cache, endpoint, Some(line))
+}
+
+/// Decides the mode and says which and why, once.
+fn announce_mode(args: &ViveArgs) -> Mode {
+    let (mode, line) = decide_mode(args, crate::xr::probe_from_env);
+    // Logging is not up before the app exists: this line goes to stderr directly, once.
+    eprintln!("client_vr: {line}");
+    mode
+}
+
+/// Builds the app, connects with `token` and plays until the session ends.
+fn play(
+    args: &ViveArgs,
+    mode: &Mode,
+    token: heist_client::ConnectToken,
+    cache: Option<heist_client::SeatCache>,
+    endpoint: SocketAddr,
+    hosted: Option<String>,
+) -> anyhow::Result<()> {
+    let mut app = app(args, mode)?;
+    app.world_mut().resource_mut::<crate::client::ViveState>().hosted = hosted;
     app.finish();
     app.cleanup();
-    heist_client::connect(&mut app, joining.token)?;
-    heist_client::hold_seat(&mut app, cache, args.addr, Role::Vive);
+    heist_client::connect(&mut app, token)?;
+    heist_client::hold_seat(&mut app, cache, endpoint, Role::Vive);
     app.run();
     Ok(())
 }
@@ -311,12 +421,12 @@ pub fn xr_check() -> anyhow::Result<()> {
 mod tests {
     use super::*;
 
-    fn args(extra: &[&str]) -> JoinArgs {
+    fn args(extra: &[&str]) -> ViveArgs {
         let mut argv = vec!["client_vr", "join", "127.0.0.1:5757", "--code", "ABCD"];
         argv.extend_from_slice(extra);
         match Cli::try_parse_from(argv).expect("parses").command {
-            Command::Join(a) => a,
-            Command::XrCheck => panic!("join"),
+            Command::Join(a) => a.vive,
+            _ => panic!("join"),
         }
     }
 

@@ -86,6 +86,8 @@ pub struct ViveState {
     pub pulses: Vec<PulseReason>,
     /// Server states reconciled.
     pub reconciliations: u32,
+    /// When this client hosts: where Phantom joins and with which code (shown in the lobby).
+    pub hosted: Option<String>,
 }
 
 impl ViveState {
@@ -99,7 +101,8 @@ impl ViveState {
         self.predictor.as_ref().map(Predictor::shown)
     }
 
-    fn say(&mut self, now: f64, text: String) {
+    /// Adds a line to the HUD's messages.
+    pub fn say(&mut self, now: f64, text: String) {
         info!("{text}");
         if self.feed.len() >= 64 {
             self.feed.drain(..32);
@@ -254,7 +257,9 @@ fn events(
             GameEvent::Delivered(i) => Some(format!("Copy {} on the workbench", i.0)),
             GameEvent::Verdict { outcome, .. } => Some(format!("Phantom's verdict: {outcome:?}")),
             GameEvent::Alarm(n) => Some(format!("ALARM level {n}")),
+            // The client core has told Phantom it arrived.
             GameEvent::Warning(w) => Some(format!("Phantom warns: {w:?}")),
+            GameEvent::WarningSeen(_) => None,
             GameEvent::GuardAlert { guard, alert, .. } => {
                 let name =
                     state.level.as_ref().and_then(|l| l.guards.get(usize::from(guard.0))).map(|g| g.name.clone());

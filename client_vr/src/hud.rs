@@ -105,7 +105,10 @@ fn spawn(commands: &mut Commands, target: Option<Entity>) {
 pub fn status_text(state: &ViveState, session: Option<&SessionView>, items: &[&ItemView]) -> String {
     let Some(session) = session else { return "Joining...".into() };
     let phase = match session.phase {
-        Phase::Lobby => "Lobby: press Enter (or the trigger) when ready".to_owned(),
+        Phase::Lobby => match &state.hosted {
+            Some(h) => format!("Lobby: press Enter (or the trigger) when ready\n{h}"),
+            None => "Lobby: press Enter (or the trigger) when ready".to_owned(),
+        },
         Phase::Heist => {
             let t = session.time_left_s.max(0.0) as u32;
             format!("{}:{:02} left", t / 60, t % 60)

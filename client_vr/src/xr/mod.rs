@@ -96,6 +96,7 @@ pub struct XrActions {
     trigger: Action<f32>,
     stick: Action<Vector2f>,
     stick_click: Action<bool>,
+    talk: Action<bool>,
     haptic: Action<Haptic>,
 }
 
@@ -168,6 +169,7 @@ impl Plugin for XrInputPlugin {
                 (read_hands, comfort).chain().in_set(IntentSystems::Gather).run_if(openxr_session_running),
             )
             .add_systems(Startup, spawn_mirror)
+            .add_systems(Update, talk_button.run_if(openxr_session_running))
             .add_systems(
                 Update,
                 (pulse, strap_wrist_panel, follow_head)
@@ -188,6 +190,7 @@ fn create_actions(instance: Res<OxrInstance>, mut commands: Commands) {
             trigger: set.create_action("use", "Break, throw", &hands)?,
             stick: set.create_action("move", "Teleport, turn", &hands)?,
             stick_click: set.create_action("run", "Run", &hands)?,
+            talk: set.create_action("talk", "Talk to Phantom (hold)", &hands)?,
             haptic: set.create_action("pulse", "Pulse", &hands)?,
             hands,
             set,
@@ -207,27 +210,35 @@ fn both(p: &str) -> Vec<Cow<'static, str>> {
 
 fn suggest_bindings(actions: Option<Res<XrActions>>, mut out: MessageWriter<OxrSuggestActionBinding>) {
     let Some(a) = actions else { return };
-    // (profile, squeeze, stick, stick click) — every path exists on both hands of its profile.
-    for (profile, squeeze, stick, click) in [
+    // (profile, squeeze, stick, stick click, talk per hand) — every path exists on its hand of its profile.
+    for (profile, squeeze, stick, click, talk) in [
         (
             "/interaction_profiles/htc/vive_controller",
             "/input/squeeze/click",
             "/input/trackpad",
             "/input/trackpad/click",
+            ["/input/menu/click", "/input/menu/click"],
         ),
         (
             "/interaction_profiles/oculus/touch_controller",
             "/input/squeeze/value",
             "/input/thumbstick",
             "/input/thumbstick/click",
+            ["/input/y/click", "/input/b/click"],
         ),
         (
             "/interaction_profiles/valve/index_controller",
             "/input/squeeze/value",
             "/input/thumbstick",
             "/input/thumbstick/click",
+            ["/input/b/click", "/input/b/click"],
         ),
     ] {
+        out.write(OxrSuggestActionBinding {
+            action: a.talk.as_raw(),
+            interaction_profile: profile.into(),
+            bindings: vec![format!("/user/hand/left{}", talk[0]).into(), format!("/user/hand/right{}", talk[1]).into()],
+        });
         let mut bind = |action: openxr::sys::Action, path: &str| {
             out.write(OxrSuggestActionBinding { action, interaction_profile: profile.into(), bindings: both(path) });
         };
@@ -238,6 +249,15 @@ fn suggest_bindings(actions: Option<Res<XrActions>>, mut out: MessageWriter<OxrS
         bind(a.stick.as_raw(), stick);
         bind(a.stick_click.as_raw(), click);
         bind(a.haptic.as_raw(), "/output/haptic");
+    }
+}
+
+/// The walkie-talkie talks while either hand holds its talk button (menu, B or Y).
+fn talk_button(actions: Option<Res<XrActions>>, session: Res<OxrSession>, mut talk: ResMut<heist_voice::Talk>) {
+    let Some(a) = actions else { return };
+    let down = a.hands.iter().any(|h| a.talk.state(&session, *h).is_ok_and(|s| s.current_state));
+    if talk.down != down {
+        talk.down = down;
     }
 }
 

@@ -17,7 +17,7 @@ pub fn join_args(extra: &[&str]) -> JoinArgs {
     argv.extend_from_slice(extra);
     match Cli::try_parse_from(argv).expect("arguments parse").command {
         Command::Join(a) => a,
-        Command::XrCheck => unreachable!(),
+        _ => unreachable!(),
     }
 }
 
@@ -25,7 +25,7 @@ pub fn join_args(extra: &[&str]) -> JoinArgs {
 /// one tick per update; `setup` adds test systems before it connects.
 pub fn vive_client(server: &HostedServer, args: &JoinArgs, setup: impl FnOnce(&mut App)) -> App {
     let token = heist_server::demo::token(server, Role::Vive).expect("token");
-    let mut app = client_vr::cli::app(args, &Mode::Headless).expect("the app builds");
+    let mut app = client_vr::cli::app(&args.vive, &Mode::Headless).expect("the app builds");
     app.insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f64(1.0 / TICK_HZ)));
     setup(&mut app);
     app.finish();
