@@ -1,7 +1,8 @@
 //! The server's whole intake under arbitrary traffic: datagrams from an unknown, a pending and a connected
 //! address, and renet packets sealed with the connected client's key (the only way random bytes get past
 //! netcode's encryption to renet), then every message renet delivers through the server's `ClientMsg`
-//! decoder. The channels are the game's own, from its registered protocol.
+//! decoder (and what arrives on the voice channel through the `ClientVoice` decoder). The channels are
+//! the game's own, from its registered protocol.
 //!
 //! `cargo fuzz run intake` (see README, "Fuzzing").
 #![no_main]
@@ -13,7 +14,7 @@ use arbitrary::Arbitrary;
 use bevy::prelude::*;
 use bevy_replicon::prelude::*;
 use bevy_replicon::shared::message::registry::RemoteMessageRegistry;
-use heist_shared::protocol::{ClientMsg, ProtocolPlugin, decode_client_msg};
+use heist_shared::protocol::{ClientMsg, ClientVoice, ProtocolPlugin, decode_client_msg};
 use heist_transport::IntakeLimits;
 use heist_transport::memory::{MemoryServer, RawClient};
 use heist_transport::renet::ConnectionConfig;
@@ -34,11 +35,12 @@ enum Op {
     Frame,
 }
 
-/// The game's renet channels and the channel `ClientMsg` travels on.
+/// The game's renet channels and the channels `ClientMsg` and `ClientVoice` travel on.
 struct Protocol {
     config: ConnectionConfig,
     client_channels: u8,
     messages: u8,
+    voice: u8,
 }
 
 fn protocol() -> &'static Protocol {
@@ -54,7 +56,12 @@ fn protocol() -> &'static Protocol {
             .resource::<RemoteMessageRegistry>()
             .client_message_channel::<ClientMsg>()
             .expect("ClientMsg is registered") as u8;
-        Protocol { config, client_channels, messages }
+        let voice = app
+            .world()
+            .resource::<RemoteMessageRegistry>()
+            .client_message_channel::<ClientVoice>()
+            .expect("ClientVoice is registered") as u8;
+        Protocol { config, client_channels, messages, voice }
     })
 }
 
@@ -88,6 +95,8 @@ fuzz_target!(|ops: Vec<Op>| {
             while let Some(message) = server.renet.receive_message(client, channel) {
                 if channel == protocol.messages {
                     let _ = decode_client_msg(&message);
+                } else if channel == protocol.voice {
+                    let _ = heist_shared::protocol::voice::decode(&message);
                 }
             }
         }

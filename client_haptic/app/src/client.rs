@@ -574,24 +574,29 @@ fn announce_events(
         if matches!(e, GameEvent::PhaseChanged(Phase::Won | Phase::Lost(_))) && !bot {
             speaker.say("Enter asks for another round; Q leaves.");
         }
-        match e {
-            GameEvent::Joined(r) | GameEvent::Resumed(r) if *r == Role::Vive => audio.earcon(Earcon::PartnerIn),
-            GameEvent::Left { role: Role::Vive, .. } | GameEvent::GaveUp(Role::Vive) => {
-                audio.earcon(Earcon::PartnerOut)
-            }
-            GameEvent::WarningSeen(_) => audio.earcon(Earcon::WarningHeard),
-            GameEvent::Verdict { outcome: VerdictOutcome::Wrong, .. } => audio.earcon(Earcon::Wrong),
-            GameEvent::Verdict { .. } => audio.earcon(Earcon::Right),
-            GameEvent::Alarm(_) => audio.earcon(Earcon::AlarmUp),
-            GameEvent::PhaseChanged(Phase::Won) => audio.earcon(Earcon::Won),
-            GameEvent::PhaseChanged(Phase::Lost(_)) => audio.earcon(Earcon::Lost),
-            _ => {}
+        if let Some(earcon) = earcon_for(e) {
+            audio.earcon(earcon);
         }
     }
     if let Some(kind) = state.arrived.take() {
         audio.earcon(Earcon::CopyArrived);
         speaker.say(status::copy_arrived(kind));
     }
+}
+
+/// The earcon that goes with an event's words, if one does.
+pub fn earcon_for(e: &GameEvent) -> Option<Earcon> {
+    Some(match e {
+        GameEvent::Joined(Role::Vive) | GameEvent::Resumed(Role::Vive) => Earcon::PartnerIn,
+        GameEvent::Left { role: Role::Vive, .. } | GameEvent::GaveUp(Role::Vive) => Earcon::PartnerOut,
+        GameEvent::WarningSeen(_) => Earcon::WarningHeard,
+        GameEvent::Verdict { outcome: VerdictOutcome::Wrong, .. } => Earcon::Wrong,
+        GameEvent::Verdict { .. } => Earcon::Right,
+        GameEvent::Alarm(_) => Earcon::AlarmUp,
+        GameEvent::PhaseChanged(Phase::Won) => Earcon::Won,
+        GameEvent::PhaseChanged(Phase::Lost(_)) => Earcon::Lost,
+        _ => return None,
+    })
 }
 
 /// Each guard's alert is said once per change, and a new round starts every guard afresh.
@@ -750,6 +755,26 @@ mod tests {
                 ..Default::default()
             })
             .collect()
+    }
+
+    #[test]
+    fn the_partners_coming_and_going_and_a_received_warning_each_have_an_earcon() {
+        use heist_shared::protocol::WarningKind;
+        assert_eq!(earcon_for(&GameEvent::Joined(Role::Vive)), Some(Earcon::PartnerIn));
+        assert_eq!(earcon_for(&GameEvent::Resumed(Role::Vive)), Some(Earcon::PartnerIn));
+        assert_eq!(earcon_for(&GameEvent::Left { role: Role::Vive, dropped: true }), Some(Earcon::PartnerOut));
+        assert_eq!(earcon_for(&GameEvent::Left { role: Role::Vive, dropped: false }), Some(Earcon::PartnerOut));
+        assert_eq!(earcon_for(&GameEvent::GaveUp(Role::Vive)), Some(Earcon::PartnerOut));
+        assert_eq!(earcon_for(&GameEvent::WarningSeen(WarningKind::Hide)), Some(Earcon::WarningHeard));
+        assert_eq!(earcon_for(&GameEvent::Joined(Role::Phantom)), None, "one's own joining is no news");
+        let earcons = [Earcon::PartnerIn, Earcon::PartnerOut, Earcon::LinkDown, Earcon::LinkUp, Earcon::WarningHeard];
+        let sounds: Vec<_> = earcons.iter().map(|e| crate::audio::synth::earcon(*e).frames.to_vec()).collect();
+        for (i, a) in sounds.iter().enumerate() {
+            assert!(a.iter().any(|f| f.left.abs() > 0.1), "{:?} is audible", earcons[i]);
+            for b in &sounds[i + 1..] {
+                assert_ne!(a, b, "each notice sounds different");
+            }
+        }
     }
 
     #[test]

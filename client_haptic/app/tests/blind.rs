@@ -344,3 +344,60 @@ fn a_blind_players_walkthrough_host_share_the_code_talk_warn_change_a_setting_pl
     assert!(saved.contains("speech_rate = 200"), "{saved}");
     let _ = std::fs::remove_dir_all(dir);
 }
+
+#[test]
+fn the_partner_joining_dropping_and_coming_back_is_heard_in_that_order() {
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let (stop, away) = (Arc::new(AtomicBool::new(false)), Arc::new(AtomicBool::new(false)));
+    let (tx, rx_code) = std::sync::mpsc::channel();
+    let (host_stop, vive_away) = (stop.clone(), away.clone());
+    // A host with an idle Vive bot that holds its seat: while `away` is set its client stands still
+    // (a frozen laptop); afterwards its client notices the silence and takes the seat back by itself.
+    let host = std::thread::spawn(move || {
+        let mut server = heist_server::build_server(heist_server::ServerOptions::local_test(9)).expect("server");
+        let endpoint = server.tokens.as_ref().expect("secure").addr;
+        tx.send((endpoint, server.join_code().expect("a code").code)).expect("the test waits");
+        let mut vive: Option<bevy::app::App> = None;
+        let deadline = Instant::now() + Duration::from_secs(120);
+        while !host_stop.load(Ordering::Relaxed) && Instant::now() < deadline {
+            std::thread::sleep(Duration::from_millis(16));
+            server.app.update();
+            if vive.is_none() && server.game().is_present(Role::Phantom) {
+                let token = heist_server::demo::token(&server, Role::Vive).expect("a token");
+                let mut app = heist_server::demo::stepped_client_app();
+                app.add_plugins(heist_bots::ViveBotPlugin { style: heist_bots::ViveStyle::Idle });
+                app.finish();
+                app.cleanup();
+                heist_client::connect(&mut app, token).expect("connects");
+                heist_client::hold_seat(&mut app, None, endpoint, Role::Vive);
+                vive = Some(app);
+            }
+            if let Some(v) = vive.as_mut().filter(|_| !vive_away.load(Ordering::Relaxed)) {
+                v.update();
+            }
+        }
+        server.log().to_vec()
+    });
+    let (addr, code) = rx_code.recv_timeout(Duration::from_secs(30)).expect("the host starts");
+    let dir = home("partner-notices");
+    let (mut child, mut stdin, rx) = headless_with_cache(&["join", &addr.to_string(), "--code", &code], &dir);
+    let mut lines = Vec::new();
+    let t = Duration::from_secs(30);
+    assert!(hear(&rx, &mut lines, "Vive joined.", t), "{lines:#?}");
+    away.store(true, Ordering::Relaxed);
+    assert!(hear(&rx, &mut lines, "Vive's connection dropped.", t), "{lines:#?}");
+    away.store(false, Ordering::Relaxed);
+    assert!(hear(&rx, &mut lines, "Vive is back.", t), "{lines:#?}");
+    writeln!(stdin, "q").expect("types q");
+    let status = wait(&mut child, Duration::from_secs(10));
+    stop.store(true, Ordering::Relaxed);
+    let log = host.join().expect("the host thread");
+    assert!(status.is_some_and(|s| s.success()), "{status:?}");
+    let at = |text: &str| lines.iter().position(|l| l.starts_with(text));
+    assert!(
+        at("Vive joined.") < at("Vive's connection dropped.") && at("Vive's connection dropped.") < at("Vive is back.")
+    );
+    assert!(log.iter().any(|l| l.contains("Vive is back")), "{log:#?}");
+    let _ = std::fs::remove_dir_all(dir);
+}
