@@ -89,21 +89,9 @@ pub struct JoinArgs {
 /// Arguments of `host`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct HostArgs {
-    /// Where the server listens (UDP game, TCP join endpoint); 0.0.0.0 for players on other machines.
-    #[arg(long, default_value = "127.0.0.1:5757")]
-    pub bind: SocketAddr,
-    /// The address the partner reaches (behind a NAT or relay).
-    #[arg(long)]
-    pub advertise: Option<SocketAddr>,
-    /// Seed of the first round (default: random, so nobody knows which copies are real).
-    #[arg(long)]
-    pub seed: Option<u64>,
-    /// Seconds a heist lasts (default: the museum's 600).
-    #[arg(long)]
-    pub time_limit: Option<f32>,
-    /// Create the session on this running server (`heist-server serve`) instead of hosting one here.
-    #[arg(long, conflicts_with_all = ["bind", "advertise", "seed", "time_limit"])]
-    pub server: Option<SocketAddr>,
+    /// Where and what to host.
+    #[command(flatten)]
+    pub host: heist_server::embedded::HostFlags,
     /// How to play.
     #[command(flatten)]
     pub vive: ViveArgs,
@@ -157,15 +145,9 @@ pub struct ViveArgs {
     /// Quit this many seconds after the heist ends.
     #[arg(long, default_value_t = 5.0)]
     pub quit_after: f32,
-    /// A WAV file as the walkie-talkie's microphone: each transmission says it from its start.
-    #[arg(long, conflicts_with = "no_mic")]
-    pub mic_wav: Option<PathBuf>,
-    /// No microphone: the walkie-talkie only listens (also without a sound card, unless --mic-wav).
-    #[arg(long)]
-    pub no_mic: bool,
-    /// Transmit from the start without push-to-talk (with --mic-wav: say the file once, then stop).
-    #[arg(long)]
-    pub open_mic: bool,
+    /// The walkie-talkie's microphone.
+    #[command(flatten)]
+    pub voice: heist_voice::VoiceFlags,
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -201,17 +183,9 @@ pub fn decide_mode(args: &ViveArgs, probe: impl FnOnce() -> XrProbe) -> (Mode, S
 }
 
 impl ViveArgs {
-    /// The walkie-talkie's settings these arguments ask for.
-    pub fn voice(&self) -> heist_voice::VoiceSettings {
-        heist_voice::VoiceSettings {
-            // Without a sound card (headless's default, or memory) there is no microphone either.
-            mic: match (&self.mic_wav, self.no_mic || !matches!(self.audio_choice(), AudioChoice::Card)) {
-                (Some(path), _) => heist_voice::MicChoice::Wav(path.clone()),
-                (None, true) => heist_voice::MicChoice::Off,
-                (None, false) => heist_voice::MicChoice::Device,
-            },
-            mode: if self.open_mic { heist_voice::TalkMode::Open } else { heist_voice::TalkMode::PushToTalk },
-        }
+    /// The walkie-talkie's settings these arguments ask for (no sound card: no microphone either).
+    pub fn voice_settings(&self) -> heist_voice::VoiceSettings {
+        self.voice.settings(self.audio_choice() == AudioChoice::Card)
     }
 
     /// The client settings these arguments ask for.
@@ -313,7 +287,7 @@ pub fn app(args: &ViveArgs, mode: &Mode) -> anyhow::Result<App> {
     if let Some(audio) = args.audio() {
         crate::sound::add(&mut app, &audio)?;
     }
-    app.insert_resource(args.voice()).add_plugins((heist_voice::VoicePlugin, crate::walkie::WalkiePlugin));
+    app.insert_resource(args.voice_settings()).add_plugins((heist_voice::VoicePlugin, crate::walkie::WalkiePlugin));
     if let Some(path) = &args.screenshot {
         app.insert_resource(ShotRequest { path: path.clone(), after_frames: args.shot_after })
             .add_systems(Update, shoot);
@@ -360,19 +334,14 @@ pub fn join(args: &JoinArgs) -> anyhow::Result<()> {
 pub fn host(args: &HostArgs) -> anyhow::Result<()> {
     use anyhow::Context as _;
     let mode = announce_mode(&args.vive);
-    let (advertised, endpoint, code, token) = match args.server {
+    let (advertised, endpoint, code, token) = match args.host.server {
         Some(server) => {
             let (code, token) = heist_client::create_session(server, Role::Vive, Duration::from_secs(5))
                 .with_context(|| format!("creating a session on {server}"))?;
             (server, server, code, token)
         }
         None => {
-            let here = heist_server::embedded::start(heist_server::embedded::HostOptions {
-                bind: args.bind,
-                advertise: args.advertise,
-                seed: args.seed,
-                time_limit_s: args.time_limit,
-            })?;
+            let here = heist_server::embedded::start(args.host.options())?;
             let token = heist_client::request_token(here.endpoint, &here.code, Role::Vive, Duration::from_secs(5))
                 .with_context(|| format!("joining the session hosted on {}", here.endpoint))?;
             (here.advertised, here.endpoint, here.code, token)

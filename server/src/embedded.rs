@@ -23,6 +23,33 @@ pub struct Embedded {
     pub code: String,
 }
 
+/// The `host` command's flags, the same in both clients.
+#[derive(clap::Args, Clone, Copy, Debug)]
+pub struct HostFlags {
+    /// Where the server listens (UDP game, TCP join endpoint); 0.0.0.0 for players on other machines.
+    #[arg(long, default_value = "127.0.0.1:5757")]
+    pub bind: SocketAddr,
+    /// The address the partner reaches (behind a NAT or relay).
+    #[arg(long)]
+    pub advertise: Option<SocketAddr>,
+    /// Seed of the first round (default: random, so nobody knows which copies are real).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Seconds a heist lasts (default: the museum's 600).
+    #[arg(long)]
+    pub time_limit: Option<f32>,
+    /// Create the session on this running server (`heist-server serve`) instead of hosting one here.
+    #[arg(long, conflicts_with_all = ["bind", "advertise", "seed", "time_limit"])]
+    pub server: Option<SocketAddr>,
+}
+
+impl HostFlags {
+    /// The server to start here (when `--server` names none).
+    pub fn options(&self) -> HostOptions {
+        HostOptions { bind: self.bind, advertise: self.advertise, seed: self.seed, time_limit_s: self.time_limit }
+    }
+}
+
 /// What a server started in this process plays, and where.
 #[derive(Clone, Copy, Debug)]
 pub struct HostOptions {

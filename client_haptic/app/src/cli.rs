@@ -152,15 +152,9 @@ pub struct ClientArgs {
     /// The push-to-talk key for this run.
     #[arg(long, value_enum)]
     pub talk_key: Option<crate::settings::TalkKey>,
-    /// A WAV file as the walkie-talkie's microphone: each transmission says it from its start.
-    #[arg(long, conflicts_with = "no_mic")]
-    pub mic_wav: Option<PathBuf>,
-    /// No microphone: the walkie-talkie only listens (also with `--audio memory` and no --mic-wav).
-    #[arg(long)]
-    pub no_mic: bool,
-    /// Transmit from the start without push-to-talk (with --mic-wav: say the file once, then stop).
-    #[arg(long)]
-    pub open_mic: bool,
+    /// The walkie-talkie's microphone.
+    #[command(flatten)]
+    pub voice: heist_voice::VoiceFlags,
     /// Real-time priority (1–99) for the haptic thread, if the system allows it.
     #[arg(long)]
     pub realtime: Option<i32>,
@@ -210,15 +204,7 @@ impl ClientArgs {
                 ..Default::default()
             },
             prefs,
-            voice: heist_voice::VoiceSettings {
-                // Rendering into memory means no sound device: no microphone either, unless a file is it.
-                mic: match (&self.mic_wav, self.no_mic || self.audio == AudioChoice::Memory) {
-                    (Some(path), _) => heist_voice::MicChoice::Wav(path.clone()),
-                    (None, true) => heist_voice::MicChoice::Off,
-                    (None, false) => heist_voice::MicChoice::Device,
-                },
-                mode: if self.open_mic { heist_voice::TalkMode::Open } else { heist_voice::TalkMode::PushToTalk },
-            },
+            voice: self.voice.settings(self.audio == AudioChoice::Card),
         })
     }
 }

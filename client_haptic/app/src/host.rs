@@ -14,21 +14,9 @@ use crate::cli::ClientArgs;
 /// Arguments of `host`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct HostArgs {
-    /// Where the server listens (UDP game, TCP join endpoint); 0.0.0.0 for players on other machines.
-    #[arg(long, default_value = "127.0.0.1:5757")]
-    pub bind: SocketAddr,
-    /// The address the partner reaches (behind a NAT or relay).
-    #[arg(long)]
-    pub advertise: Option<SocketAddr>,
-    /// Seed of the first round (default: random, so nobody knows which copies are real).
-    #[arg(long)]
-    pub seed: Option<u64>,
-    /// Seconds a heist lasts (default: the museum's 600).
-    #[arg(long)]
-    pub time_limit: Option<f32>,
-    /// Create the session on this running server (`heist-server serve`) instead of hosting one here.
-    #[arg(long, conflicts_with_all = ["bind", "advertise", "seed", "time_limit"])]
-    pub server: Option<SocketAddr>,
+    /// Where and what to host.
+    #[command(flatten)]
+    pub host: heist_server::embedded::HostFlags,
     /// Device, window, audio and bot settings, as for `join`.
     #[command(flatten)]
     pub client: ClientArgs,
@@ -59,7 +47,7 @@ pub fn spell(code: &str) -> String {
 pub fn host(args: &HostArgs) -> anyhow::Result<()> {
     let mut settings = args.client.settings().map_err(anyhow::Error::msg)?;
     let mut prompter = crate::prompt::Prompter::new(&mut settings)?;
-    let started = match args.server {
+    let started = match args.host.server {
         Some(server) => match heist_client::create_session(server, Role::Phantom, Duration::from_secs(5)) {
             Ok((code, token)) => Ok((server, server, code, token)),
             Err(e) => {
@@ -70,7 +58,7 @@ pub fn host(args: &HostArgs) -> anyhow::Result<()> {
         None => host_here(args).inspect_err(|e| {
             prompter.say(format!(
                 "Could not host the heist: {e:#}. If another program uses port {}, choose another with --bind.",
-                args.bind.port()
+                args.host.bind.port()
             ))
         }),
     };
@@ -99,12 +87,7 @@ pub fn host(args: &HostArgs) -> anyhow::Result<()> {
 /// Starts the server in this process; returns its advertised address, its endpoint, the code and
 /// Phantom's token.
 fn host_here(args: &HostArgs) -> anyhow::Result<(SocketAddr, SocketAddr, String, heist_client::ConnectToken)> {
-    let here = heist_server::embedded::start(heist_server::embedded::HostOptions {
-        bind: args.bind,
-        advertise: args.advertise,
-        seed: args.seed,
-        time_limit_s: args.time_limit,
-    })?;
+    let here = heist_server::embedded::start(args.host.options())?;
     let token = heist_client::request_token(here.endpoint, &here.code, Role::Phantom, Duration::from_secs(5))
         .with_context(|| format!("joining the session hosted on {}", here.endpoint))?;
     Ok((here.advertised, here.endpoint, here.code, token))

@@ -17,6 +17,7 @@ use heist_conditioner::{Conditions, SteppedRelay};
 use heist_server::demo::join;
 use heist_server::{ServerOptions, build_server};
 use heist_shared::protocol::{Role, TICK_HZ};
+use heist_voice::measure::{align, envelope};
 use heist_voice::plugin::Voice;
 use heist_voice::{MicChoice, TalkMode, VoicePlugin, VoiceSettings};
 
@@ -36,30 +37,6 @@ fn sentence(name: &str) -> (std::path::PathBuf, Vec<f32>) {
     assert!(status.success());
     let samples = heist_voice::mic::read_wav(&path).expect("the sentence reads");
     (path, samples)
-}
-
-/// Energy envelope: RMS over windows of `hop` samples.
-fn envelope(x: &[f32], hop: usize) -> Vec<f32> {
-    x.chunks(hop).map(|c| (c.iter().map(|s| s * s).sum::<f32>() / c.len() as f32).sqrt()).collect()
-}
-
-fn pearson(a: &[f32], b: &[f32]) -> f32 {
-    let n = a.len().min(b.len());
-    let (a, b) = (&a[..n], &b[..n]);
-    let (ma, mb) = (a.iter().sum::<f32>() / n as f32, b.iter().sum::<f32>() / n as f32);
-    let cov: f32 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
-    let va: f32 = a.iter().map(|x| (x - ma).powi(2)).sum();
-    let vb: f32 = b.iter().map(|y| (y - mb).powi(2)).sum();
-    cov / (va * vb).sqrt().max(1e-12)
-}
-
-/// The lag (in envelope windows, 0..max_lag) at which `heard` best matches `said`, and the correlation.
-fn align(said: &[f32], heard: &[f32], max_lag: usize) -> (usize, f32) {
-    (0..max_lag)
-        .filter(|lag| heard.len() > lag + said.len() / 2)
-        .map(|lag| (lag, pearson(said, &heard[lag..])))
-        .max_by(|a, b| a.1.total_cmp(&b.1))
-        .unwrap_or((0, 0.0))
 }
 
 struct Heard {
@@ -125,6 +102,7 @@ fn talk_over(conditions: Option<Conditions>, name: &str) -> Heard {
     let heard = &heard[mouth_tick * PER_TICK..];
     let hop = RATE / 400; // 2.5 ms windows
     let (lag, correlation) = align(&envelope(&said, hop), &envelope(heard, hop), 400);
+    // (heist_voice::measure: RMS envelopes in 2.5 ms windows, the lag of best Pearson correlation.)
     let latency_ms = (lag * hop) as f32 / RATE as f32 * 1000.0 + 1000.0 / TICK_HZ as f32;
     let voice = phantom.world().non_send::<Voice>();
     let stats = voice.rx.as_ref().expect("Phantom plays the partner's voice").stats();

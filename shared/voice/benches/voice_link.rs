@@ -16,6 +16,7 @@ use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
 use heist_audio::{AudioEngine, AudioOutput, AudioSettings};
 use heist_shared::protocol::{ClientMsg, GameEvent, PhantomMsg, Role, WarningKind};
+use heist_voice::measure::{envelope, pearson};
 use heist_voice::plugin::Voice;
 use heist_voice::{MicChoice, TalkMode, VoicePlugin, VoiceSettings};
 
@@ -112,10 +113,7 @@ fn run(wav: Option<&std::path::Path>, said: &[f32], seconds: f64) -> Run {
         (Some(mouth), Some(from), Some(_)) => {
             // Envelopes in 2.5 ms windows; the lag where what was heard best follows what was said.
             let hop = 120;
-            let env = |x: &[f32]| -> Vec<f32> {
-                x.chunks(hop).map(|c| (c.iter().map(|s| s * s).sum::<f32>() / c.len() as f32).sqrt()).collect()
-            };
-            let (said_env, heard_env) = (env(&said[..said.len().min(48_000 * 4)]), env(&heard));
+            let (said_env, heard_env) = (envelope(&said[..said.len().min(48_000 * 4)], hop), envelope(&heard, hop));
             // Where the mouth's start falls in what was heard.
             let offset = (mouth.duration_since(from).as_secs_f64() * RATE / hop as f64).floor() as usize;
             let lag = (0..200).filter(|l| heard_env.len() > offset + l + said_env.len()).max_by(|a, b| {
@@ -130,16 +128,6 @@ fn run(wav: Option<&std::path::Path>, said: &[f32], seconds: f64) -> Run {
         _ => None,
     };
     Run { latency_ms, warn_delays_ms, voice_frames: voice_frames.unwrap_or(0) }
-}
-
-fn pearson(a: &[f32], b: &[f32]) -> f32 {
-    let n = a.len().min(b.len());
-    let (a, b) = (&a[..n], &b[..n]);
-    let (ma, mb) = (a.iter().sum::<f32>() / n as f32, b.iter().sum::<f32>() / n as f32);
-    let cov: f32 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
-    let va: f32 = a.iter().map(|x| (x - ma).powi(2)).sum();
-    let vb: f32 = b.iter().map(|y| (y - mb).powi(2)).sum();
-    cov / (va * vb).sqrt().max(1e-12)
 }
 
 fn quantile(v: &[f64], q: f64) -> f64 {

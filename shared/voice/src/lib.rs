@@ -11,19 +11,21 @@
 //!   loss concealment);
 //! - [`playback`]: a kira sound that pulls frames from the jitter buffer and decodes them on the audio
 //!   thread, so the playout clock is the sound card's (no allocation, lock or log there);
-//! - [`plugin`]: the Bevy plugin both clients add ([`VoicePlugin`]), steered by the [`Talk`] resource.
+//! - [`plugin`]: the Bevy plugin both clients add ([`VoicePlugin`]), steered by the [`Talk`] resource;
+//! - [`measure`]: envelopes and alignment, to measure a voice path end to end.
 #![warn(missing_docs)]
 
 pub mod codec;
 mod error;
 pub mod jitter;
+pub mod measure;
 pub mod mic;
 pub mod playback;
 pub mod plugin;
 pub mod tx;
 
 pub use error::VoiceError;
-pub use plugin::{HeardVoice, MicChoice, Talk, TalkMode, VoicePlugin, VoiceSettings, VoiceSystems};
+pub use plugin::{HeardVoice, MicChoice, Talk, TalkMode, VoiceFlags, VoicePlugin, VoiceSettings, VoiceSystems};
 
 pub use heist_shared::protocol::voice::{MAX_VOICE_BYTES, VOICE_FRAME_SAMPLES, VOICE_SAMPLE_RATE};
 

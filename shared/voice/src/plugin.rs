@@ -49,6 +49,36 @@ pub struct VoiceSettings {
     pub mode: TalkMode,
 }
 
+/// The walkie-talkie's command-line flags, the same in both clients (`clap` with the `cli` feature).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
+pub struct VoiceFlags {
+    /// A WAV file as the walkie-talkie's microphone: each transmission says it from its start.
+    #[cfg_attr(feature = "cli", arg(long, conflicts_with = "no_mic"))]
+    pub mic_wav: Option<PathBuf>,
+    /// No microphone: the walkie-talkie only listens (also when there is no sound card, unless --mic-wav).
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub no_mic: bool,
+    /// Transmit from the start without push-to-talk (with --mic-wav: say the file once, then stop).
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub open_mic: bool,
+}
+
+impl VoiceFlags {
+    /// The settings these flags ask for; `sound_card` says whether the client plays on a sound card
+    /// (without one there is no microphone either, unless a file is given).
+    pub fn settings(&self, sound_card: bool) -> VoiceSettings {
+        VoiceSettings {
+            mic: match (&self.mic_wav, self.no_mic || !sound_card) {
+                (Some(path), _) => MicChoice::Wav(path.clone()),
+                (None, true) => MicChoice::Off,
+                (None, false) => MicChoice::Device,
+            },
+            mode: if self.open_mic { TalkMode::Open } else { TalkMode::PushToTalk },
+        }
+    }
+}
+
 /// Push-to-talk, as the app's input systems set it each frame.
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Talk {
