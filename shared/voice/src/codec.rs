@@ -44,6 +44,24 @@ pub enum Decode<'a> {
     Conceal,
 }
 
+/// Why a frame could not be decoded (plain data: the audio thread makes it without allocating).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DecodeError {
+    /// libopus refused the packet.
+    Opus(opus::ErrorCode),
+    /// The packet held this many samples, not one 20 ms frame.
+    Length(usize),
+}
+
+impl std::fmt::Display for DecodeError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            DecodeError::Opus(code) => write!(f, "opus: {}", code.description()),
+            DecodeError::Length(n) => write!(f, "a packet of {n} samples, not {VOICE_FRAME_SAMPLES}"),
+        }
+    }
+}
+
 /// Turns packets back into speech, and fills lost frames.
 pub struct Decoder {
     inner: opus::Decoder,
@@ -56,24 +74,20 @@ impl Decoder {
     }
 
     /// Decodes one frame into `out`; on an error `out` is silence and the error is returned (the audio
-    /// thread counts it, it does not log).
-    pub fn decode(&mut self, how: Decode<'_>, out: &mut [f32; VOICE_FRAME_SAMPLES]) -> Result<(), VoiceError> {
+    /// thread counts it, it does not log). Never allocates.
+    pub fn decode(&mut self, how: Decode<'_>, out: &mut [f32; VOICE_FRAME_SAMPLES]) -> Result<(), DecodeError> {
         let r = match how {
             Decode::Packet(p) => self.inner.decode_float(p, out, false),
             Decode::Recover(next) => self.inner.decode_float(next, out, true),
             Decode::Conceal => self.inner.decode_float(&[], out, false),
         };
-        match r {
-            Ok(n) if n == VOICE_FRAME_SAMPLES => Ok(()),
-            Ok(n) => {
-                out.fill(0.0);
-                Err(VoiceError::Codec(format!("a packet of {n} samples, not {VOICE_FRAME_SAMPLES}")))
-            }
-            Err(e) => {
-                out.fill(0.0);
-                Err(e.into())
-            }
-        }
+        let r = match r {
+            Ok(n) if n == VOICE_FRAME_SAMPLES => return Ok(()),
+            Ok(n) => DecodeError::Length(n),
+            Err(e) => DecodeError::Opus(e.code()),
+        };
+        out.fill(0.0);
+        Err(r)
     }
 }
 

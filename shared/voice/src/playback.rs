@@ -121,7 +121,7 @@ impl VoiceSound {
             }
         };
         if decoded.is_err() {
-            // The error's text is dropped here: formatting it allocated, and this is the audio thread.
+            // Counted, not logged: this is the audio thread.
             self.shared.errors.fetch_add(1, Ordering::Relaxed);
         }
         let stats = self.jitter.stats();
