@@ -104,3 +104,60 @@ fn a_rough_scrape_is_louder_than_a_smooth_one() {
     };
     assert!(scrape(1.0) > 1.5 * scrape(0.0));
 }
+
+#[test]
+fn hrtf_turned_off_while_playing_renders_as_time_and_level_from_then_on() {
+    let mut switched = engine(SpatialMode::Hrtf);
+    assert!(switched.uses_hrtf());
+    switched.set_hrtf(false);
+    assert!(!switched.uses_hrtf());
+    let mut plain = engine(SpatialMode::TimeLevel);
+    for e in [&mut switched, &mut plain] {
+        e.play_at(click(), Vec3::new(2.0, 0.0, 0.0), "click");
+    }
+    let a = switched.capture().expect("memory output").render(4800);
+    let b = plain.capture().expect("memory output").render(4800);
+    let diff: f32 = a.iter().zip(&b).map(|(x, y)| (x.0 - y.0).abs() + (x.1 - y.1).abs()).sum();
+    assert!(diff < 1e-3, "the same as an engine started without HRTF: {diff}");
+    switched.set_hrtf(true);
+    switched.play_at(click(), Vec3::new(2.0, 0.0, 0.0), "click");
+    let c = switched.capture().expect("memory output").render(4800);
+    plain.play_at(click(), Vec3::new(2.0, 0.0, 0.0), "click");
+    let d = plain.capture().expect("memory output").render(4800);
+    let diff: f32 = c.iter().zip(&d).map(|(x, y)| (x.0 - y.0).abs() + (x.1 - y.1).abs()).sum();
+    assert!(diff > 1.0, "turned back on, it renders through the HRTF again: {diff}");
+}
+
+#[test]
+fn speech_lines_are_said_one_after_the_other_never_over_each_other() {
+    let mut e = engine(SpatialMode::Hrtf);
+    let capture = e.capture().expect("memory output").clone();
+    // Two half-second "lines" given at once: the second starts when the first has ended.
+    let line = synth::mono(&vec![0.5; 24_000]);
+    e.speak(line.clone());
+    e.speak(line);
+    assert!(e.is_speaking());
+    let mut loud = 0;
+    for _ in 0..30 {
+        let frames = capture.render(4800);
+        loud += frames.iter().filter(|f| f.0.abs() + f.1.abs() > 0.05).count();
+        e.update();
+    }
+    // Overlapping, they would have sounded for half a second; in turn, for about a second.
+    assert!(loud > 40_000, "{loud} loud frames");
+    assert!(!e.is_speaking());
+}
+
+#[test]
+fn each_groups_volume_sets_its_own_level() {
+    let mut e = engine(SpatialMode::TimeLevel);
+    let capture = e.capture().expect("memory output").clone();
+    e.set_volumes(Volumes { earcon_db: kira::Decibels::SILENCE.0, ..Default::default() });
+    capture.render(4800);
+    e.earcon(synth::Earcon::Won);
+    let (l, r) = energy(&capture.render(48_000));
+    assert!(l + r < 1e-6, "earcons muted: {}", l + r);
+    e.play_at(click(), Vec3::new(0.0, 0.0, -1.0), "click");
+    let (l, r) = energy(&capture.render(9600));
+    assert!(l + r > 1.0, "the museum still plays: {}", l + r);
+}
