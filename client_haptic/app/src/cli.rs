@@ -408,7 +408,7 @@ fn get_a_seat(
 ) -> anyhow::Result<(SocketAddr, heist_client::Joining)> {
     use crate::prompt::Next;
     let asking = args.code.is_none();
-    let no_answer = || anyhow::anyhow!("joining: no answer was typed");
+    let no_answer = || anyhow::anyhow!("joining: no answer (the input ended, or the client was stopped)");
     let mut addr = args.addr;
     let mut code = args.code.clone();
     loop {
