@@ -3,14 +3,16 @@
 use heist_bots::ViveStyle;
 use heist_server::ServerOptions;
 use heist_shared::protocol::{LossReason, Phase};
-use heist_tests::bot_heist;
+use heist_tests::{bot_heist, easy};
 
 #[test]
 fn a_reckless_vive_gets_caught() {
     for seed in [1, 2] {
         let (phase, log, t) = bot_heist(ServerOptions::local_test(seed), ViveStyle::Reckless, 120.0);
         assert_eq!(phase, Phase::Lost(LossReason::Caught), "seed {seed} after {t} s:\n{}", log.join("\n"));
-        assert!(log.iter().any(|l| l.contains("Chasing")), "a guard chased him first");
+        // Running is heard: a guard comes to look (or chases) before the catch.
+        let alerted = ["Investigating", "Chasing", "Searching"];
+        assert!(log.iter().any(|l| alerted.iter().any(|a| l.contains(a))), "a guard was after him first");
     }
 }
 
@@ -35,20 +37,21 @@ fn careful_bots_break_cases_and_get_verdicts_over_the_network() {
 
 #[test]
 fn careful_bots_can_win_a_whole_heist() {
-    // Seed 12 is one the careful bot wins, delivering fakes too (deterministic: stepped clock, loopback UDP).
-    let (phase, log, t) = bot_heist(ServerOptions::local_test(12), ViveStyle::Careful, 600.0);
+    // Seed 2 on easy is one the careful bot wins, delivering fakes too (deterministic: stepped clock,
+    // loopback UDP).
+    let (phase, log, t) = bot_heist(easy(2), ViveStyle::Careful, 750.0);
     assert_eq!(phase, Phase::Won, "after {t} s:\n{}", log.join("\n"));
     assert_eq!(log.iter().filter(|l| l.contains(": Secured")).count(), 3);
     assert!(log.iter().any(|l| l.contains(": Discarded")), "fakes were delivered and recognised too");
 }
 
-/// Bots win whole heists on several seeds. These are seeds the careful Vive bot wins (it wins about
-/// 1 in 5; `heist-server sweep` measures it, and docs/rules.md "Bot status" has the figures). The
-/// outcome of a seed is deterministic: stepped clock, loopback UDP.
+/// Bots win whole heists on several seeds. These are easy seeds the careful Vive bot wins
+/// (`heist-server sweep --difficulty easy` measures it, and docs/rules.md "Bot status" has the figures).
+/// The outcome of a seed is deterministic: stepped clock, loopback UDP.
 #[test]
 fn careful_bots_win_full_heists_on_several_seeds() {
-    for seed in [41, 101, 194] {
-        let (phase, log, t) = bot_heist(ServerOptions::local_test(seed), ViveStyle::Careful, 600.0);
+    for seed in [4, 13, 19] {
+        let (phase, log, t) = bot_heist(easy(seed), ViveStyle::Careful, 750.0);
         assert_eq!(phase, Phase::Won, "seed {seed} after {t} s:\n{}", log.join("\n"));
         assert_eq!(log.iter().filter(|l| l.contains(": Secured")).count(), 3, "seed {seed}");
     }

@@ -76,6 +76,15 @@ impl Session {
     }
 }
 
+/// A local test server on `seed` at the easy difficulty: the one the careful Vive bot wins most often
+/// (docs/rules.md, "Bot status"). Tests of the network, seats and attacks that need a whole heist won
+/// use it with a seed the bots win (deterministic: stepped clock, loopback UDP).
+pub fn easy(seed: u64) -> ServerOptions {
+    let mut options = ServerOptions::local_test(seed);
+    options.game.difficulty = heist_shared::rules::Difficulty::Easy;
+    options
+}
+
 /// Runs a whole bot heist and returns the final phase and the log.
 pub fn bot_heist(options: ServerOptions, style: heist_bots::ViveStyle, max_game_s: f32) -> (Phase, Vec<String>, f32) {
     let mut heist = Heist::start(options, style).expect("heist starts");

@@ -269,6 +269,21 @@ fn events(
                     format!("{alert:?}").to_lowercase()
                 ))
             }
+            GameEvent::Radio { guard, about, at, .. } => {
+                let level = state.level.as_ref();
+                let name = level.and_then(|l| l.guards.get(usize::from(guard.0))).map(|g| g.name.clone());
+                let room =
+                    level.and_then(|l| l.rooms.iter().find(|r| r.contains(*at, 0.0))).map(|r| r.id.replace('_', " "));
+                let what = match about {
+                    heist_shared::protocol::RadioAbout::Sighting => "intruder seen",
+                    heist_shared::protocol::RadioAbout::Evidence => "broken case found",
+                };
+                Some(format!(
+                    "RADIO {}: {what} in the {}",
+                    name.unwrap_or_else(|| format!("Guard {}", guard.0)),
+                    room.unwrap_or_else(|| "museum".into())
+                ))
+            }
             GameEvent::Noise { .. } | GameEvent::PhaseChanged(_) | GameEvent::PickedUp(_) => None,
             GameEvent::Joined(_)
             | GameEvent::Left { .. }

@@ -174,6 +174,7 @@ mod tests {
             alarm: 1,
             targets: vec![(ArtifactKind::Crown, true), (ArtifactKind::Idol, false)],
             present: (true, true),
+            difficulty: Default::default(),
         };
         let look = heist_shared::artifact::look(ArtifactKind::Idol);
         let item = ItemView {

@@ -338,6 +338,7 @@ pub fn alert_colour(alert: GuardAlert) -> Color {
         GuardAlert::Investigating => Color::srgb(1.0, 0.5, 0.05),
         GuardAlert::Chasing => Color::srgb(1.0, 0.1, 0.1),
         GuardAlert::Returning => Color::srgb(0.3, 0.6, 1.0),
+        GuardAlert::Searching => Color::srgb(1.0, 0.3, 0.6),
     }
 }
 

@@ -8,7 +8,7 @@ use std::time::Duration;
 use anyhow::Context as _;
 use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
-use heist_bots::{PhantomBotPlugin, Rounds, ViveBotPlugin, ViveStyle};
+use heist_bots::{PhantomBotPlugin, Rounds, ViveBotPlugin, ViveBrain, ViveStyle};
 use heist_client::{ClientNetPlugin, request_token};
 use heist_shared::protocol::{Phase, Role, TICK_HZ};
 use heist_transport::renetcode::ConnectToken;
@@ -181,10 +181,16 @@ impl Heist {
     }
 }
 
+/// The heist's time limit on its difficulty, seconds.
+fn time_limit(options: &ServerOptions) -> f32 {
+    let scale = options.level.tuning(options.game.difficulty).time_scale;
+    options.game.time_limit_s.unwrap_or(options.level.time_limit_s * scale)
+}
+
 /// Plays a whole heist with bots to its end (or a little past its time limit); returns the heist, the
 /// final phase and the result line.
 fn play_to_the_end(options: ServerOptions, style: ViveStyle) -> anyhow::Result<(Heist, Phase, String)> {
-    let limit = options.game.time_limit_s.unwrap_or(options.level.time_limit_s);
+    let limit = time_limit(&options);
     let mut heist = Heist::start(options, style)?;
     let phase = heist.run(limit + 5.0);
     let result = heist.results.last().map_or_else(|| format!("RESULT: unfinished ({phase:?})"), |r| r.line.clone());
@@ -194,7 +200,7 @@ fn play_to_the_end(options: ServerOptions, style: ViveStyle) -> anyhow::Result<(
 /// Runs the demo: `rounds` heists in one session, the bots asking for another round after each result;
 /// prints each round's result line. Returns the last round's phase.
 pub fn run_demo(options: ServerOptions, style: ViveStyle, rounds: u32) -> anyhow::Result<Phase> {
-    let limit = options.game.time_limit_s.unwrap_or(options.level.time_limit_s);
+    let limit = time_limit(&options);
     let rounds = rounds.max(1);
     let mut heist = Heist::join_for_rounds(build_server(options)?, style, rounds)?;
     let mut phase = heist.run(limit + 5.0);
@@ -234,6 +240,46 @@ pub struct Tally {
     pub caught: Vec<u64>,
     /// Seeds lost for any other reason (the timer, the alarm).
     pub other: Vec<u64>,
+    /// Catches by guard and room ("Clara in the west_gallery"), with their count.
+    pub caught_where: std::collections::BTreeMap<String, u32>,
+    /// Seconds the Vive bot spent under each of its decisions, summed over the heists.
+    pub time_in: std::collections::BTreeMap<&'static str, f32>,
+    /// Seconds the Vive bot spent carrying something, summed over the heists.
+    pub carrying_s: f32,
+}
+
+impl Tally {
+    /// Adds one finished heist: its seed, how it ended, and where the bot's time went.
+    fn add(&mut self, seed: u64, heist: &Heist, phase: Phase) {
+        let game = heist.server.game();
+        match phase {
+            Phase::Won => self.won.push(seed),
+            Phase::Lost(heist_shared::protocol::LossReason::Caught) => self.caught.push(seed),
+            _ => self.other.push(seed),
+        }
+        if let Some(place) = caught_where(game) {
+            *self.caught_where.entry(place).or_default() += 1;
+        }
+        let (time_in, carrying_s) = heist.vive.world().resource::<ViveBrain>().time_spent();
+        for (decision, s) in time_in {
+            *self.time_in.entry(decision).or_default() += s;
+        }
+        self.carrying_s += carrying_s;
+    }
+}
+
+/// "Clara in the west_gallery" when a guard caught Vive.
+fn caught_where(game: &crate::game::Game) -> Option<String> {
+    let (guard, at) = game.caught_by?;
+    let room = game.level.room_at(at).map_or("a doorway", |r| game.level.rooms[r].id.as_str());
+    Some(format!("{} in the {room}", game.guards[guard].name))
+}
+
+/// Where one heist's bot time went, as "decision 12.3 s, …; carrying 40.0 s".
+fn time_line(heist: &Heist) -> String {
+    let (time_in, carrying_s) = heist.vive.world().resource::<ViveBrain>().time_spent();
+    let parts: Vec<String> = time_in.iter().map(|(d, s)| format!("{d} {s:.0} s")).collect();
+    format!("{}; carrying {carrying_s:.0} s", parts.join(", "))
 }
 
 impl std::fmt::Display for Tally {
@@ -247,7 +293,21 @@ impl std::fmt::Display for Tally {
             self.caught.len(),
             self.other.len(),
             self.won
-        )
+        )?;
+        if !self.caught_where.is_empty() {
+            let mut by: Vec<_> = self.caught_where.iter().collect();
+            by.sort_by(|a, b| b.1.cmp(a.1).then(a.0.cmp(b.0)));
+            let by: Vec<String> = by.iter().map(|(w, n)| format!("{w} ×{n}")).collect();
+            write!(f, "\n  caught by: {}", by.join(", "))?;
+        }
+        let total: f32 = self.time_in.values().sum();
+        if total > 0.0 {
+            let mut by: Vec<_> = self.time_in.iter().collect();
+            by.sort_by(|a, b| b.1.total_cmp(a.1));
+            let by: Vec<String> = by.iter().map(|(d, s)| format!("{d} {:.0}%", 100.0 * *s / total)).collect();
+            write!(f, "\n  bot's time: {}; carrying {:.0}%", by.join(", "), 100.0 * self.carrying_s / total)?;
+        }
+        Ok(())
     }
 }
 
@@ -256,17 +316,18 @@ impl std::fmt::Display for Tally {
 pub fn sweep(
     seeds: impl IntoIterator<Item = u64>,
     style: ViveStyle,
+    difficulty: heist_shared::rules::Difficulty,
     mut each: impl FnMut(u64, &str),
 ) -> anyhow::Result<Tally> {
     let mut tally = Tally::default();
     for seed in seeds {
-        let (heist, phase, result) = play_to_the_end(ServerOptions::local_test(seed), style)?;
-        each(seed, &format!("{result} after {:.1} s", heist.server.game().elapsed_s));
-        match phase {
-            Phase::Won => tally.won.push(seed),
-            Phase::Lost(heist_shared::protocol::LossReason::Caught) => tally.caught.push(seed),
-            _ => tally.other.push(seed),
-        }
+        let mut options = ServerOptions::local_test(seed);
+        options.game.difficulty = difficulty;
+        let (heist, phase, result) = play_to_the_end(options, style)?;
+        let game = heist.server.game();
+        let by = caught_where(game).map(|w| format!(" by {w}")).unwrap_or_default();
+        each(seed, &format!("{result}{by} after {:.1} s ({})", game.elapsed_s, time_line(&heist)));
+        tally.add(seed, &heist, phase);
     }
     Ok(tally)
 }

@@ -35,9 +35,12 @@ pub struct HostFlags {
     /// Seed of the first round (default: random, so nobody knows which copies are real).
     #[arg(long)]
     pub seed: Option<u64>,
-    /// Seconds a heist lasts (default: the museum's 600).
+    /// Seconds a heist lasts (default: the museum's 600, scaled by the difficulty).
     #[arg(long)]
     pub time_limit: Option<f32>,
+    /// How hard the guards are: easy, normal or hard.
+    #[arg(long, default_value_t = heist_shared::rules::Difficulty::Normal)]
+    pub difficulty: heist_shared::rules::Difficulty,
     /// Create the session on this running server (`heist-server serve`) instead of hosting one here.
     #[arg(long, conflicts_with_all = ["bind", "advertise", "seed", "time_limit"])]
     pub server: Option<SocketAddr>,
@@ -46,7 +49,13 @@ pub struct HostFlags {
 impl HostFlags {
     /// The server to start here (when `--server` names none).
     pub fn options(&self) -> HostOptions {
-        HostOptions { bind: self.bind, advertise: self.advertise, seed: self.seed, time_limit_s: self.time_limit }
+        HostOptions {
+            bind: self.bind,
+            advertise: self.advertise,
+            seed: self.seed,
+            time_limit_s: self.time_limit,
+            difficulty: self.difficulty,
+        }
     }
 }
 
@@ -59,19 +68,22 @@ pub struct HostOptions {
     pub advertise: Option<SocketAddr>,
     /// The first round's seed (default: random, and random for every later round).
     pub seed: Option<u64>,
-    /// Seconds a heist lasts (default: the level's).
+    /// Seconds a heist lasts (default: the level's, scaled by the difficulty).
     pub time_limit_s: Option<f32>,
+    /// How hard the guards are.
+    pub difficulty: heist_shared::rules::Difficulty,
 }
 
 /// Starts a one-session server with `host`'s settings on a thread of this process.
 pub fn start(host: HostOptions) -> anyhow::Result<Embedded> {
-    let HostOptions { bind, advertise, seed, time_limit_s } = host;
+    let HostOptions { bind, advertise, seed, time_limit_s, difficulty } = host;
     let options = ServerOptions {
         level: Level::museum(),
         game: crate::game::GameOptions {
             seed: seed.unwrap_or_else(rand::random),
             random_rounds: seed.is_none(),
             time_limit_s,
+            difficulty,
             ..Default::default()
         },
         host_session: true,

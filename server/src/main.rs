@@ -16,6 +16,7 @@ use heist_server::session::LogEcho;
 use heist_server::{Clock, ServerOptions, build_server};
 use heist_shared::level::Level;
 use heist_shared::protocol::Role;
+use heist_shared::rules::Difficulty;
 
 #[derive(Parser)]
 #[command(name = "heist-server", about = "Phantom Heist: the authoritative server, its demo and its bots")]
@@ -48,8 +49,8 @@ impl From<Style> for ViveStyle {
 enum Command {
     /// Host a session on loopback with both bots, print the live log and the result.
     Demo {
-        /// Seed for the copies and the guards (default 18: a heist the bots win).
-        #[arg(long, default_value_t = 18)]
+        /// Seed for the copies and the guards (default 1: on easy, a heist the bots win).
+        #[arg(long, default_value_t = 1)]
         seed: u64,
         /// Level file (default: the shipped museum).
         #[arg(long)]
@@ -63,6 +64,10 @@ enum Command {
         /// Heists in the session: after each result the bots ask for another round (a new seed).
         #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100))]
         rounds: u32,
+        /// How hard the guards are: easy, normal or hard (the level's tuning for it). The demo shows easy,
+        /// where the careful bot wins most often (docs/rules.md, "Bot status").
+        #[arg(long, default_value_t = Difficulty::Easy)]
+        difficulty: Difficulty,
     },
     /// Play one whole bot heist per seed (no live log) and print each result and the tally.
     Sweep {
@@ -75,6 +80,9 @@ enum Command {
         /// How the Vive bot plays.
         #[arg(long, value_enum, default_value_t = Style::Careful)]
         vive: Style,
+        /// Difficulties to sweep, comma-separated (easy,normal,hard): a tally for each.
+        #[arg(long, value_delimiter = ',', default_value = "normal")]
+        difficulty: Vec<Difficulty>,
     },
     /// Serve many sessions: any player may create one (and gets its join code for a partner), up to
     /// --max-sessions at once; each session ends on its own when it is over, the server runs on.
@@ -102,6 +110,9 @@ enum Command {
         /// Override the level's time limit, seconds.
         #[arg(long, value_parser = positive_seconds)]
         time_limit: Option<f32>,
+        /// How hard the guards are in the sessions created here: easy, normal or hard.
+        #[arg(long, default_value_t = Difficulty::Normal)]
+        difficulty: Difficulty,
         #[command(flatten)]
         fleet: FleetArgs,
         /// Run as an Agones game server: Ready, health pings, the `sessions` Counter and `players` List,
@@ -157,6 +168,9 @@ enum Command {
         /// Sessions open at once: besides the host's, players may create this many less one.
         #[arg(long, default_value_t = 1, value_parser = max_sessions)]
         max_sessions: usize,
+        /// How hard the guards are: easy, normal or hard (the level's tuning for it).
+        #[arg(long, default_value_t = Difficulty::Normal)]
+        difficulty: Difficulty,
         #[command(flatten)]
         fleet: FleetArgs,
     },
@@ -283,6 +297,7 @@ struct Hosting {
     time_limit: Option<f32>,
     max_sessions: usize,
     drain_limit: f32,
+    difficulty: Difficulty,
 }
 
 impl Hosting {
@@ -295,6 +310,7 @@ impl Hosting {
                 idle_end_s: Some(self.idle_end),
                 time_limit_s: self.time_limit,
                 ends_unjoined: false,
+                difficulty: self.difficulty,
             },
             host_session,
             max_sessions: self.max_sessions,
@@ -353,20 +369,28 @@ fn main() -> std::process::ExitCode {
 
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
-        Command::Demo { seed, level, vive, time_limit, rounds } => {
+        Command::Demo { seed, level, vive, time_limit, rounds, difficulty } => {
             let mut options = ServerOptions::local_test(seed);
             options.level = load_level(level)?;
-            options.game = GameOptions { seed, time_limit_s: time_limit, ..Default::default() };
+            options.game = GameOptions { seed, time_limit_s: time_limit, difficulty, ..Default::default() };
             options.echo_log = LogEcho::Stdout;
-            println!("Phantom Heist demo: {} with seed {seed}, both bots over loopback UDP", options.level.name);
+            println!(
+                "Phantom Heist demo: {} with seed {seed} on {difficulty}, both bots over loopback UDP",
+                options.level.name
+            );
             heist_server::demo::run_demo(options, vive.into(), rounds)?;
             Ok(())
         }
-        Command::Sweep { from, to, vive } => {
+        Command::Sweep { from, to, vive, difficulty } => {
             anyhow::ensure!(from <= to, "--from {from} is after --to {to}");
-            let tally =
-                heist_server::demo::sweep(from..=to, vive.into(), |seed, line| println!("seed {seed:>4}: {line}"))?;
-            println!("{tally}");
+            let mut tallies = Vec::new();
+            for d in difficulty {
+                let each = |seed: u64, line: &str| println!("{d:>6} seed {seed:>4}: {line}");
+                tallies.push((d, heist_server::demo::sweep(from..=to, vive.into(), d, each)?));
+            }
+            for (d, tally) in tallies {
+                println!("{d}: {tally}");
+            }
             Ok(())
         }
         Command::Host {
@@ -379,13 +403,24 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             idle_end,
             time_limit,
             max_sessions,
+            difficulty,
             fleet,
         } => {
             if insecure {
                 eprintln!("WARNING: --insecure: anyone who reaches {bind} can join as any role. LAN development only!");
             }
             let drain_limit = fleet.drain_limit;
-            let hosting = Hosting { bind, advertise, code_ttl, level, idle_end, time_limit, max_sessions, drain_limit };
+            let hosting = Hosting {
+                bind,
+                advertise,
+                code_ttl,
+                level,
+                idle_end,
+                time_limit,
+                max_sessions,
+                drain_limit,
+                difficulty,
+            };
             let server = build_server(hosting.options(seed, insecure, true)?)?;
             print_address(&server);
             if let Some(codes) = server.codes.clone() {
@@ -411,6 +446,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             level,
             idle_end,
             time_limit,
+            difficulty,
             fleet,
             agones,
         } => {
@@ -424,7 +460,17 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 advertise = Some(SocketAddr::new(ip, host_port.unwrap_or(bind.port())));
             }
             let drain_limit = fleet.drain_limit;
-            let hosting = Hosting { bind, advertise, code_ttl, level, idle_end, time_limit, max_sessions, drain_limit };
+            let hosting = Hosting {
+                bind,
+                advertise,
+                code_ttl,
+                level,
+                idle_end,
+                time_limit,
+                max_sessions,
+                drain_limit,
+                difficulty,
+            };
             let server = build_server(hosting.options(None, false, false)?)?;
             print_address(&server);
             println!("serving up to {max_sessions} sessions: a player creates one and gets its join code");

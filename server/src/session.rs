@@ -121,6 +121,15 @@ pub enum Record<'a> {
     },
     /// A case was broken.
     CaseBroken(&'a str),
+    /// A guard radioed the others.
+    GuardRadio {
+        /// His name.
+        guard: &'a str,
+        /// `sighting` or `evidence`.
+        about: &'static str,
+        /// How many answer.
+        answering: usize,
+    },
     /// Vive picked an item up.
     ItemPicked(u16),
     /// A copy was placed on the workbench.
@@ -192,6 +201,9 @@ impl SessionLog {
                 )
             }
             Record::CaseBroken(case) => ev!("case_broken", role = Role::Vive.name(), case = case),
+            Record::GuardRadio { guard, about, answering } => {
+                ev!("guard_radio", guard = guard, about = about, answering = answering)
+            }
             Record::ItemPicked(item) => ev!("item_picked", role = Role::Vive.name(), item = item),
             Record::Delivered(item) => ev!("delivered", role = Role::Vive.name(), item = item),
             Record::Verdict { item, declared_real, outcome } => ev!(
@@ -252,6 +264,28 @@ impl SessionLog {
                 (
                     Record::Verdict { item: item.0, declared_real: *declared_real, outcome: *outcome },
                     format!("Phantom declares copy #{} {said}: {outcome:?}", item.0),
+                )
+            }
+            GameEvent::Radio { guard, about, at, answering, .. } => {
+                let name = |id: heist_shared::protocol::GuardId| {
+                    game.guards.get(usize::from(id.0)).map_or("?", |g| g.name.as_str())
+                };
+                let caller = name(*guard);
+                let room = game.nav.room_at(*at).and_then(|r| game.level.rooms.get(r)).map_or("?", |r| r.id.as_str());
+                let what = match about {
+                    heist_shared::protocol::RadioAbout::Sighting => "intruder seen",
+                    heist_shared::protocol::RadioAbout::Evidence => "broken case found",
+                };
+                let who: Vec<&str> = answering.iter().map(|g| name(*g)).collect();
+                let answer =
+                    if who.is_empty() { "nobody in range".to_owned() } else { who.join(" and ") + " come to search" };
+                let about = match about {
+                    heist_shared::protocol::RadioAbout::Sighting => "sighting",
+                    heist_shared::protocol::RadioAbout::Evidence => "evidence",
+                };
+                (
+                    Record::GuardRadio { guard: caller, about, answering: answering.len() },
+                    format!("guard {caller} radios: {what} in the {room} at ({:.1}, {:.1}); {answer}", at.x, at.y),
                 )
             }
             GameEvent::Alarm(level) => (Record::Note, format!("alarm level {level}")),
@@ -431,6 +465,7 @@ fn session_view(g: &Game) -> SessionView {
         alarm: g.alarm,
         targets: g.targets.iter().map(|t| (t.kind, t.secured)).collect(),
         present: g.present,
+        difficulty: g.difficulty,
     }
 }
 

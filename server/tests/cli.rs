@@ -52,11 +52,15 @@ fn a_sweep_tallies_every_seed() {
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("seed    1: RESULT: Lost(caught)"), "{stdout}");
     assert!(stdout.contains("seed    2: RESULT: Lost(caught)"), "{stdout}");
-    assert_eq!(
-        stdout.lines().last(),
-        Some("won 0 of 2 (0.0%), caught 2, other losses 0; winning seeds: []"),
+    assert!(stdout.contains("\nnormal: won 0 of 2 (0.0%), caught 2, other losses 0; winning seeds: []\n"), "{stdout}");
+    assert!(stdout.contains("\n  caught by: "), "the causes of the losses: {stdout}");
+    assert!(
+        stdout.contains("by Bruno in the ")
+            || stdout.contains("by Clara in the ")
+            || stdout.contains("by Dmitri in the "),
         "{stdout}"
     );
+    assert!(stdout.contains("\n  bot's time: rush_if_reckless 100%; carrying "), "where the time went: {stdout}");
 
     let bad =
         Command::new(env!("CARGO_BIN_EXE_heist-server")).args(["sweep", "--from", "5", "--to", "2"]).output().unwrap();

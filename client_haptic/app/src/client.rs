@@ -636,6 +636,9 @@ fn museum_sounds(
             GameEvent::Noise { kind: NoiseKind::Footsteps, position, loudness } => {
                 audio.footstep(at(*position, 0.0), *loudness, "vive footstep")
             }
+            GameEvent::Radio { from, .. } => {
+                audio.play_at(crate::audio::synth::radio_squawk(), at(*from, 1.4), "guard radio")
+            }
             GameEvent::GuardAlert { alert, position, .. } => {
                 if matches!(alert, GuardAlert::Suspicious | GuardAlert::Chasing) {
                     audio.play_at(

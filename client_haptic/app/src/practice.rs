@@ -72,6 +72,7 @@ fn set_up(mut commands: Commands, p: Res<Practice>, mut inbox: ResMut<Inbox>) {
         alarm: 0,
         targets: vec![(p.kind, false)],
         present: (true, true),
+        difficulty: Default::default(),
     });
     for i in 0..p.copies.len() {
         let kind = ItemKind::Copy { artifact: p.kind, look: artifact::look(p.kind) };

@@ -6,7 +6,7 @@
 use glam::Vec2;
 use heist_shared::artifact::{ArtifactKind, number_in_words};
 use heist_shared::protocol::{
-    GameEvent, GuardAlert, GuardView, LossReason, Phase, SessionView, VerdictOutcome, WarningKind,
+    GameEvent, GuardAlert, GuardView, LossReason, Phase, RadioAbout, SessionView, VerdictOutcome, WarningKind,
 };
 
 /// The lobby menu, read item by item (up/down moves, Enter chooses).
@@ -78,6 +78,7 @@ fn alert_words(a: GuardAlert) -> &'static str {
         GuardAlert::Investigating => "investigating a noise",
         GuardAlert::Chasing => "chasing Vive",
         GuardAlert::Returning => "going back to the round",
+        GuardAlert::Searching => "searching the rooms around",
     }
 }
 
@@ -149,6 +150,19 @@ pub fn announce(event: &GameEvent, guard_name: impl Fn(u16) -> Option<String>) -
             format!("{} heard something.", guard_name(guard.0).unwrap_or_else(|| "A guard".into()))
         }
         GameEvent::Alarm(level) => format!("Alarm level {}.", number_in_words(*level as u32)),
+        GameEvent::Radio { guard, about, answering, .. } => {
+            let caller = guard_name(guard.0).unwrap_or_else(|| "A guard".into());
+            let what = match about {
+                RadioAbout::Sighting => "he saw Vive",
+                RadioAbout::Evidence => "he found a broken case",
+            };
+            let coming = match answering.len() {
+                0 => "Nobody answers.".to_owned(),
+                1 => format!("{} is coming.", guard_name(answering[0].0).unwrap_or_else(|| "a guard".into())),
+                n => format!("{} guards are coming.", number_in_words(n as u32)),
+            };
+            format!("{caller} radios: {what}. {coming}")
+        }
         GameEvent::Verdict { declared_real, outcome, .. } => match (outcome, declared_real) {
             (VerdictOutcome::Secured, _) => "Correct. It was the real one: secured.".to_owned(),
             (VerdictOutcome::Discarded, _) => "Correct. It was a fake: thrown away.".to_owned(),
@@ -206,6 +220,7 @@ mod tests {
             alarm: 1,
             targets: vec![(ArtifactKind::Crown, true), (ArtifactKind::Amphora, false), (ArtifactKind::Idol, false)],
             present: (true, true),
+            difficulty: Default::default(),
         };
         let clara = GuardView {
             id: GuardId(0),

@@ -6,9 +6,11 @@
 
 mod actions;
 mod guard;
+mod radio;
 mod setup;
 
 pub use guard::{Guard, GuardState, Perception};
+pub use radio::Radio;
 pub use setup::CopyTruth;
 
 use glam::Vec2;
@@ -49,6 +51,8 @@ pub struct GameOptions {
     /// A lobby nobody ever joined idles out too (a session created on a `serve`d server whose creator
     /// never came); a `host`'s own session waits for its players for as long as the process runs.
     pub ends_unjoined: bool,
+    /// How hard the guards are (the level's tuning for it: [`Level::tuning`]).
+    pub difficulty: rules::Difficulty,
 }
 
 /// The seed of the round after one played on `seed` (SplitMix64), when rounds are reproducible (a given
@@ -129,6 +133,8 @@ pub struct Case {
     pub position: Vec2,
     /// Shattered?
     pub broken: bool,
+    /// A guard found it shattered and reported it (the alarm went up once for it).
+    pub reported: bool,
 }
 
 /// An item and, for copies, its hidden truth.
@@ -172,8 +178,12 @@ pub struct Game {
     pub alarm: u8,
     /// Vive.
     pub vive: Vive,
-    /// Guards.
+    /// Guards on duty.
     pub guards: Vec<Guard>,
+    /// The session's difficulty.
+    pub difficulty: rules::Difficulty,
+    /// What the guards can do (the level's tuning for the difficulty).
+    pub tuning: rules::GuardTuning,
     /// Display cases.
     pub cases: Vec<Case>,
     /// Items (copies and props), indexed by `ItemId`.
@@ -195,6 +205,8 @@ pub struct Game {
     /// Set when the server drains ([`Game::drain`]): no new round, and the session closes once no heist
     /// is under way.
     pub draining: bool,
+    /// Which guard caught Vive, and where, once one has (for the sweep's causes of losses).
+    pub caught_by: Option<(usize, Vec2)>,
     options: GameOptions,
     ready: (bool, bool),
     rematch: (bool, bool),
@@ -207,6 +219,9 @@ pub struct Game {
     noises: Vec<(Vec2, f32)>,
     outgoing: Vec<Outgoing>,
     rng: ChaCha8Rng,
+    radio: radio::Radio,
+    /// The alarm level and hot rooms the guards' patrols were last laid out for.
+    patrols_for: Option<(u8, Vec<usize>)>,
 }
 
 fn slot(role: Role) -> usize {
@@ -563,21 +578,111 @@ impl Game {
     }
 
     fn step_guards(&mut self, dt: f32) {
-        let alarm = f32::from(self.alarm);
+        let alarm = self.alarm;
+        let t = self.tuning;
+        let now = self.elapsed_s;
+        // Radio calls that have come through: each answering guard gets his share of the spots.
+        for (answering, at, limit) in self.radio.heard(now) {
+            let spots = heist_shared::level::patrol::search_spots(&self.nav, at, limit);
+            for (k, &i) in answering.iter().enumerate() {
+                self.guards[i].orders = Some(heist_shared::level::patrol::share_of(&spots, k, answering.len()));
+            }
+        }
+        self.lay_out_patrols();
+        let unreported: Vec<(usize, Vec2)> = (self.cases.iter().enumerate())
+            .filter(|(_, c)| c.broken && !c.reported)
+            .map(|(i, c)| (i, c.position))
+            .collect();
         for i in 0..self.guards.len() {
-            let perception = guard::perceive(&self.guards[i], &self.vive, &self.walls, &self.nav, &self.noises, alarm);
+            let perception = guard::perceive(
+                &self.guards[i],
+                &self.vive,
+                &self.walls,
+                &self.nav,
+                &self.noises,
+                &unreported,
+                alarm,
+                &t,
+            );
             let before = self.guards[i].alert;
-            let caught = guard::think_and_act(&mut self.guards[i], &perception, &self.walls, &self.nav, alarm, dt);
+            let acted = guard::think_and_act(&mut self.guards[i], &perception, &self.walls, &self.nav, alarm, &t, dt);
             let g = &self.guards[i];
             if g.alert != before {
                 let event = GameEvent::GuardAlert { guard: g.id, alert: g.alert, position: g.position };
                 self.event(event);
             }
-            if caught {
+            if acted.caught {
+                self.caught_by = Some((i, self.vive.position));
                 self.set_phase(Phase::Lost(LossReason::Caught));
                 return;
             }
+            if let Some(case) = acted.reported
+                && !self.cases[case].reported
+            {
+                self.cases[case].reported = true;
+                self.raise_alarm_for_evidence();
+            }
+            if let Some((about, at)) = acted.radio {
+                self.radio_call(i, about, at);
+            }
         }
+    }
+
+    /// Guard `caller` radios about `at`: both players hear it; those within range come after the delay.
+    fn radio_call(&mut self, caller: usize, about: heist_shared::protocol::RadioAbout, at: Vec2) {
+        if self.tuning.radio_range_m <= 0.0 {
+            return;
+        }
+        // A sighting: the rooms around are searched; evidence: the spot and the nearest room next to it.
+        let spots = match about {
+            heist_shared::protocol::RadioAbout::Sighting => guard::SEARCH_SPOTS,
+            heist_shared::protocol::RadioAbout::Evidence => guard::EVIDENCE_SPOTS,
+        };
+        let answering = self.radio.call(&self.guards, caller, (at, spots), &self.tuning, self.elapsed_s);
+        let g = &self.guards[caller];
+        let answering = answering.iter().map(|&i| self.guards[i].id).collect();
+        self.event(GameEvent::Radio { guard: g.id, about, at, from: g.position, answering });
+    }
+
+    /// A broken case was found: the alarm goes up one level, but never past the tuning's
+    /// `evidence_alarm_cap` (only wrong verdicts lock the museum down).
+    fn raise_alarm_for_evidence(&mut self) {
+        if self.alarm < self.tuning.evidence_alarm_cap.min(rules::ALARM_LOCKDOWN - 1) {
+            self.alarm += 1;
+            self.event(GameEvent::Alarm(self.alarm));
+        }
+    }
+
+    /// The rooms that still hold a copy of a target not yet secured, in an intact case.
+    pub fn hot_rooms(&self) -> Vec<usize> {
+        let mut rooms: Vec<usize> = self
+            .items
+            .iter()
+            .filter_map(|it| match (it.place, &it.truth) {
+                (ItemPlace::InCase(c), Some(truth)) if !self.targets[truth.target].secured => {
+                    let case = self.cases.get(usize::from(c.0))?;
+                    (!case.broken).then(|| self.nav.room_at(case.position)).flatten()
+                }
+                _ => None,
+            })
+            .collect();
+        rooms.sort_unstable();
+        rooms.dedup();
+        rooms
+    }
+
+    /// Lays the guards' patrols out for the alarm level and the rooms that hold targets, when either
+    /// changed ([`heist_shared::level::patrol::alert_route`]).
+    fn lay_out_patrols(&mut self) {
+        let now = (self.alarm, self.hot_rooms());
+        if self.patrols_for.as_ref() == Some(&now) {
+            return;
+        }
+        for i in 0..self.guards.len() {
+            let route = heist_shared::level::patrol::alert_route(&self.level, &self.nav, i, now.0, &now.1);
+            self.guards[i].set_route(route);
+        }
+        self.patrols_for = Some(now);
     }
 
     /// The case with `id`, if it exists.

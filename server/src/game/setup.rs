@@ -56,15 +56,17 @@ pub(super) fn new_game(level: Level, options: &GameOptions) -> Game {
         .collect();
     items.extend(level.props.iter().map(|&p| Item { kind: ItemKind::Prop, place: ItemPlace::Floor(p), truth: None }));
 
+    let tuning = level.tuning(options.difficulty);
     let guards = level
         .guards
         .iter()
+        .take(tuning.guards.unwrap_or(usize::MAX))
         .enumerate()
         .map(|(i, g)| Guard::new(GuardId(i as u16), g.name.clone(), g.route.clone()))
         .collect();
-    let cases = level.cases.iter().map(|c| Case { position: c.at, broken: false }).collect();
+    let cases = level.cases.iter().map(|c| Case { position: c.at, broken: false, reported: false }).collect();
     let vive = Vive { position: level.vive_spawn, facing: 0.0, ..Default::default() };
-    let time_left_s = options.time_limit_s.unwrap_or(level.time_limit_s);
+    let time_left_s = options.time_limit_s.unwrap_or(level.time_limit_s * tuning.time_scale);
 
     Game {
         walls,
@@ -75,6 +77,8 @@ pub(super) fn new_game(level: Level, options: &GameOptions) -> Game {
         alarm: 0,
         vive,
         guards,
+        difficulty: options.difficulty,
+        tuning,
         cases,
         items,
         targets,
@@ -85,6 +89,9 @@ pub(super) fn new_game(level: Level, options: &GameOptions) -> Game {
         noises: Vec::new(),
         outgoing: Vec::new(),
         rng,
+        radio: Default::default(),
+        patrols_for: None,
+        caught_by: None,
         level,
         seed: options.seed,
         round: 1,

@@ -668,3 +668,102 @@ fn a_drain_lets_a_running_heist_finish_then_closes_and_closes_a_lobby_at_once() 
     lobby.step(TICK_S);
     assert!(lobby.closed);
 }
+
+/// Steps until `found` picks an event out (at most `seconds`), teleporting nobody.
+fn step_until_event<T>(g: &mut Game, seconds: f32, mut found: impl FnMut(&GameEvent) -> Option<T>) -> Option<T> {
+    for _ in 0..(seconds / TICK_S).ceil() as u32 {
+        g.step(TICK_S);
+        if let Some(hit) = events(g).iter().find_map(&mut found) {
+            return Some(hit);
+        }
+    }
+    None
+}
+
+/// A corner of the workshop, out of every guard's sight and hearing at the start.
+const HIDEOUT: Vec2 = Vec2::new(1.0, 15.0);
+
+#[test]
+fn a_guard_who_sees_vive_radios_and_the_two_others_split_up_to_search_the_rooms_around() {
+    use heist_shared::protocol::RadioAbout;
+    let mut g = started(7);
+    // Vive stands in plain sight three metres in front of Bruno.
+    let bruno = &g.guards[0];
+    g.vive.position = bruno.position + Vec2::from_angle(bruno.facing) * 3.0;
+    let call = step_until_event(&mut g, 10.0, |e| match e {
+        GameEvent::Radio { guard, about: RadioAbout::Sighting, at, answering, .. } => {
+            Some((*guard, *at, answering.clone()))
+        }
+        _ => None,
+    });
+    let (caller, seen_at, answering) = call.expect("Bruno radios once he is sure");
+    assert_eq!(caller, g.guards[0].id);
+    assert_eq!(answering, vec![g.guards[1].id, g.guards[2].id], "both others are in range, nearest first");
+    g.vive.position = HIDEOUT; // gone
+    let expected = heist_shared::level::patrol::search_spots(&g.nav, seen_at, guard::SEARCH_SPOTS);
+    assert!(expected.len() >= 3, "the spot and the rooms next to it: {expected:?}");
+    let delay = g.tuning.radio_delay_s;
+    step_for(&mut g, delay + 0.5);
+    let mut first_spots = Vec::new();
+    for i in [1, 2] {
+        let guard::GuardState::Search { spots, next: 0, .. } = &g.guards[i].state else {
+            panic!("{} answers the call: {:?}", g.guards[i].name, g.guards[i].state)
+        };
+        assert_eq!(g.guards[i].alert, heist_shared::protocol::GuardAlert::Searching);
+        assert!(spots.iter().all(|s| expected.contains(s)), "{spots:?} are around {seen_at:?}");
+        first_spots.push(spots[0]);
+    }
+    assert_ne!(first_spots[0], first_spots[1], "the searchers split up");
+    let rooms: std::collections::BTreeSet<_> = first_spots.iter().filter_map(|s| g.nav.room_at(*s)).collect();
+    assert_eq!(rooms.len(), 2, "they search two different rooms first: {first_spots:?}");
+    // Each walks to his first spot and looks around there.
+    let mut reached = [false; 2];
+    for _ in 0..(40.0 / TICK_S) as u32 {
+        g.step(TICK_S);
+        for (k, i) in [1, 2].into_iter().enumerate() {
+            reached[k] |= g.guards[i].position.distance(first_spots[k]) < 1.0;
+        }
+    }
+    assert_eq!(reached, [true, true], "both searchers got to their first spot");
+    assert_eq!(g.phase, Phase::Heist, "nobody found Vive in his hideout");
+}
+
+#[test]
+fn a_guard_who_finds_a_broken_case_raises_the_alarm_and_radios_the_others_to_search_around_it() {
+    use heist_shared::protocol::RadioAbout;
+    let mut g = started(7);
+    let case = g.level.cases.iter().position(|c| c.id == "west_2").expect("the museum has west_2");
+    let at = g.cases[case].position;
+    g.vive.position = at + Vec2::new(0.0, 0.5);
+    vive(&mut g, ViveMsg::Break(CaseId(case as u16))).unwrap();
+    g.vive.position = HIDEOUT; // broke it and slipped away unseen
+    assert_eq!(g.alarm, 0, "breaking alone does not raise the alarm");
+    let mut alarm = None;
+    let call = step_until_event(&mut g, 30.0, |e| match e {
+        GameEvent::Alarm(level) => {
+            alarm = Some(*level);
+            None
+        }
+        GameEvent::Radio { about: RadioAbout::Evidence, at, .. } => Some(*at),
+        _ => None,
+    });
+    assert_eq!(call, Some(at), "a guard came to the noise, found the broken case and radioed about it");
+    assert_eq!(alarm, Some(1), "the alarm went up with the report");
+    assert_eq!(g.alarm, 1);
+    assert!(g.cases[case].reported, "reported once");
+    // The alarm changed the patrols: a guard whose round missed every room holding a target now passes one.
+    let hot = g.hot_rooms();
+    for (i, guard) in g.guards.iter().enumerate() {
+        let rooms: Vec<_> = guard.route.iter().filter_map(|p| g.nav.room_at(*p)).collect();
+        assert!(
+            rooms.iter().any(|r| hot.contains(r)),
+            "guard {i} ({}) patrols a hot room: {rooms:?} vs {hot:?}",
+            guard.name
+        );
+    }
+    // A second broken case found does not raise it past the tuning's cap.
+    let other = g.level.cases.iter().position(|c| c.id == "west_3").expect("west_3");
+    g.cases[other].broken = true;
+    step_for(&mut g, 60.0);
+    assert_eq!(g.alarm, g.tuning.evidence_alarm_cap, "evidence raises the alarm at most to its cap");
+}

@@ -166,6 +166,26 @@ fn squelch(len: f32, beep_hz: f32) -> StaticSoundData {
     mono(&out)
 }
 
+/// A guard's radio: a squelch, a burst of garbled band-limited voice, a squelch tail.
+pub fn radio_squawk() -> StaticSoundData {
+    let mut noise = Noise::new(31);
+    let (mut lp, mut hp) = (0.0, 0.0);
+    let len = 0.7;
+    let mut phase = 0.0f32;
+    mono(&samples(len, |t| {
+        let n = noise.next_sample();
+        lp += 0.35 * (n - lp);
+        hp += 0.05 * (lp - hp);
+        let hiss = lp - hp;
+        // A buzzy "voice" whose pitch wanders, chopped into syllables.
+        phase += TAU * (140.0 + 40.0 * (TAU * 3.0 * t).sin()) / RATE as f32;
+        let syllable = ((TAU * 6.0 * t).sin() * 0.5 + 0.5).powi(2);
+        let voice = phase.sin().signum() * 0.25 * syllable * (TAU * 900.0 * t).sin();
+        let gate = if t < 0.06 || t > len - 0.08 { 0.6 } else { 0.15 };
+        (gate * hiss + if (0.08..len - 0.1).contains(&t) { voice } else { 0.0 }) * (1.0 - t / len).max(0.0).sqrt()
+    }))
+}
+
 /// A guard's bark: a voiced "hey!" (two formants over a falling pitch); sharper when chasing.
 pub fn bark(chasing: bool) -> StaticSoundData {
     let (len, f0) = if chasing { (0.35, 210.0) } else { (0.45, 160.0) };

@@ -1,23 +1,21 @@
-//! Where guards will be and look in the next seconds, from their public patrol routes.
+//! Where guards will be and look in the next seconds, from their public patrol routes (the level's, or
+//! the ones the alarm switches them to: `heist_shared::level::patrol::alert_route`).
 //!
 //! A patrolling guard walks its route at patrol speed; the bot replays that walk ahead of time. A guard
-//! that is not patrolling (staring, investigating, chasing, returning) is unpredictable: the bot treats
-//! it as standing still and looking every way.
+//! that is not patrolling (staring, investigating, chasing, searching, returning) is unpredictable: the
+//! bot treats it as coming at it and looking every way.
 
 use glam::Vec2;
-use heist_shared::level::{Level, WallSet};
+use heist_shared::level::WallSet;
 use heist_shared::protocol::{GuardAlert, GuardView};
+use heist_shared::rules::GuardTuning;
 
-/// Patrol speed the server uses, m/s (×1.15 per alarm level).
-const PATROL_SPEED: f32 = 1.1;
-/// Speed at which the bot assumes an alerted guard comes at it, m/s.
-const ALERT_SPEED: f32 = 1.4;
-/// Sight range the bot assumes (server value + margin), metres.
-const RANGE: f32 = 5.5 + 1.5;
-/// Half-angle of the cone the bot assumes (server value + margin), radians.
-const HALF_ANGLE: f32 = 0.7 + 0.35;
-/// Anyone within this distance is assumed seen, whatever the facing, metres.
-const ALL_ROUND: f32 = 2.2;
+/// The bot's caution on top of the guards' published sight range, metres.
+const RANGE_MARGIN: f32 = 1.0;
+/// The bot's caution on top of the guards' published half-angle of view, radians.
+const ANGLE_MARGIN: f32 = 0.25;
+/// The bot's caution on top of the guards' all-round noticing radius, metres.
+const ALL_ROUND_MARGIN: f32 = 1.0;
 
 /// One guard's future.
 enum Future {
@@ -30,7 +28,8 @@ enum Future {
 /// The forecast of every guard.
 pub struct Forecast {
     futures: Vec<Future>,
-    alarm: f32,
+    alarm: u8,
+    tuning: GuardTuning,
 }
 
 fn angle_of(v: Vec2) -> f32 {
@@ -42,12 +41,13 @@ fn wrap(a: f32) -> f32 {
 }
 
 impl Forecast {
-    /// Builds the forecast from what the client sees now; `me` is the bot's position.
-    pub fn new(level: &Level, guards: &[&GuardView], alarm: u8, me: Vec2) -> Self {
+    /// Builds the forecast from what the client sees now; `me` is the bot's position, `tuning` what the
+    /// guards can do on the session's difficulty, `routes` each guard's patrol (by guard id) now.
+    pub fn new(tuning: &GuardTuning, routes: &[Vec<Vec2>], guards: &[&GuardView], alarm: u8, me: Vec2) -> Self {
         let futures = guards
             .iter()
             .map(|g| {
-                let route = level.guards.get(usize::from(g.id.0)).map(|s| s.route.clone()).unwrap_or_default();
+                let route = routes.get(usize::from(g.id.0)).cloned().unwrap_or_default();
                 if g.alert != GuardAlert::Patrolling || route.len() < 2 {
                     return Future::Alert(g.position, me);
                 }
@@ -60,22 +60,29 @@ impl Forecast {
                         da.total_cmp(&db)
                     })
                     .unwrap_or(0);
-                Future::Patrol(route, next, g.position, PATROL_SPEED * (1.0 + 0.15 * f32::from(alarm)))
+                Future::Patrol(route, next, g.position, tuning.hasted(tuning.patrol_speed, alarm))
             })
             .collect();
-        Self { futures, alarm: f32::from(alarm) }
+        Self { futures, alarm, tuning: *tuning }
     }
 
     /// Where a guard last seen as `last`, `ago_s` seconds ago, is likely now (what a player who lost
     /// sight of it would guess): walked on along its route if it was patrolling; where it was if it was
     /// alerted, for `alert_memory_s`, and after that back on its patrol from there.
-    pub fn imagine(level: &Level, last: &GuardView, alarm: u8, ago_s: f32, alert_memory_s: f32) -> GuardView {
+    pub fn imagine(
+        tuning: &GuardTuning,
+        routes: &[Vec<Vec2>],
+        last: &GuardView,
+        alarm: u8,
+        ago_s: f32,
+        alert_memory_s: f32,
+    ) -> GuardView {
         if last.alert != GuardAlert::Patrolling && ago_s < alert_memory_s {
             return last.clone();
         }
         let calm = GuardView { alert: GuardAlert::Patrolling, ..last.clone() };
         let ago_s = if last.alert == GuardAlert::Patrolling { ago_s } else { ago_s - alert_memory_s };
-        let forecast = Self::new(level, &[&calm], alarm, last.position);
+        let forecast = Self::new(tuning, routes, &[&calm], alarm, last.position);
         match forecast.futures.first() {
             Some(Future::Patrol(..)) => {
                 let (position, facing) = forecast.pose(0, ago_s);
@@ -90,7 +97,7 @@ impl Forecast {
         match &self.futures[i] {
             Future::Alert(p, towards) => {
                 let d = *towards - *p;
-                let walk = (ALERT_SPEED * t).min((d.length() - 1.0).max(0.0));
+                let walk = (self.tuning.investigate_speed * t).min((d.length() - 1.0).max(0.0));
                 (*p + d.normalize_or_zero() * walk, None)
             }
             Future::Patrol(route, next, start, speed) => {
@@ -114,15 +121,18 @@ impl Forecast {
 
     /// True when some guard could see a person at `p` (crouching or not) `t` seconds from now.
     pub fn seen(&self, p: Vec2, t: f32, crouching: bool, walls: &WallSet) -> bool {
-        let range = RANGE * (1.0 + 0.1 * self.alarm) * if crouching { 0.6 } else { 1.0 };
+        let t_ = &self.tuning;
+        let margined = GuardTuning { sight_range: t_.sight_range + RANGE_MARGIN, ..*t_ };
+        let range = margined.sight_range_at(self.alarm, false, crouching);
+        let (all_round, half_angle) = (t_.notice_radius + ALL_ROUND_MARGIN, t_.half_angle(false) + ANGLE_MARGIN);
         (0..self.futures.len()).any(|i| {
             let (g, facing) = self.pose(i, t);
             let d = p - g;
             let dist = d.length();
             let in_view = match facing {
-                _ if dist < ALL_ROUND => true,
+                _ if dist < all_round => true,
                 None => dist < range,
-                Some(f) => dist < range && wrap(angle_of(d) - f).abs() < HALF_ANGLE,
+                Some(f) => dist < range && wrap(angle_of(d) - f).abs() < half_angle,
             };
             in_view && walls.line_of_sight(g, p)
         })
@@ -167,7 +177,12 @@ impl Forecast {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use heist_shared::level::Level;
     use heist_shared::protocol::GuardId;
+
+    fn routes(level: &Level) -> Vec<Vec<Vec2>> {
+        level.guards.iter().map(|g| g.route.clone()).collect()
+    }
 
     fn guard(at: Vec2, facing: f32) -> GuardView {
         GuardView { id: GuardId(0), name: "Bruno".into(), position: at, facing, alert: GuardAlert::Patrolling }
@@ -178,7 +193,7 @@ mod tests {
         let level = Level::museum();
         let route = level.guards[0].route.clone();
         let g = guard(route[0], 0.0);
-        let f = Forecast::new(&level, &[&g], 0, Vec2::ZERO);
+        let f = Forecast::new(&GuardTuning::default(), &routes(&level), &[&g], 0, Vec2::ZERO);
         let (p, facing) = f.pose(0, 2.0);
         assert!((p - (route[0] + (route[1] - route[0]).normalize() * 2.2)).length() < 1e-3, "{p:?}");
         assert!(facing.is_some());
@@ -190,7 +205,7 @@ mod tests {
         let walls = WallSet::new(&level);
         let route = level.guards[0].route.clone();
         let g = guard(route[0] + Vec2::new(4.0, 0.0), 0.0); // walking +x along the gallery
-        let f = Forecast::new(&level, &[&g], 0, Vec2::ZERO);
+        let f = Forecast::new(&GuardTuning::default(), &routes(&level), &[&g], 0, Vec2::ZERO);
         assert!(f.seen(g.position + Vec2::new(4.0, 0.0), 0.0, false, &walls));
         assert!(!f.seen(g.position - Vec2::new(4.0, 0.0), 0.0, false, &walls));
     }

@@ -48,6 +48,7 @@ fn run(wav: Option<&std::path::Path>, said: &[f32], seconds: f64) -> Run {
         advertise: None,
         seed: Some(3),
         time_limit_s: None,
+        difficulty: Default::default(),
     };
     let here = heist_server::embedded::start(host).expect("server");
     let timeout = Duration::from_secs(5);

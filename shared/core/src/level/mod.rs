@@ -6,6 +6,7 @@
 
 mod geometry;
 mod nav;
+pub mod patrol;
 
 pub use geometry::{Segment, WallSet};
 pub use nav::NavGraph;
@@ -44,6 +45,9 @@ pub struct Level {
     pub vive_spawn: Vec2,
     /// The museum's exit.
     pub exit: Vec2,
+    /// The guards' tuning per difficulty, where this level wants its own (default: the built-in ones).
+    #[serde(default)]
+    pub difficulties: crate::rules::DifficultyTable,
 }
 
 /// A rectangular room.
@@ -209,10 +213,20 @@ impl Level {
         self.targets.iter().map(|t| t.copies).sum()
     }
 
+    /// The guards' tuning on difficulty `d` in this level.
+    pub fn tuning(&self, d: crate::rules::Difficulty) -> crate::rules::GuardTuning {
+        self.difficulties.tuning(d)
+    }
+
     fn validate(&self) -> Result<(), (String, String)> {
         let err = |place: String, problem: String| Err((place, problem));
         if !(self.time_limit_s.is_finite() && self.time_limit_s > 0.0) {
             return err("time_limit_s".into(), format!("must be a positive number, got {}", self.time_limit_s));
+        }
+        for d in crate::rules::Difficulty::ALL {
+            if let Some(why) = self.tuning(d).out_of_range() {
+                return err(format!("difficulties.{}", d.name()), why);
+            }
         }
         if self.rooms.len() < MIN_ROOMS {
             return err(

@@ -115,6 +115,19 @@ impl NavGraph {
         length
     }
 
+    /// The rooms a door leads to from room `room`, each once.
+    pub fn neighbours(&self, room: usize) -> Vec<usize> {
+        let mut out: Vec<usize> = self.links.get(room).map_or_else(Vec::new, |l| l.iter().map(|l| l.1).collect());
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
+    /// The centre of room `room`.
+    pub fn room_centre(&self, room: usize) -> Option<Vec2> {
+        self.rooms.get(room).map(|(min, max)| (*min + *max) * 0.5)
+    }
+
     /// Centres of all rooms.
     pub fn room_centres(&self) -> impl Iterator<Item = Vec2> + '_ {
         self.rooms.iter().map(|(min, max)| (*min + *max) * 0.5)

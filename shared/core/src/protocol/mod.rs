@@ -18,7 +18,9 @@ pub use replicated::{
     Audience, CaseView, ClientRole, GuardAlert, GuardView, ItemKind, ItemPlace, ItemView, LossReason, PhantomTool,
     Phase, REPLICATED, SessionView, Stance, ViveAvatar,
 };
-pub use server_msg::{DisconnectReason, GameEvent, NoiseKind, Refusal, ServerMsg, VerdictOutcome, WorkbenchCopy};
+pub use server_msg::{
+    DisconnectReason, GameEvent, NoiseKind, RadioAbout, Refusal, ServerMsg, VerdictOutcome, WorkbenchCopy,
+};
 pub use token::{SeatTicket, TokenUserData, USER_DATA_MAGIC};
 pub use verify::verify;
 pub use voice::{ClientVoice, PartnerVoice, VoiceFrame};

@@ -115,6 +115,8 @@ pub struct SessionView {
     pub targets: Vec<(ArtifactKind, bool)>,
     /// Which roles are connected.
     pub present: (bool, bool),
+    /// The session's difficulty (with the level, it says what the guards can do: `Level::tuning`).
+    pub difficulty: crate::rules::Difficulty,
 }
 
 /// Vive's stance.
@@ -160,6 +162,8 @@ pub enum GuardAlert {
     Chasing,
     /// Going back to the patrol route.
     Returning,
+    /// Searching the rooms around where Vive was seen (after a chase, or called by radio).
+    Searching,
 }
 
 /// A guard.

@@ -72,6 +72,15 @@ pub enum NoiseKind {
     Alarm,
 }
 
+/// What a guard radios about.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum RadioAbout {
+    /// He is sure he saw an intruder.
+    Sighting,
+    /// He found a broken display case.
+    Evidence,
+}
+
 /// Something that happened, for logs, speech and sound.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum GameEvent {
@@ -143,6 +152,20 @@ pub enum GameEvent {
     },
     /// Vive picked an item up.
     PickedUp(ItemId),
+    /// A guard radioed the others (heard as a squawk where he stands); those within range come to search
+    /// around `at` after the radio's delay.
+    Radio {
+        /// Who called.
+        guard: GuardId,
+        /// What about.
+        about: RadioAbout,
+        /// Where (the intruder's last known position, or the broken case).
+        at: Vec2,
+        /// Where the caller stands.
+        from: Vec2,
+        /// The guards who will answer the call.
+        answering: Vec<GuardId>,
+    },
 }
 
 /// Why an input was refused. Sent as data; the session goes on.

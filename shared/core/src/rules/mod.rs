@@ -55,3 +55,6 @@ pub fn move_body(
 pub const VIVE_SIGHT_RANGE: f32 = 30.0;
 /// Audible radius of a guard's footsteps for Vive, metres, along the door path (closed doors muffle).
 pub const GUARD_STEP_LOUDNESS: f32 = 15.0;
+
+mod guards;
+pub use guards::{Difficulty, DifficultyTable, GuardTuning};

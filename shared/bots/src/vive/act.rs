@@ -1,0 +1,289 @@
+//! Working out the Vive bot's [`Perception`] from the view, its map and memory, and carrying a
+//! [`Plan`] out as a movement and maybe an action (the routes, the hiding places and the refuges).
+
+use glam::Vec2;
+use heist_shared::protocol::{Gait, GuardAlert, ItemKind, ItemPlace, ViveMsg};
+use heist_shared::rules;
+
+use super::View;
+use super::decide::{LURE_AFTER_S, Perception, Plan};
+use super::goal::Goal;
+use super::map::Map;
+use super::memory::Memory;
+use crate::forecast::Forecast;
+
+/// How far ahead the bot checks that its way stays out of sight, seconds.
+const LOOK_AHEAD_S: f32 = 6.0;
+/// Closer than this beyond a guard's all-round noticing radius counts as exposed, seen or not (walls
+/// and doors are thin), metres.
+const TOO_CLOSE_M: f32 = 1.0;
+/// Glass may be broken within a guard's hearing only when he needs this long to get to it, seconds
+/// (time to grab the copy and get out of sight).
+const BREAK_HEADSTART_S: f32 = 7.0;
+/// After the last sight of a guard chasing, the bot keeps fleeing this long, seconds.
+const FLEE_ON_S: f32 = 5.0;
+/// How long an item given up on stays given up, seconds.
+const AVOID_FOR_S: f32 = 60.0;
+
+/// Everything the decisions need this frame. Plans the way to the goal first (kept in memory while the
+/// goal stays).
+pub(crate) fn perceive(
+    map: &Map,
+    memory: &mut Memory,
+    view: &View<'_>,
+    forecast: &Forecast,
+    goal: &Goal,
+    reckless: bool,
+) -> Perception {
+    let me = view.me.position;
+    let target = goal.at();
+    let action = match goal {
+        Goal::Go(_) => None,
+        Goal::Break(_, c, _) => Some(ViveMsg::Break(*c)),
+        Goal::Take(_, i) => Some(ViveMsg::PickUp(*i)),
+        Goal::Deliver(_, i) => {
+            let busy = view.items.iter().any(|it| it.place == ItemPlace::Workbench);
+            (!busy).then_some(ViveMsg::PlaceOnWorkbench(*i))
+        }
+    };
+    let at_goal = me.distance(target) <= rules::REACH * 0.8;
+    memory.approach(target, me);
+    plan_route(map, memory, view, target, reckless);
+    if view.guards.iter().any(|g| g.alert == GuardAlert::Chasing) {
+        memory.chased_at = Some(memory.clock_s);
+    }
+    let mut p = Perception {
+        reckless,
+        chased: memory.chased_at.is_some_and(|t| memory.clock_s - t < FLEE_ON_S),
+        at_goal,
+        action,
+        waited_s: memory.stalled_s(),
+        break_waited_s: memory.break_waited_s,
+        fetching: goal.item().is_some(),
+        ..Default::default()
+    };
+    if reckless || p.chased {
+        return p;
+    }
+    let close = view.tuning.notice_radius + TOO_CLOSE_M;
+    let crowded = view.guards.iter().any(|g| g.position.distance(me) < close);
+    p.exposed = crowded || forecast.seen(me, 0.0, true, &map.walls);
+    if p.exposed {
+        return p;
+    }
+    if at_goal && matches!(p.action, Some(ViveMsg::Break(_))) {
+        let hearing = view.tuning.hearing_at(view.alarm);
+        let speed = view.tuning.hasted(view.tuning.investigate_speed, view.alarm);
+        p.break_heard = view.guards.iter().any(|g| {
+            map.nav.heard_margin(target, g.position, rules::GLASS_LOUDNESS * hearing) >= 0.0
+                && map.nav.route_length(g.position, target) / speed < BREAK_HEADSTART_S
+        });
+        if p.break_heard {
+            memory.quiet_since = None;
+        }
+        let since = *memory.quiet_since.get_or_insert(memory.clock_s);
+        p.quiet_s = memory.clock_s - since;
+    } else {
+        memory.quiet_since = None;
+    }
+    if !at_goal {
+        p.way = fastest_hidden_gait(map, memory, view, forecast);
+    }
+    p.hidden_here = forecast.hidden_for(me, LOOK_AHEAD_S * 0.5, &map.walls);
+    let lure_due = memory.lured_at.is_none_or(|t| memory.clock_s - t > LURE_AFTER_S);
+    if lure_due {
+        let nearest = view.guards.iter().min_by(|a, b| a.position.distance(me).total_cmp(&b.position.distance(me)));
+        let prop = view
+            .me
+            .carrying
+            .iter()
+            .copied()
+            .find(|&i| view.items.iter().any(|it| it.id == i && matches!(it.kind, ItemKind::Prop)));
+        if let (Some(g), Some(prop)) = (nearest, prop) {
+            p.lure = Some((prop, g.position + (g.position - me).normalize_or_zero() * 7.0));
+        }
+    }
+    p
+}
+
+/// Keeps a route to `target` in memory, away from rooms with guards in them (straight for a reckless
+/// bot); replanned when the target moves.
+fn plan_route(map: &Map, memory: &mut Memory, view: &View<'_>, target: Vec2, reckless: bool) {
+    let me = view.me.position;
+    if memory.route_goal.is_none_or(|g| g.distance(target) > 0.3) || memory.route.is_empty() {
+        let guard_rooms: Vec<usize> = view.guards.iter().filter_map(|g| map.nav.room_at(g.position)).collect();
+        let cost = |room: usize| 1.0 + 3.0 * guard_rooms.iter().filter(|&&r| r == room).count() as f32;
+        let route = if reckless { map.nav.route(me, target) } else { map.nav.route_avoiding(me, target, cost) };
+        memory.route = route.unwrap_or_else(|| vec![target]);
+        memory.route.reverse();
+        memory.route_goal = Some(target);
+    }
+    while memory.route.len() > 1 && memory.route.last().is_some_and(|w| w.distance(me) < 0.25) {
+        memory.route.pop();
+    }
+}
+
+/// Run when out of every guard's earshot and the way stays unseen at a run; else walk; else crouch.
+fn fastest_hidden_gait(map: &Map, memory: &Memory, view: &View<'_>, forecast: &Forecast) -> Option<Gait> {
+    let me = view.me.position;
+    let path: Vec<Vec2> = memory.route.iter().rev().copied().collect();
+    let hearing = view.tuning.hearing_at(view.alarm);
+    let quiet =
+        view.guards.iter().all(|g| map.nav.heard_margin(me, g.position, rules::RUN_LOUDNESS * hearing * 1.5) < 0.0);
+    let hidden = |speed: f32, horizon: f32, crouching: bool| {
+        forecast.path_hidden(me, &path, speed, horizon, crouching, &map.walls)
+    };
+    if quiet && hidden(rules::RUN_SPEED, LOOK_AHEAD_S, false) {
+        Some(Gait::Run)
+    } else if hidden(rules::WALK_SPEED, LOOK_AHEAD_S, false) {
+        Some(Gait::Walk)
+    } else if hidden(rules::CROUCH_SPEED, LOOK_AHEAD_S * 0.5, true) {
+        Some(Gait::Crouch)
+    } else {
+        None
+    }
+}
+
+/// Carries `plan` out: (direction, gait, action). Updates the memory's timers.
+pub(crate) fn carry_out(
+    plan: Plan,
+    map: &Map,
+    memory: &mut Memory,
+    view: &View<'_>,
+    forecast: &Forecast,
+) -> (Vec2, Gait, Option<ViveMsg>) {
+    let me = view.me.position;
+    if !matches!(plan, Plan::Flee) {
+        memory.refuge = None;
+    }
+    memory.walked(me);
+    match plan {
+        Plan::Go(gait) => {
+            let waypoint = memory.route.last().copied().unwrap_or(me);
+            ((waypoint - me).normalize_or_zero(), gait, None)
+        }
+        Plan::Act(action) => (Vec2::ZERO, Gait::Walk, Some(action)),
+        Plan::Wait => (Vec2::ZERO, Gait::Crouch, None),
+        Plan::Throw(item, target) => {
+            memory.lured_at = Some(memory.clock_s);
+            (Vec2::ZERO, Gait::Crouch, Some(ViveMsg::Throw { item, target }))
+        }
+        Plan::GiveUp => {
+            if let Some(item) = memory.committed.take() {
+                memory.avoid.push((item, memory.clock_s + AVOID_FOR_S));
+            }
+            memory.progress = None;
+            memory.break_waited_s = 0.0;
+            (Vec2::ZERO, Gait::Crouch, None)
+        }
+        Plan::Hide => {
+            let (direction, gait) = hide(map, memory, view, forecast);
+            (direction, gait, None)
+        }
+        Plan::Flee => {
+            // Run while a guard is after us; after losing him, walk on quietly (running is heard).
+            let pursued = view.guards.iter().any(|g| g.alert == GuardAlert::Chasing);
+            (flee(map, memory, view), if pursued { Gait::Run } else { Gait::Walk }, None)
+        }
+    }
+}
+
+/// Towards the nearest spot we can reach unseen that then stays hidden (places we have been, room
+/// centres, spots around), crouching when a guard is near enough to see a standing Vive soon;
+/// failing that, away along the flight route.
+fn hide(map: &Map, memory: &mut Memory, view: &View<'_>, forecast: &Forecast) -> (Vec2, Gait) {
+    let me = view.me.position;
+    memory.route_goal = None;
+    let standing_seen_at = view.tuning.sight_range_at(view.alarm, false, false) + 2.0;
+    let near = view.guards.iter().any(|g| g.position.distance(me) < standing_seen_at);
+    let (gait, speed) = if near { (Gait::Crouch, rules::CROUCH_SPEED) } else { (Gait::Walk, rules::WALK_SPEED) };
+    let mut candidates: Vec<Vec2> = memory.trail.iter().rev().step_by(15).take(20).copied().collect();
+    candidates.extend(map.nav.room_centres());
+    for dx in [-3.0f32, 0.0, 3.0] {
+        for dy in [-3.0f32, 0.0, 3.0] {
+            candidates.push(me + Vec2::new(dx, dy));
+        }
+    }
+    let best = candidates
+        .into_iter()
+        .filter(|c| map.nav.room_at(*c).is_some())
+        .filter_map(|c| {
+            let route = map.nav.route(me, c)?;
+            let length = map.nav.route_length(me, c);
+            let horizon = length / speed + 3.0;
+            forecast.path_hidden(me, &route, speed, horizon, near, &map.walls).then_some((length, route))
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0));
+    if let Some((_, route)) = best
+        && let Some(first) = route.into_iter().find(|p| p.distance(me) > 0.2)
+    {
+        return ((first - me).normalize_or_zero(), gait);
+    }
+    // Nowhere better within reach: keep still and low if no guard sees this spot now, else get away.
+    if !forecast.seen(me, 0.0, true, &map.walls) {
+        return (Vec2::ZERO, Gait::Crouch);
+    }
+    (flee(map, memory, view), gait)
+}
+
+/// Towards the refuge chosen by [`pick_refuge`] (the workbench when there is none); the choice is
+/// reconsidered every second and dropped once reached.
+fn flee(map: &Map, memory: &mut Memory, view: &View<'_>) -> Vec2 {
+    let me = view.me.position;
+    if memory.refuge.is_some_and(|(r, _)| r.distance(me) < 1.5) {
+        memory.refuge = None; // reached it and still in danger: pick the next one
+    }
+    // Think again every second (guards move), but switch only for a clearly better refuge.
+    let now = memory.clock_s;
+    if memory.refuge.is_none_or(|(_, at)| now - at > 1.0) {
+        let current = memory.refuge.map(|(r, _)| r);
+        memory.refuge = pick_refuge(map, view, current).map(|r| (r, now));
+    }
+    let refuge = memory.refuge.map_or(map.workbench, |(r, _)| r);
+    let first = map.nav.route(me, refuge).and_then(|r| r.into_iter().find(|p| p.distance(me) > 0.3)).unwrap_or(refuge);
+    memory.route_goal = None;
+    (first - me).normalize_or_zero()
+}
+
+/// The spot we keep the most room at along the whole way there: ahead of every alerted guard, and
+/// outside every patrolling guard's sight.
+fn pick_refuge(map: &Map, view: &View<'_>, current: Option<Vec2>) -> Option<Vec2> {
+    let me = view.me.position;
+    let room_left = |p: Vec2| {
+        let Some(route) = map.nav.route(me, p) else { return f32::NEG_INFINITY };
+        let (mut last, mut mine, mut worst) = (me, 0.0f32, 20.0f32);
+        for wp in points_along(me, &route) {
+            mine += last.distance(wp);
+            last = wp;
+            for g in &view.guards {
+                let theirs = map.nav.route_length(g.position, wp);
+                worst = worst.min(match g.alert {
+                    GuardAlert::Patrolling | GuardAlert::Returning => theirs - 6.0,
+                    _ => theirs - mine,
+                });
+            }
+        }
+        worst + 0.05 * mine
+    };
+    let best = map
+        .refuge_spots()
+        .filter(|p| p.distance(me) > 6.0)
+        .map(|p| (room_left(p), p))
+        .max_by(|a, b| a.0.total_cmp(&b.0));
+    match (current, best) {
+        (Some(c), Some((s, _))) if room_left(c) + 3.0 >= s => Some(c),
+        (_, best) => best.map(|b| b.1),
+    }
+}
+
+/// Points every metre along a polyline starting at `from`.
+fn points_along(from: Vec2, route: &[Vec2]) -> Vec<Vec2> {
+    let mut at = from;
+    let mut points = Vec::new();
+    for &wp in route {
+        let steps = at.distance(wp).ceil().max(1.0) as usize;
+        points.extend((1..=steps).map(|k| at.lerp(wp, k as f32 / steps as f32)));
+        at = wp;
+    }
+    points
+}

@@ -1,0 +1,140 @@
+//! What the Vive bot remembers from frame to frame: its clock, the way it is walking, how long it has
+//! waited, where it fled to, which item it is after and which it gave up on for now, where it has been,
+//! and each guard as last seen. Apart from the [`super::map::Map`], which never changes.
+
+use std::collections::VecDeque;
+
+use glam::Vec2;
+use heist_shared::protocol::{GuardView, ItemId};
+use heist_shared::rules::GuardTuning;
+
+use crate::forecast::Forecast;
+
+/// Seconds an alerted guard out of sight is imagined where it was last seen; after that it is
+/// imagined back on its patrol.
+const ALERT_MEMORY_S: f32 = 8.0;
+/// Positions kept of where the bot has been (one a frame): hiding places it knows are reachable.
+const TRAIL_LEN: usize = 900;
+
+#[derive(Default)]
+pub(crate) struct Memory {
+    /// Heist time as the bot counts it, seconds.
+    pub clock_s: f32,
+    /// The way to the current target, last waypoint first.
+    pub route: Vec<Vec2>,
+    /// The target `route` leads to.
+    pub route_goal: Option<Vec2>,
+    /// Progress towards the goal: (goal, the closest the bot has come to it, when it last came a metre
+    /// closer). Waiting and hiding make none; a frame's step forward and back again does not count.
+    pub progress: Option<(Vec2, f32, f32)>,
+    /// Seconds spent waiting at a case for the guards to get out of earshot.
+    pub break_waited_s: f32,
+    /// Since when the case at hand has been out of every guard's earshot.
+    pub quiet_since: Option<f32>,
+    /// When the bot last threw something to lure a guard.
+    pub lured_at: Option<f32>,
+    /// When the bot last saw a guard chasing it.
+    pub chased_at: Option<f32>,
+    /// Where the bot is fleeing to, and when it chose it.
+    pub refuge: Option<(Vec2, f32)>,
+    /// The item the bot is going for.
+    pub committed: Option<ItemId>,
+    /// Items given up on until a time (the way to them was watched too long).
+    pub avoid: Vec<(ItemId, f32)>,
+    /// Where the bot has been, oldest first.
+    pub trail: VecDeque<Vec2>,
+    /// Each guard as last seen and when (the server sends only guards Vive can perceive).
+    pub remembered: Vec<(GuardView, f32)>,
+}
+
+impl Memory {
+    /// Remembers the guards in sight now.
+    pub fn see(&mut self, guards: &[&GuardView]) {
+        for g in guards {
+            self.remembered.retain(|(r, _)| r.id != g.id);
+            self.remembered.push(((*g).clone(), self.clock_s));
+        }
+    }
+
+    /// The guards out of sight, imagined where they have likely walked since they were last seen.
+    pub fn imagined(
+        &self,
+        in_sight: &[&GuardView],
+        tuning: &GuardTuning,
+        routes: &[Vec<Vec2>],
+        alarm: u8,
+    ) -> Vec<GuardView> {
+        self.remembered
+            .iter()
+            .filter(|(r, _)| !in_sight.iter().any(|g| g.id == r.id))
+            .map(|(r, at)| Forecast::imagine(tuning, routes, r, alarm, self.clock_s - at, ALERT_MEMORY_S))
+            .collect()
+    }
+
+    /// Notes where the bot is (bounded).
+    pub fn walked(&mut self, at: Vec2) {
+        if self.trail.len() == TRAIL_LEN {
+            self.trail.pop_front();
+        }
+        self.trail.push_back(at);
+    }
+
+    /// Notes how close the bot is to `goal` now.
+    pub fn approach(&mut self, goal: Vec2, at: Vec2) {
+        let d = goal.distance(at);
+        match &mut self.progress {
+            Some((g, best, since)) if g.distance(goal) < 0.3 => {
+                if d < *best - 1.0 {
+                    (*best, *since) = (d, self.clock_s);
+                }
+            }
+            _ => self.progress = Some((goal, d, self.clock_s)),
+        }
+    }
+
+    /// Seconds since the bot last came a metre closer to its goal.
+    pub fn stalled_s(&self) -> f32 {
+        self.progress.map_or(0.0, |(_, _, since)| self.clock_s - since)
+    }
+
+    /// True while `item` is given up on.
+    pub fn avoids(&self, item: ItemId) -> bool {
+        self.avoid.iter().any(|(a, until)| *a == item && *until > self.clock_s)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stepping_forth_and_back_is_no_progress_but_a_metre_closer_is() {
+        let mut m = Memory::default();
+        let goal = Vec2::new(10.0, 0.0);
+        m.approach(goal, Vec2::ZERO);
+        for k in 0..100 {
+            m.clock_s += 0.1;
+            m.approach(goal, Vec2::new(if k % 2 == 0 { 0.5 } else { 0.0 }, 0.0));
+        }
+        assert!((m.stalled_s() - 10.0).abs() < 1e-3, "dithering for 10 s: stalled {}", m.stalled_s());
+        m.approach(goal, Vec2::new(1.5, 0.0));
+        assert_eq!(m.stalled_s(), 0.0, "a metre closer");
+        m.clock_s += 1.0;
+        m.approach(Vec2::new(0.0, 20.0), Vec2::new(1.5, 0.0));
+        assert_eq!(m.stalled_s(), 0.0, "a new goal starts afresh");
+    }
+
+    #[test]
+    fn the_trail_keeps_the_latest_places_only_and_given_up_items_come_back_in_time() {
+        let mut m = Memory::default();
+        for i in 0..(TRAIL_LEN + 10) {
+            m.walked(Vec2::new(i as f32, 0.0));
+        }
+        assert_eq!(m.trail.len(), TRAIL_LEN);
+        assert_eq!(m.trail.front(), Some(&Vec2::new(10.0, 0.0)));
+        m.avoid.push((ItemId(3), 5.0));
+        assert!(m.avoids(ItemId(3)) && !m.avoids(ItemId(4)));
+        m.clock_s = 6.0;
+        assert!(!m.avoids(ItemId(3)));
+    }
+}

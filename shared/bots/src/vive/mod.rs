@@ -1,0 +1,245 @@
+//! The Vive bot: plans routes over the room graph, keeps out of guards' sight, breaks cases, carries
+//! copies to the workbench and throws a prop to lure a guard that blocks the way.
+//!
+//! Each frame: what it sees (the replicated state: [`Sight`]) and remembers ([`memory`]) becomes a
+//! [`View`]; an ordered table of choices picks the goal ([`goal`]); the [`decide::Perception`] of
+//! the moment ([`act::perceive`]) goes through the ordered decision table ([`decide`]); the plan is
+//! carried out as a movement and maybe an action ([`act::carry_out`]). The museum it knows
+//! ([`map`]) is built once and kept apart from its memory. It plans only with what a player could
+//! know: the published patrol routes and guard numbers (`heist_shared::rules`), and what it saw.
+
+use bevy::prelude::*;
+use glam::Vec2;
+use heist_client::Inbox;
+use heist_shared::protocol::{
+    CaseView, ClientMsg, Gait, GuardView, ItemView, LobbyMsg, Phase, SessionView, ViveAvatar, ViveMsg,
+};
+use heist_shared::rules;
+
+use crate::forecast::Forecast;
+
+/// How the Vive bot plays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ViveStyle {
+    /// Sneaks: avoids sight, waits, lures guards away.
+    #[default]
+    Careful,
+    /// Runs straight for the copies, ignoring guards (gets caught).
+    Reckless,
+    /// Readies up, then stands still at the spawn (lets the timer run out).
+    Idle,
+}
+
+mod act;
+mod decide;
+mod goal;
+mod map;
+mod memory;
+
+/// The Vive bot: what it knows of the museum (built once) apart from what it remembers.
+#[derive(Resource, Default)]
+pub struct ViveBrain {
+    style: ViveStyle,
+    round: u32,
+    ready_sent: bool,
+    seq: u32,
+    map: Option<map::Map>,
+    memory: memory::Memory,
+    /// Seconds spent under each decision (by index in the decision table) and carrying something.
+    spent: (Vec<f32>, f32),
+    /// Actions taken, for tests and logs.
+    pub actions: Vec<String>,
+}
+
+/// Plays Vive with a given style.
+pub struct ViveBotPlugin {
+    /// Play style.
+    pub style: ViveStyle,
+}
+
+impl Plugin for ViveBotPlugin {
+    fn build(&self, app: &mut App) {
+        app.insert_resource(ViveBrain::new(self.style))
+            .add_systems(Update, (play, crate::rounds::ask_for_another_round));
+    }
+}
+
+/// Everything the bot sees this frame.
+pub(crate) struct View<'a> {
+    me: &'a ViveAvatar,
+    alarm: u8,
+    tuning: rules::GuardTuning,
+    /// The guards: those in sight, and those out of sight where they are likely now.
+    guards: Vec<&'a GuardView>,
+    cases: Vec<&'a CaseView>,
+    items: Vec<&'a ItemView>,
+    secured: Vec<heist_shared::artifact::ArtifactKind>,
+}
+
+/// What the bot decided in one frame.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Turn {
+    /// Say "ready" in the lobby now.
+    pub ready: bool,
+    /// Where to go: direction (|d| ≤ 1, museum floor), gait and facing (radians); `None` outside the heist.
+    pub movement: Option<(Vec2, Gait, f32)>,
+    /// What to do besides moving (break, pick up, throw, place…).
+    pub action: Option<ViveMsg>,
+}
+
+/// Everything the bot may look at in one frame (the replicated state, or a client's predicted view of it).
+pub struct Sight<'a> {
+    /// The level, once the server has sent it.
+    pub level: Option<&'a heist_shared::level::Level>,
+    /// Whether the server has granted the role.
+    pub joined: bool,
+    /// The session.
+    pub session: &'a SessionView,
+    /// Vive as the bot should see itself.
+    pub me: &'a ViveAvatar,
+    /// The guards.
+    pub guards: Vec<&'a GuardView>,
+    /// The display cases.
+    pub cases: Vec<&'a CaseView>,
+    /// The items.
+    pub items: Vec<&'a ItemView>,
+}
+
+impl ViveBrain {
+    /// A fresh brain playing `style`.
+    pub fn new(style: ViveStyle) -> Self {
+        Self { style, ..Default::default() }
+    }
+
+    /// Seconds spent under each of the bot's decisions this round (those used), most first, and seconds
+    /// spent carrying something: where a heist's time went.
+    pub fn time_spent(&self) -> (Vec<(&'static str, f32)>, f32) {
+        let mut by: Vec<(&'static str, f32)> = (self.spent.0.iter().enumerate())
+            .filter(|(_, s)| **s > 0.0)
+            .map(|(i, s)| (decide::DECISIONS[i].0, *s))
+            .collect();
+        by.sort_by(|a, b| b.1.total_cmp(&a.1));
+        (by, self.spent.1)
+    }
+
+    /// Thinks for one frame of `dt` seconds: what to say, where to go, what to do. The bot plugin sends
+    /// the result as messages; the Vive client turns it into the same intents a player's input makes.
+    pub fn think(&mut self, sight: &Sight<'_>, dt: f32) -> Turn {
+        let mut turn = Turn::default();
+        let (session, me) = (sight.session, sight.me);
+        if self.map.is_none()
+            && let Some(level) = sight.level
+        {
+            self.map = Some(map::Map::new(level));
+        }
+        if session.phase == Phase::Lobby && !self.ready_sent && sight.joined {
+            turn.ready = true;
+            self.ready_sent = true;
+        }
+        let Some(map) = self.map.as_ref() else { return turn };
+        if session.phase != Phase::Heist || self.style == ViveStyle::Idle {
+            return turn;
+        }
+        let memory = &mut self.memory;
+        memory.see(&sight.guards);
+        let tuning = map.tuning(session);
+        let routes = map.patrols(session, &sight.cases, &sight.items);
+        let imagined = memory.imagined(&sight.guards, &tuning, &routes, session.alarm);
+        let view = View {
+            me,
+            alarm: session.alarm,
+            tuning,
+            guards: sight.guards.iter().copied().chain(imagined.iter()).collect(),
+            cases: sight.cases.clone(),
+            items: sight.items.clone(),
+            secured: session.targets.iter().filter(|t| t.1).map(|t| t.0).collect(),
+        };
+        memory.clock_s += dt;
+        let now = memory.clock_s;
+        memory.avoid.retain(|(_, until)| *until > now);
+        let goal = goal::choose(&goal::Wants::new(&view, memory, map.workbench));
+        memory.committed = goal.item();
+        let forecast = Forecast::new(&view.tuning, &routes, &view.guards, view.alarm, me.position);
+        let perception = act::perceive(map, memory, &view, &forecast, &goal, self.style == ViveStyle::Reckless);
+        let (decision, plan) = decide::decide(&perception);
+        let waiting_at_case = perception.at_goal
+            && matches!(perception.action, Some(ViveMsg::Break(_)))
+            && matches!(plan, decide::Plan::Wait | decide::Plan::Throw(..));
+        memory.break_waited_s = if waiting_at_case { memory.break_waited_s + dt } else { 0.0 };
+        if self.spent.0.len() != decide::DECISIONS.len() {
+            self.spent.0 = vec![0.0; decide::DECISIONS.len()];
+        }
+        self.spent.0[decision] += dt;
+        if !me.carrying.is_empty() {
+            self.spent.1 += dt;
+        }
+        let (direction, gait, action) = act::carry_out(plan, map, memory, &view, &forecast);
+        if let Some(action) = &action {
+            self.actions.push(format!("{action:?}"));
+        }
+        let facing = if direction.length_squared() > 0.0 { direction.y.atan2(direction.x) } else { me.facing };
+        turn.movement = Some((direction, gait, facing));
+        turn.action = action;
+        turn
+    }
+}
+
+/// The replicated state a Vive bot looks at, as one system parameter: the bot plugin and the Vive
+/// client (which shows the brain its predicted body) both read the world through it.
+#[derive(bevy::ecs::system::SystemParam)]
+pub struct Seen<'w, 's> {
+    inbox: Res<'w, Inbox>,
+    session: Query<'w, 's, &'static SessionView>,
+    avatar: Query<'w, 's, &'static ViveAvatar>,
+    guards: Query<'w, 's, &'static GuardView>,
+    cases: Query<'w, 's, &'static CaseView>,
+    items: Query<'w, 's, &'static ItemView>,
+}
+
+impl Seen<'_, '_> {
+    /// The replicated avatar, once there is one.
+    pub fn avatar(&self) -> Option<&ViveAvatar> {
+        self.avatar.single().ok()
+    }
+
+    /// What the bot sees, with itself as `me` (the replicated avatar, or a client's prediction of it);
+    /// `None` before the session and the avatar are replicated.
+    pub fn sight<'a>(&'a self, me: &'a ViveAvatar) -> Option<Sight<'a>> {
+        Some(Sight {
+            level: self.inbox.level.as_ref(),
+            joined: self.inbox.role.is_some(),
+            session: self.session.single().ok()?,
+            me,
+            guards: self.guards.iter().collect(),
+            cases: self.cases.iter().collect(),
+            items: self.items.iter().collect(),
+        })
+    }
+}
+
+fn play(
+    mut brain: ResMut<ViveBrain>,
+    time: Res<Time>,
+    seen: Seen,
+    inbox: Res<heist_client::Inbox>,
+    mut out: MessageWriter<ClientMsg>,
+) {
+    let round = inbox.current_round();
+    if brain.round != round {
+        // A new round: plans of the last one go; the move numbers carry on, as the server's do.
+        let first = brain.round == 0;
+        *brain = ViveBrain { round, seq: brain.seq, ready_sent: !first, ..ViveBrain::new(brain.style) };
+    }
+    let Some(sight) = seen.avatar().and_then(|me| seen.sight(me)) else { return };
+    let turn = brain.think(&sight, time.delta_secs());
+    if turn.ready {
+        out.write(ClientMsg::Lobby(LobbyMsg::Ready));
+    }
+    if let Some(action) = turn.action {
+        out.write(ClientMsg::Vive(action));
+    }
+    if let Some((direction, gait, facing)) = turn.movement {
+        brain.seq += 1;
+        out.write(ClientMsg::Vive(ViveMsg::Move { seq: brain.seq, direction, gait, facing }));
+    }
+}
