@@ -249,8 +249,9 @@ pub struct Tally {
 }
 
 impl Tally {
-    /// Adds one finished heist: its seed, how it ended, and where the bot's time went.
-    fn add(&mut self, seed: u64, heist: &Heist, phase: Phase) {
+    /// Adds one finished heist: its seed, how it ended, and where the bot's time went (`spent`:
+    /// [`ViveBrain::time_spent`]).
+    fn add(&mut self, seed: u64, heist: &Heist, phase: Phase, spent: &TimeSpent) {
         let game = heist.server.game();
         match phase {
             Phase::Won => self.won.push(seed),
@@ -260,7 +261,7 @@ impl Tally {
         if let Some(place) = caught_where(game) {
             *self.caught_where.entry(place).or_default() += 1;
         }
-        let (time_in, carrying_s) = heist.vive.world().resource::<ViveBrain>().time_spent();
+        let (time_in, carrying_s) = spent;
         for (decision, s) in time_in {
             *self.time_in.entry(decision).or_default() += s;
         }
@@ -275,9 +276,11 @@ fn caught_where(game: &crate::game::Game) -> Option<String> {
     Some(format!("{} in the {room}", game.guards[guard].name))
 }
 
-/// Where one heist's bot time went, as "decision 12.3 s, …; carrying 40.0 s".
-fn time_line(heist: &Heist) -> String {
-    let (time_in, carrying_s) = heist.vive.world().resource::<ViveBrain>().time_spent();
+/// The Vive bot's seconds per decision and seconds carrying ([`ViveBrain::time_spent`]).
+type TimeSpent = (Vec<(&'static str, f32)>, f32);
+
+/// Where one heist's bot time went, as "decision 12 s, …; carrying 40 s".
+fn time_line((time_in, carrying_s): &TimeSpent) -> String {
     let parts: Vec<String> = time_in.iter().map(|(d, s)| format!("{d} {s:.0} s")).collect();
     format!("{}; carrying {carrying_s:.0} s", parts.join(", "))
 }
@@ -326,8 +329,9 @@ pub fn sweep(
         let (heist, phase, result) = play_to_the_end(options, style)?;
         let game = heist.server.game();
         let by = caught_where(game).map(|w| format!(" by {w}")).unwrap_or_default();
-        each(seed, &format!("{result}{by} after {:.1} s ({})", game.elapsed_s, time_line(&heist)));
-        tally.add(seed, &heist, phase);
+        let spent = heist.vive.world().resource::<ViveBrain>().time_spent();
+        each(seed, &format!("{result}{by} after {:.1} s ({})", game.elapsed_s, time_line(&spent)));
+        tally.add(seed, &heist, phase, &spent);
     }
     Ok(tally)
 }

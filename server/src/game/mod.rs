@@ -655,20 +655,14 @@ impl Game {
 
     /// The rooms that still hold a copy of a target not yet secured, in an intact case.
     pub fn hot_rooms(&self) -> Vec<usize> {
-        let mut rooms: Vec<usize> = self
-            .items
-            .iter()
-            .filter_map(|it| match (it.place, &it.truth) {
-                (ItemPlace::InCase(c), Some(truth)) if !self.targets[truth.target].secured => {
-                    let case = self.cases.get(usize::from(c.0))?;
-                    (!case.broken).then(|| self.nav.room_at(case.position)).flatten()
-                }
-                _ => None,
-            })
-            .collect();
-        rooms.sort_unstable();
-        rooms.dedup();
-        rooms
+        let cases = self.items.iter().filter_map(|it| match (it.place, &it.truth) {
+            (ItemPlace::InCase(c), Some(truth)) if !self.targets[truth.target].secured => {
+                let case = self.cases.get(usize::from(c.0))?;
+                (!case.broken).then_some(case.position)
+            }
+            _ => None,
+        });
+        heist_shared::level::patrol::hot_rooms(&self.nav, cases)
     }
 
     /// Lays the guards' patrols out for the alarm level and the rooms that hold targets, when either

@@ -29,18 +29,13 @@ impl Map {
     /// same function the server moves its guards with).
     pub fn patrols(&self, session: &SessionView, cases: &[&CaseView], items: &[&ItemView]) -> Vec<Vec<Vec2>> {
         let secured: Vec<_> = session.targets.iter().filter(|t| t.1).map(|t| t.0).collect();
-        let mut hot: Vec<usize> = items
-            .iter()
-            .filter_map(|i| match (&i.kind, i.place) {
-                (ItemKind::Copy { artifact, .. }, ItemPlace::InCase(c)) if !secured.contains(artifact) => {
-                    let case = cases.iter().find(|cv| cv.id == c && !cv.broken)?;
-                    self.nav.room_at(case.position)
-                }
-                _ => None,
-            })
-            .collect();
-        hot.sort_unstable();
-        hot.dedup();
+        let cases = items.iter().filter_map(|i| match (&i.kind, i.place) {
+            (ItemKind::Copy { artifact, .. }, ItemPlace::InCase(c)) if !secured.contains(artifact) => {
+                cases.iter().find(|cv| cv.id == c && !cv.broken).map(|cv| cv.position)
+            }
+            _ => None,
+        });
+        let hot = patrol::hot_rooms(&self.nav, cases);
         (0..self.level.guards.len())
             .map(|g| patrol::alert_route(&self.level, &self.nav, g, session.alarm, &hot))
             .collect()

@@ -39,6 +39,16 @@ pub fn alert_route(level: &Level, nav: &NavGraph, guard: usize, alarm: u8, hot: 
     }
 }
 
+/// The hot rooms: those that hold any of `cases` (the positions of the intact cases that still hold a
+/// copy of a target not yet secured), each once, in room order. The server passes its cases, the Vive
+/// bot the replicated ones, so both lay the alarm's routes out alike.
+pub fn hot_rooms(nav: &NavGraph, cases: impl IntoIterator<Item = Vec2>) -> Vec<usize> {
+    let mut rooms: Vec<usize> = cases.into_iter().filter_map(|at| nav.room_at(at)).collect();
+    rooms.sort_unstable();
+    rooms.dedup();
+    rooms
+}
+
 /// The spots to search around `at`, nearest first: `at` itself, then the centres of the rooms next to
 /// the room it is in; at most `limit`.
 pub fn search_spots(nav: &NavGraph, at: Vec2, limit: usize) -> Vec<Vec2> {
