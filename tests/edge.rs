@@ -23,7 +23,7 @@ const RELIABLE: u8 = 0;
 #[test]
 fn crafted_datagrams_from_every_kind_of_address_leave_a_real_heist_running() {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(12);
-    let mut server = build_server(heist_tests::easy(2)).expect("server starts");
+    let mut server = build_server(heist_tests::easy(19)).expect("server starts");
     // Tokens minted while both roles are free: every attacker holds a real one.
     let mut intruder = UdpAttacker::new(token_for(&server, Role::Vive));
     let mut pending = UdpAttacker::new(token_for(&server, Role::Phantom));

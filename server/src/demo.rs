@@ -314,9 +314,10 @@ impl std::fmt::Display for Tally {
     }
 }
 
-/// Plays one whole heist per seed on the shipped museum and tallies the outcomes; `each` gets every
+/// Plays one whole heist per seed on `level` and tallies the outcomes; `each` gets every
 /// seed's result line as it finishes.
 pub fn sweep(
+    level: &heist_shared::level::Level,
     seeds: impl IntoIterator<Item = u64>,
     style: ViveStyle,
     difficulty: heist_shared::rules::Difficulty,
@@ -325,6 +326,7 @@ pub fn sweep(
     let mut tally = Tally::default();
     for seed in seeds {
         let mut options = ServerOptions::local_test(seed);
+        options.level = level.clone();
         options.game.difficulty = difficulty;
         let (heist, phase, result) = play_to_the_end(options, style)?;
         let game = heist.server.game();

@@ -83,6 +83,9 @@ enum Command {
         /// Difficulties to sweep, comma-separated (easy,normal,hard): a tally for each.
         #[arg(long, value_delimiter = ',', default_value = "normal")]
         difficulty: Vec<Difficulty>,
+        /// Level file (default: the shipped museum): to try a level's own difficulty table.
+        #[arg(long)]
+        level: Option<PathBuf>,
     },
     /// Serve many sessions: any player may create one (and gets its join code for a partner), up to
     /// --max-sessions at once; each session ends on its own when it is over, the server runs on.
@@ -381,12 +384,13 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             heist_server::demo::run_demo(options, vive.into(), rounds)?;
             Ok(())
         }
-        Command::Sweep { from, to, vive, difficulty } => {
+        Command::Sweep { from, to, vive, difficulty, level } => {
             anyhow::ensure!(from <= to, "--from {from} is after --to {to}");
+            let level = load_level(level)?;
             let mut tallies = Vec::new();
             for d in difficulty {
                 let each = |seed: u64, line: &str| println!("{d:>6} seed {seed:>4}: {line}");
-                tallies.push((d, heist_server::demo::sweep(from..=to, vive.into(), d, each)?));
+                tallies.push((d, heist_server::demo::sweep(&level, from..=to, vive.into(), d, each)?));
             }
             for (d, tally) in tallies {
                 println!("{d}: {tally}");

@@ -62,6 +62,30 @@ fn a_sweep_tallies_every_seed() {
     );
     assert!(stdout.contains("\n  bot's time: rush_if_reckless 100%; carrying "), "where the time went: {stdout}");
 
+    // A level file's own difficulty table is what the sweep measures: here its normal heist lasts 6 s.
+    let short = write(
+        "short.ron",
+        &include_str!("../../assets/levels/museum.ron").replace(
+            "    exit: (1.0, 1.0),",
+            "    exit: (1.0, 1.0),\n    difficulties: (normal: Some((time_scale: 0.01))),",
+        ),
+    );
+    let out = Command::new(env!("CARGO_BIN_EXE_heist-server"))
+        .args(["sweep", "--from", "1", "--to", "1", "--level"])
+        .arg(&short)
+        .output()
+        .expect("the server binary runs");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("seed    1: RESULT: Lost(time) after 6.0 s"), "the level's own 6 s: {stdout}");
+    let missing = Command::new(env!("CARGO_BIN_EXE_heist-server"))
+        .args(["sweep", "--level", "/nonexistent/level.ron"])
+        .output()
+        .unwrap();
+    assert!(!missing.status.success());
+    let stderr = String::from_utf8_lossy(&missing.stderr);
+    assert!(stderr.contains("/nonexistent/level.ron") && stderr.lines().count() == 1, "{stderr}");
+
     let bad =
         Command::new(env!("CARGO_BIN_EXE_heist-server")).args(["sweep", "--from", "5", "--to", "2"]).output().unwrap();
     assert!(!bad.status.success());

@@ -583,9 +583,9 @@ impl Game {
         let now = self.elapsed_s;
         // Radio calls that have come through: each answering guard gets his share of the spots.
         for (answering, at, limit) in self.radio.heard(now) {
-            let spots = heist_shared::level::patrol::search_spots(&self.nav, at, limit);
-            for (k, &i) in answering.iter().enumerate() {
-                self.guards[i].orders = Some(heist_shared::level::patrol::share_of(&spots, k, answering.len()));
+            let orders = heist_shared::level::patrol::orders(&self.nav, at, limit, answering.len());
+            for (&i, spots) in answering.iter().zip(orders) {
+                self.guards[i].orders = Some(spots);
             }
         }
         self.lay_out_patrols();

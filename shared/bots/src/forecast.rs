@@ -6,9 +6,9 @@
 //! bot treats it as coming at it and looking every way.
 
 use glam::Vec2;
-use heist_shared::level::WallSet;
-use heist_shared::protocol::{GuardAlert, GuardView};
-use heist_shared::rules::GuardTuning;
+use heist_shared::level::{NavGraph, WallSet};
+use heist_shared::protocol::{GuardAlert, GuardId, GuardView};
+use heist_shared::rules::{GUARD_TURN_RATE, GuardTuning, SEARCH_LOOK_S, about_turn};
 
 /// The bot's caution on top of the guards' published sight range, metres.
 const RANGE_MARGIN: f32 = 1.0;
@@ -16,11 +16,47 @@ const RANGE_MARGIN: f32 = 1.0;
 const ANGLE_MARGIN: f32 = 0.25;
 /// The bot's caution on top of the guards' all-round noticing radius, metres.
 const ALL_ROUND_MARGIN: f32 = 1.0;
+/// A spot is worth stopping at (a harbour) when it stays unseen this long, seconds: long enough for
+/// the guards nearby to walk past and turn round.
+pub const HOLD_S: f32 = 10.0;
+/// An alerted guard (unpredictable) is assumed to come at the bot this long, seconds, then stay.
+const ALERT_APPROACH_S: f32 = 5.0;
+
+/// What any player knows of the guards: their published numbers on the session's difficulty, the
+/// museum's doors (they walk through them), each one's round now (by guard id, its waypoints) and the
+/// alarm level.
+#[derive(Clone, Copy)]
+pub struct Known<'a> {
+    /// The guards' numbers.
+    pub tuning: &'a GuardTuning,
+    /// The room graph.
+    pub nav: &'a NavGraph,
+    /// Each guard's round now.
+    pub routes: &'a [Vec<Vec2>],
+    /// The alarm level.
+    pub alarm: u8,
+}
+
+/// What the bot heard: the noises it made lately (a guard who comes to look comes to one of them) and
+/// the search spots radio calls gave each guard (by guard id).
+#[derive(Clone, Copy, Default)]
+pub struct Heard<'a> {
+    /// Where the bot made a noise lately.
+    pub noises: &'a [Vec2],
+    /// The spots each radioed guard has still to search.
+    pub searches: &'a [(GuardId, Vec<Vec2>)],
+}
 
 /// One guard's future.
 enum Future {
-    /// Walks the route: (route, index of the waypoint it heads to, position now, speed).
-    Patrol(Vec<Vec2>, usize, Vec2, f32),
+    /// Walks `lead` first (back to his round, through the doors, at `lead_speed`), then the route
+    /// (through the doors, as the guard walks it) from waypoint `next` on, at `speed`; faces `facing`
+    /// now (he may still be turning).
+    Patrol { lead: Vec<Vec2>, lead_speed: f32, route: Vec<Vec2>, next: usize, start: Vec2, facing: f32, speed: f32 },
+    /// Walks `path` (through the doors) at `speed` from `start`, looking where he walks, stopping at
+    /// each point its pause to look every way, and at its end for good (an investigating guard going
+    /// to a noise the bot made, a searching one going round the spots the radio gave him).
+    Goes { path: Vec<(Vec2, f32)>, start: Vec2, facing: f32, speed: f32 },
     /// Unpredictable: assumed to walk straight at the bot, looking all round.
     Alert(Vec2, Vec2),
 }
@@ -40,27 +76,124 @@ fn wrap(a: f32) -> f32 {
     (a + std::f32::consts::PI).rem_euclid(std::f32::consts::TAU) - std::f32::consts::PI
 }
 
+/// The waypoint a guard at `p` facing `facing` walks to: the far end (in the facing's direction) of
+/// the route's leg nearest to it.
+fn next_waypoint(route: &[Vec2], p: Vec2, facing: f32) -> usize {
+    let n = route.len();
+    let ahead = Vec2::from_angle(facing);
+    let leg = (0..n)
+        .map(|i| {
+            let (a, b) = (route[i], route[(i + 1) % n]);
+            let ab = b - a;
+            let along = ((p - a).dot(ab) / ab.length_squared().max(1e-6)).clamp(0.0, 1.0);
+            // Legs walked the other way are a last resort (the guard may be mid-turn).
+            let against = if ab.dot(ahead) < 0.0 { 0.5 } else { 0.0 };
+            (p.distance(a + ab * along) + against, i)
+        })
+        .min_by(|x, y| x.0.total_cmp(&y.0))
+        .map_or(0, |(_, i)| i);
+    let (a, b) = (route[leg], route[(leg + 1) % n]);
+    if (b - a).dot(ahead) >= 0.0 && p.distance(b) > 0.3 { (leg + 1) % n } else { leg }
+}
+
+/// Where a guard who began turning from `from` towards `to` `turning_s` seconds ago looks now: guards
+/// turn at [`GUARD_TURN_RATE`], the short way round, about-turns to their left ([`about_turn`]).
+fn turning_facing(from: f32, to: f32, turning_s: f32) -> f32 {
+    let diff = about_turn(wrap(to - from));
+    let swept = GUARD_TURN_RATE * turning_s;
+    if swept >= diff.abs() { to } else { wrap(from + diff.signum() * swept) }
+}
+
+/// A guard farther than this from every leg of his round is off it (coming back to it), metres.
+const OFF_ROUTE_M: f32 = 0.75;
+
+/// The round through `waypoints` as a guard walks it, from each to the next through the doors between
+/// (the room graph's route, as the server's guards take it), and where each waypoint is in it.
+fn walked(nav: &NavGraph, waypoints: &[Vec2]) -> (Vec<Vec2>, Vec<usize>) {
+    let n = waypoints.len();
+    let (mut points, mut at) = (vec![waypoints[0]], vec![0]);
+    for i in 0..n {
+        let (a, b) = (waypoints[i], waypoints[(i + 1) % n]);
+        let mut leg = nav.route(a, b).unwrap_or_else(|| vec![b]);
+        if i + 1 == n {
+            leg.pop(); // back at the first waypoint
+        } else {
+            at.push(points.len() + leg.len() - 1);
+        }
+        points.extend(leg);
+    }
+    (points, at)
+}
+
+/// How far `p` is from the nearest leg of `route`, metres.
+fn off_route(route: &[Vec2], p: Vec2) -> f32 {
+    let n = route.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (route[i], route[(i + 1) % n]);
+            let ab = b - a;
+            let along = ((p - a).dot(ab) / ab.length_squared().max(1e-6)).clamp(0.0, 1.0);
+            p.distance(a + ab * along)
+        })
+        .fold(f32::INFINITY, f32::min)
+}
+
 impl Forecast {
-    /// Builds the forecast from what the client sees now; `me` is the bot's position, `tuning` what the
-    /// guards can do on the session's difficulty, `routes` each guard's patrol (by guard id) now.
-    pub fn new(tuning: &GuardTuning, routes: &[Vec<Vec2>], guards: &[&GuardView], alarm: u8, me: Vec2) -> Self {
+    /// Builds the forecast of `guards` (those in sight and those imagined) from what any player knows
+    /// (`known`) and what the bot heard (`heard`); `me` is the bot's position.
+    pub fn new(known: &Known<'_>, guards: &[&GuardView], me: Vec2, heard: &Heard<'_>) -> Self {
+        let Known { tuning, nav, routes, alarm } = *known;
         let futures = guards
             .iter()
             .map(|g| {
-                let route = routes.get(usize::from(g.id.0)).cloned().unwrap_or_default();
-                if g.alert != GuardAlert::Patrolling || route.len() < 2 {
+                let waypoints = routes.get(usize::from(g.id.0)).map_or(&[][..], |r| &r[..]);
+                if g.alert == GuardAlert::Searching
+                    && let Some((_, spots)) = heard.searches.iter().find(|(id, _)| *id == g.id)
+                {
+                    // Radioed to search these spots: through the doors to each, looking round there.
+                    let mut path = Vec::new();
+                    let mut from = g.position;
+                    for &spot in spots {
+                        path.extend(nav.route(from, spot).unwrap_or_else(|| vec![spot]).into_iter().map(|p| (p, 0.0)));
+                        if let Some(last) = path.last_mut() {
+                            last.1 = SEARCH_LOOK_S;
+                        }
+                        from = spot;
+                    }
+                    let speed = tuning.hasted(tuning.investigate_speed, alarm);
+                    return Future::Goes { path, start: g.position, facing: g.facing, speed };
+                }
+                if g.alert == GuardAlert::Investigating {
+                    // Coming to look at a noise the bot made (the nearest by the doors), if any.
+                    let noise =
+                        heard.noises.iter().copied().filter_map(|n| Some((nav.route(g.position, n)?, n))).min_by(
+                            |a, b| nav.route_length(g.position, a.1).total_cmp(&nav.route_length(g.position, b.1)),
+                        );
+                    if let Some((path, _)) = noise {
+                        let path = path.into_iter().map(|p| (p, 0.0)).collect();
+                        let speed = tuning.hasted(tuning.investigate_speed, alarm);
+                        return Future::Goes { path, start: g.position, facing: g.facing, speed };
+                    }
+                }
+                let calm = matches!(g.alert, GuardAlert::Patrolling | GuardAlert::Returning);
+                if !calm || waypoints.len() < 2 {
                     return Future::Alert(g.position, me);
                 }
-                let facing = Vec2::from_angle(g.facing);
-                let next = (0..route.len())
-                    .filter(|&i| route[i].distance(g.position) > 0.3)
-                    .max_by(|&a, &b| {
-                        let da = (route[a] - g.position).normalize_or_zero().dot(facing);
-                        let db = (route[b] - g.position).normalize_or_zero().dot(facing);
-                        da.total_cmp(&db)
-                    })
+                let (route, at) = walked(nav, waypoints);
+                let speed = tuning.hasted(tuning.patrol_speed, alarm);
+                let lead_speed = tuning.hasted(tuning.investigate_speed, alarm);
+                let (start, facing) = (g.position, g.facing);
+                if g.alert == GuardAlert::Patrolling && off_route(&route, start) < OFF_ROUTE_M {
+                    let next = next_waypoint(&route, start, facing);
+                    return Future::Patrol { lead: Vec::new(), lead_speed, route, next, start, facing, speed };
+                }
+                // Back to the nearest waypoint of his round, then on along it (as the server's guards do).
+                let k = (0..waypoints.len())
+                    .min_by(|&a, &b| start.distance(waypoints[a]).total_cmp(&start.distance(waypoints[b])))
                     .unwrap_or(0);
-                Future::Patrol(route, next, g.position, tuning.hasted(tuning.patrol_speed, alarm))
+                let mut lead = nav.route(start, waypoints[k]).unwrap_or_default();
+                lead.pop();
+                Future::Patrol { lead, lead_speed, route, next: at[k], start, facing, speed }
             })
             .collect();
         Self { futures, alarm, tuning: *tuning }
@@ -69,22 +202,15 @@ impl Forecast {
     /// Where a guard last seen as `last`, `ago_s` seconds ago, is likely now (what a player who lost
     /// sight of it would guess): walked on along its route if it was patrolling; where it was if it was
     /// alerted, for `alert_memory_s`, and after that back on its patrol from there.
-    pub fn imagine(
-        tuning: &GuardTuning,
-        routes: &[Vec<Vec2>],
-        last: &GuardView,
-        alarm: u8,
-        ago_s: f32,
-        alert_memory_s: f32,
-    ) -> GuardView {
+    pub fn imagine(known: &Known<'_>, last: &GuardView, ago_s: f32, alert_memory_s: f32) -> GuardView {
         if last.alert != GuardAlert::Patrolling && ago_s < alert_memory_s {
             return last.clone();
         }
         let calm = GuardView { alert: GuardAlert::Patrolling, ..last.clone() };
         let ago_s = if last.alert == GuardAlert::Patrolling { ago_s } else { ago_s - alert_memory_s };
-        let forecast = Self::new(tuning, routes, &[&calm], alarm, last.position);
+        let forecast = Self::new(known, &[&calm], last.position, &Heard::default());
         match forecast.futures.first() {
-            Some(Future::Patrol(..)) => {
+            Some(Future::Patrol { .. }) => {
                 let (position, facing) = forecast.pose(0, ago_s);
                 GuardView { position, facing: facing.unwrap_or(last.facing), ..calm }
             }
@@ -97,24 +223,71 @@ impl Forecast {
         match &self.futures[i] {
             Future::Alert(p, towards) => {
                 let d = *towards - *p;
-                let walk = (self.tuning.investigate_speed * t).min((d.length() - 1.0).max(0.0));
+                let walk = (self.tuning.investigate_speed * t.min(ALERT_APPROACH_S)).min((d.length() - 1.0).max(0.0));
                 (*p + d.normalize_or_zero() * walk, None)
             }
-            Future::Patrol(route, next, start, speed) => {
-                let mut at = *start;
-                let mut target = *next;
-                let mut left = t * speed;
-                loop {
-                    let to = route[target] - at;
+            Future::Goes { path, start, facing, speed } => {
+                let (mut at, mut left) = (*start, t);
+                for (i, &(wp, pause)) in path.iter().enumerate() {
+                    let d = at.distance(wp);
+                    if d >= left * speed {
+                        let dir = (wp - at).normalize_or_zero();
+                        // Turning from where he looked towards the way first (the first leg).
+                        let look = |h: f32| if i == 0 { turning_facing(*facing, h, t) } else { h };
+                        return (at + dir * left * speed, (dir != Vec2::ZERO).then(|| look(angle_of(dir))));
+                    }
+                    left -= d / speed.max(1e-3) + pause;
+                    at = wp;
+                    if left <= 0.0 {
+                        return (at, None); // looking round there
+                    }
+                }
+                (at, None)
+            }
+            Future::Patrol { lead, lead_speed, route, next, start, facing, speed } => {
+                let n = route.len();
+                let target_at = |k: usize| if k < lead.len() { lead[k] } else { route[(next + k - lead.len()) % n] };
+                let lead_length: f32 = std::iter::once(*start)
+                    .chain(lead.iter().copied())
+                    .zip(lead.iter().copied().chain(std::iter::once(route[*next])))
+                    .map(|(a, b)| a.distance(b))
+                    .sum();
+                // Distance walked in `t`: the way back at `lead_speed`, then the round at `speed`.
+                let lead_s = lead_length / lead_speed.max(1e-3);
+                let mut left = if lead.is_empty() || t <= lead_s {
+                    t * if lead.is_empty() { *speed } else { *lead_speed }
+                } else {
+                    lead_length + (t - lead_s) * speed
+                };
+                let (mut at, mut k) = (*start, 0);
+                // The facing the guard turns from, and the distance walked when that turn began.
+                let (mut turned_from, mut turn_at) = (*facing, 0.0);
+                let mut heading: Option<f32> = None;
+                let mut walked = 0.0;
+                for _ in 0..=4 * (n + lead.len()) {
+                    let to = target_at(k) - at;
                     let d = to.length();
-                    if d >= left || d < 1e-4 && left <= 0.0 {
-                        let dir = to.normalize_or_zero();
-                        return (at + dir * left.min(d), Some(angle_of(if dir == Vec2::ZERO { Vec2::X } else { dir })));
+                    if d > 1e-4 {
+                        let new = angle_of(to);
+                        if let Some(old) = heading
+                            && wrap(new - old).abs() > 1e-3
+                        {
+                            (turned_from, turn_at) = (old, walked);
+                        }
+                        heading = Some(new);
+                    }
+                    if d >= left {
+                        at += to.normalize_or_zero() * left;
+                        walked += left;
+                        break;
                     }
                     left -= d;
-                    at = route[target];
-                    target = (target + 1) % route.len();
+                    walked += d;
+                    at = target_at(k);
+                    k += 1;
                 }
+                let turning_s = (walked - turn_at) / speed.max(1e-3);
+                (at, heading.map(|h| turning_facing(turned_from, h, turning_s)))
             }
         }
     }
@@ -140,10 +313,49 @@ impl Forecast {
 
     /// True when `p` stays unseen (crouching) for the next `horizon` seconds.
     pub fn hidden_for(&self, p: Vec2, horizon: f32, walls: &WallSet) -> bool {
-        (0..=(horizon * 4.0) as usize).all(|k| !self.seen(p, k as f32 * 0.25, true, walls))
+        self.holdable_for(p, 0.0, horizon, walls)
     }
 
-    /// True when walking the polyline from `from` through `path` at `speed` stays unseen for `horizon` s.
+    /// True when a crouching Vive at `p` from `t` seconds on stays unseen for `hold` seconds more.
+    fn holdable_for(&self, p: Vec2, t: f32, hold: f32, walls: &WallSet) -> bool {
+        (0..=(hold * 4.0) as usize).all(|k| !self.seen(p, t + k as f32 * 0.25, true, walls))
+    }
+
+    /// Walks the polyline from `from` through `path` at `speed` (crouching or not; a quarter second a
+    /// step), `until` seconds at most, asking `stop` at each step (where, when).
+    fn walk(
+        &self,
+        from: Vec2,
+        path: &[Vec2],
+        (speed, crouching): (f32, bool),
+        until: f32,
+        walls: &WallSet,
+        mut stop: impl FnMut(Vec2, f32) -> bool,
+    ) -> Walk {
+        let (mut at, mut t, step) = (from, 0.0, 0.25);
+        for &wp in path {
+            while at.distance(wp) > 1e-3 {
+                if self.seen(at, t, crouching, walls) {
+                    return Walk::Seen;
+                }
+                if stop(at, t) {
+                    return Walk::Stopped;
+                }
+                if t >= until {
+                    return Walk::OutOfTime;
+                }
+                let d = (wp - at).length().min(speed * step);
+                at += (wp - at).normalize_or_zero() * d;
+                t += step;
+            }
+        }
+        Walk::Arrived(at, t)
+    }
+
+    /// True when walking the polyline from `from` through `path` at `speed` stays unseen until it
+    /// reaches, within `horizon` seconds, a harbour: a spot that then stays unseen for [`HOLD_S`]
+    /// (checked every second of the walk, and at the end of the path). A way that is clear for the
+    /// next seconds but ends where a guard is about to look is no way.
     pub fn path_hidden(
         &self,
         from: Vec2,
@@ -153,60 +365,196 @@ impl Forecast {
         crouching: bool,
         walls: &WallSet,
     ) -> bool {
-        let mut at = from;
-        let mut t = 0.0;
-        let step = 0.25;
-        for &wp in path {
-            while at.distance(wp) > 1e-3 {
-                if self.seen(at, t, crouching, walls) {
-                    return false;
-                }
-                if t >= horizon {
-                    return true;
-                }
-                let d = (wp - at).length().min(speed * step);
-                at += (wp - at).normalize_or_zero() * d;
-                t += step;
+        let mut next_check = 1.0;
+        let harbour = |at: Vec2, t: f32| {
+            if t + 1e-3 < next_check {
+                return false;
             }
+            next_check += 1.0;
+            self.holdable_for(at, t, HOLD_S, walls)
+        };
+        match self.walk(from, path, (speed, crouching), horizon, walls, harbour) {
+            Walk::Stopped => true,
+            Walk::Arrived(at, t) => self.holdable_for(at, t, HOLD_S, walls),
+            Walk::Seen | Walk::OutOfTime => false,
         }
-        // Arrived: the goal itself must stay hidden for what is left of the horizon.
-        (0..=((horizon - t).max(0.0) * 4.0) as usize).all(|k| !self.seen(at, t + k as f32 * 0.25, crouching, walls))
     }
+
+    /// True when the whole walk from `from` through `path` at `speed` stays unseen and its end then
+    /// stays unseen for [`HOLD_S`] (a hiding place worth going to).
+    pub fn hiding_place(&self, from: Vec2, path: &[Vec2], speed: f32, crouching: bool, walls: &WallSet) -> bool {
+        match self.walk(from, path, (speed, crouching), 60.0, walls, |_, _| false) {
+            Walk::Arrived(at, t) => self.holdable_for(at, t, HOLD_S, walls),
+            _ => false,
+        }
+    }
+}
+
+/// How a forecast walk ended.
+enum Walk {
+    /// A guard would see the walker.
+    Seen,
+    /// The caller's stop condition held.
+    Stopped,
+    /// Time ran out on the way.
+    OutOfTime,
+    /// At the end of the path (where, when).
+    Arrived(Vec2, f32),
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use heist_shared::level::Level;
-    use heist_shared::protocol::GuardId;
+    use std::f32::consts::{FRAC_PI_2, PI};
 
-    fn routes(level: &Level) -> Vec<Vec<Vec2>> {
-        level.guards.iter().map(|g| g.route.clone()).collect()
+    const BRUNO: usize = 0;
+    const CLARA: usize = 1;
+
+    struct Museum {
+        level: Level,
+        nav: NavGraph,
+        walls: WallSet,
+        routes: Vec<Vec<Vec2>>,
+        tuning: GuardTuning,
     }
 
-    fn guard(at: Vec2, facing: f32) -> GuardView {
-        GuardView { id: GuardId(0), name: "Bruno".into(), position: at, facing, alert: GuardAlert::Patrolling }
+    impl Museum {
+        fn new() -> Self {
+            let level = Level::museum();
+            let routes = level.guards.iter().map(|g| g.route.clone()).collect();
+            Self {
+                nav: NavGraph::new(&level),
+                walls: WallSet::new(&level),
+                routes,
+                level,
+                tuning: GuardTuning::default(),
+            }
+        }
+
+        fn known(&self) -> Known<'_> {
+            Known { tuning: &self.tuning, nav: &self.nav, routes: &self.routes, alarm: 0 }
+        }
+
+        fn forecast(&self, g: &GuardView, heard: &Heard<'_>) -> Forecast {
+            Forecast::new(&self.known(), &[g], Vec2::ZERO, heard)
+        }
+    }
+
+    fn guard(id: usize, at: Vec2, facing: f32, alert: GuardAlert) -> GuardView {
+        GuardView { id: GuardId(id as u16), name: format!("G{id}"), position: at, facing, alert }
     }
 
     #[test]
     fn a_patrolling_guard_is_replayed_along_its_route() {
-        let level = Level::museum();
-        let route = level.guards[0].route.clone();
-        let g = guard(route[0], 0.0);
-        let f = Forecast::new(&GuardTuning::default(), &routes(&level), &[&g], 0, Vec2::ZERO);
+        let m = Museum::new();
+        let route = &m.routes[BRUNO];
+        let f = m.forecast(&guard(BRUNO, route[0], 0.0, GuardAlert::Patrolling), &Heard::default());
         let (p, facing) = f.pose(0, 2.0);
         assert!((p - (route[0] + (route[1] - route[0]).normalize() * 2.2)).length() < 1e-3, "{p:?}");
-        assert!(facing.is_some());
+        assert_eq!(facing, Some(0.0));
     }
 
     #[test]
     fn a_spot_behind_a_walking_guard_is_hidden_but_one_ahead_is_not() {
-        let level = Level::museum();
-        let walls = WallSet::new(&level);
-        let route = level.guards[0].route.clone();
-        let g = guard(route[0] + Vec2::new(4.0, 0.0), 0.0); // walking +x along the gallery
-        let f = Forecast::new(&GuardTuning::default(), &routes(&level), &[&g], 0, Vec2::ZERO);
-        assert!(f.seen(g.position + Vec2::new(4.0, 0.0), 0.0, false, &walls));
-        assert!(!f.seen(g.position - Vec2::new(4.0, 0.0), 0.0, false, &walls));
+        let m = Museum::new();
+        let g = guard(BRUNO, m.routes[BRUNO][0] + Vec2::new(4.0, 0.0), 0.0, GuardAlert::Patrolling);
+        let f = m.forecast(&g, &Heard::default());
+        assert!(f.seen(g.position + Vec2::new(4.0, 0.0), 0.0, false, &m.walls));
+        assert!(!f.seen(g.position - Vec2::new(4.0, 0.0), 0.0, false, &m.walls));
+    }
+
+    #[test]
+    fn a_guard_at_the_end_of_his_round_sweeps_his_look_round_to_his_left_as_the_server_turns_him() {
+        let m = Museum::new();
+        let end = m.routes[BRUNO][1]; // (35, 5), walking +x towards it
+        let f = m.forecast(&guard(BRUNO, end - Vec2::new(1.1, 0.0), 0.0, GuardAlert::Patrolling), &Heard::default());
+        // One second to the end; a quarter turn (π/2 at 4 rad/s: 0.39 s) later he looks +z, his left.
+        let (_, facing) = f.pose(0, 1.0 + FRAC_PI_2 / GUARD_TURN_RATE);
+        assert!(wrap(facing.expect("walking") - FRAC_PI_2).abs() < 0.05, "{facing:?}");
+        let (_, facing) = f.pose(0, 1.0 + PI / GUARD_TURN_RATE + 0.1);
+        assert!(wrap(facing.expect("walking") - PI).abs() < 1e-3, "turned about: {facing:?}");
+        // So a spot on his left just past the end is seen mid-turn, one on his right is not.
+        let (left, right) = (end + Vec2::new(0.0, 3.0), end - Vec2::new(0.0, 3.0));
+        let mid_turn = 1.0 + FRAC_PI_2 / GUARD_TURN_RATE;
+        assert!(f.seen(left, mid_turn, false, &m.walls) && !f.seen(right, mid_turn, false, &m.walls));
+        assert_eq!(about_turn(-PI + 0.01), PI + 0.01, "the rule the server turns by");
+    }
+
+    #[test]
+    fn a_round_through_another_room_is_walked_through_the_doors_between() {
+        let m = Museum::new();
+        let treasury = m.nav.room_centre(m.level.room_index("treasury").expect("room")).expect("centre");
+        let waypoints = vec![Vec2::new(17.0, 13.5), treasury]; // sculpture hall, then the treasury
+        let (route, at) = walked(&m.nav, &waypoints);
+        assert_eq!(route[at[1]], treasury);
+        let door = Vec2::new(24.0, 16.0);
+        assert!(route.iter().any(|p| p.distance(door) < 1.0), "through the door: {route:?}");
+        assert!(route.iter().all(|p| m.nav.room_at(*p).is_some()), "never through a wall: {route:?}");
+    }
+
+    #[test]
+    fn a_returning_guard_walks_back_to_his_nearest_waypoint_through_the_doors() {
+        let m = Museum::new();
+        // Clara, back from a search in the west gallery, returns to her round in the sculpture hall
+        // through the closed door at (17, 10), not through the wall.
+        let g = guard(CLARA, Vec2::new(13.4, 1.9), 0.0, GuardAlert::Returning);
+        let f = m.forecast(&g, &Heard::default());
+        let speed = m.tuning.investigate_speed;
+        let door = Vec2::new(17.0, 10.0);
+        let to_door = m.nav.route_length(g.position, door) / speed;
+        let (p, _) = f.pose(0, to_door);
+        assert!(p.distance(door) < 1.0, "at the door after {to_door} s: {p:?}");
+        let (later, _) = f.pose(0, to_door + 10.0);
+        assert!(m.nav.room_at(later) == m.level.room_index("sculpture_hall"), "back on the round: {later:?}");
+    }
+
+    #[test]
+    fn an_investigating_guard_comes_to_the_noise_the_bot_made_and_looks_round_there() {
+        let m = Museum::new();
+        let glass = Vec2::new(21.0, 1.2);
+        let g = guard(BRUNO, Vec2::new(30.0, 5.0), 0.0, GuardAlert::Investigating);
+        let f = m.forecast(&g, &Heard { noises: &[glass], searches: &[] });
+        let (p, facing) = f.pose(0, 2.0);
+        assert!(p.x < 30.0 - 2.0, "walks towards the glass: {p:?}");
+        assert!(facing.is_some(), "looking where he goes");
+        let (there, look) = f.pose(0, 30.0);
+        assert!(there.distance(glass) < 1e-3 && look.is_none(), "looks round at the glass: {there:?}");
+        let unknown = m.forecast(&g, &Heard::default());
+        assert!(unknown.pose(0, 2.0).1.is_none(), "without a noise he is unpredictable: looks every way");
+    }
+
+    #[test]
+    fn a_searching_guard_goes_round_the_spots_the_radio_gave_him_looking_round_at_each() {
+        let m = Museum::new();
+        let (a, b) = (Vec2::new(20.0, 5.0), Vec2::new(31.0, 5.0));
+        let g = guard(BRUNO, Vec2::new(15.0, 5.0), 0.0, GuardAlert::Searching);
+        let searches = [(GuardId(BRUNO as u16), vec![a, b])];
+        let f = m.forecast(&g, &Heard { noises: &[], searches: &searches });
+        let speed = m.tuning.investigate_speed;
+        let at_a = 5.0 / speed;
+        assert!(f.pose(0, at_a + 0.5 * SEARCH_LOOK_S).0.distance(a) < 1e-3, "looks round at the first spot");
+        assert!(f.pose(0, at_a + 0.5 * SEARCH_LOOK_S).1.is_none());
+        let (p, facing) = f.pose(0, at_a + SEARCH_LOOK_S + 1.0);
+        assert!((p.x - (20.0 + speed)).abs() < 1e-3 && facing == Some(0.0), "then on to the next: {p:?}");
+    }
+
+    #[test]
+    fn a_way_clear_now_that_ends_where_a_guard_is_about_to_look_is_no_way() {
+        let m = Museum::new();
+        // Clara walks up and down x = 17 between z 13.5 and 19. Creeping to a spot just past the north
+        // end of her line is clear while she walks away south, but the spot is no harbour: she comes
+        // back within seconds.
+        let g = guard(CLARA, Vec2::new(17.0, 14.0), -FRAC_PI_2, GuardAlert::Patrolling); // walking back south
+        let f = m.forecast(&g, &Heard::default());
+        let on_her_line = [Vec2::new(17.0, 20.2)];
+        let from = Vec2::new(14.5, 20.2);
+        assert!(f.hidden_for(from, 2.0, &m.walls), "here is fine for now");
+        assert!(!f.path_hidden(from, &on_her_line, rules_crouch(), 6.0, true, &m.walls));
+        assert!(!f.hiding_place(from, &on_her_line, rules_crouch(), true, &m.walls));
+    }
+
+    fn rules_crouch() -> f32 {
+        heist_shared::rules::CROUCH_SPEED
     }
 }

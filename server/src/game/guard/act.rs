@@ -5,12 +5,11 @@
 use glam::Vec2;
 use heist_shared::level::{NavGraph, WallSet, patrol};
 use heist_shared::protocol::{GuardAlert, RadioAbout};
+use heist_shared::rules::GUARD_TURN_RATE as TURN_RATE;
 use heist_shared::rules::GuardTuning;
 
 use super::{Decision, Guard, GuardState, Perception, SEARCH_LOOK_S, angle_of, decide, wrap};
 
-/// Turning speed, rad/s.
-const TURN_RATE: f32 = 4.0;
 /// A guard radios about Vive at most this often, seconds (a report of evidence always goes out).
 pub const RADIO_COOLDOWN_S: f32 = 10.0;
 
@@ -159,8 +158,11 @@ fn search(g: &mut Guard, spots: Vec<Vec2>, t: &GuardTuning, haste: f32, walls: &
     }
 }
 
+/// Turns towards `yaw` at [`TURN_RATE`], the short way round; an about-turn (either way about as short)
+/// always to the guard's left (anticlockwise seen from above), so a player can tell which way a guard
+/// at the end of his round will sweep his look (`heist_shared::rules::about_turn`).
 fn turn_towards(g: &mut Guard, yaw: f32, dt: f32) {
-    let diff = wrap(yaw - g.facing);
+    let diff = heist_shared::rules::about_turn(wrap(yaw - g.facing));
     g.facing = wrap(g.facing + diff.clamp(-TURN_RATE * dt, TURN_RATE * dt));
 }
 

@@ -18,16 +18,11 @@ use heist_shared::rules::{self, GuardTuning};
 
 /// How long a guard looks around at a spot before moving on, seconds.
 const LOOK_AROUND_S: f32 = 3.0;
-/// How long a searching guard looks around at each spot, seconds.
-const SEARCH_LOOK_S: f32 = 2.0;
 /// How long a guard keeps staring at a vanished glimpse before checking the spot, seconds.
 const STARE_S: f32 = 1.5;
 /// Longest a guard stares at all before walking over to check, seconds.
 const MAX_STARE_S: f32 = 4.0;
-/// Spots a search covers at most (the spot itself and the rooms next to it).
-pub const SEARCH_SPOTS: usize = 4;
-/// Spots a search for whoever broke a case covers (the case and the room next to it nearest to it).
-pub const EVIDENCE_SPOTS: usize = 2;
+pub use heist_shared::rules::{EVIDENCE_SPOTS, SEARCH_LOOK_S, SEARCH_SPOTS};
 
 /// What a guard is doing and why.
 #[derive(Clone, Debug, PartialEq)]
@@ -441,6 +436,26 @@ mod tests {
         assert_eq!(decide(&g, &Perception::default()), Decision::Search(spots.clone()));
         g.state = GuardState::Search { spots, next: 2, looked: 0.0 };
         assert_eq!(decide(&g, &Perception::default()), Decision::Return);
+    }
+
+    #[test]
+    fn at_the_end_of_his_round_a_guard_about_turns_to_his_left() {
+        // Bruno walks +x to the east end of the galleries' round, then back: his look sweeps through
+        // +z (his left), as the published rule says (`rules::about_turn`), never through −z.
+        let level = heist_shared::level::Level::museum();
+        let (walls, nav) = (heist_shared::level::WallSet::new(&level), heist_shared::level::NavGraph::new(&level));
+        let mut g = Guard::new(GuardId(0), "Bruno".into(), level.guards[0].route.clone());
+        g.position = g.route[1] - Vec2::new(0.5, 0.0);
+        (g.facing, g.next) = (0.0, 1);
+        let (t, dt) = (GuardTuning::default(), 1.0 / 60.0);
+        let mut swept = Vec::new();
+        for _ in 0..90 {
+            act::think_and_act(&mut g, &Perception::default(), &walls, &nav, 0, &t, dt);
+            swept.push(g.facing);
+        }
+        assert!(swept.iter().any(|f| (f - std::f32::consts::FRAC_PI_2).abs() < 0.1), "through +z: {swept:?}");
+        assert!(swept.iter().all(|f| *f > -0.1), "never through −z: {swept:?}");
+        assert!((wrap(g.facing - std::f32::consts::PI)).abs() < 1e-3, "turned about: {}", g.facing);
     }
 
     #[test]

@@ -10,7 +10,7 @@ use super::decide::{LURE_AFTER_S, Perception, Plan};
 use super::goal::Goal;
 use super::map::Map;
 use super::memory::Memory;
-use crate::forecast::Forecast;
+use crate::forecast::{Forecast, HOLD_S};
 
 /// How far ahead the bot checks that its way stays out of sight, seconds.
 const LOOK_AHEAD_S: f32 = 6.0;
@@ -22,6 +22,8 @@ const TOO_CLOSE_M: f32 = 1.0;
 const BREAK_HEADSTART_S: f32 = 7.0;
 /// After the last sight of a guard chasing, the bot keeps fleeing this long, seconds.
 const FLEE_ON_S: f32 = 5.0;
+/// Seconds the usual way must have been watched before the bot looks for a way round another room.
+const DETOUR_AFTER_S: f32 = 3.0;
 /// How long an item given up on stays given up, seconds.
 const AVOID_FOR_S: f32 = 60.0;
 
@@ -87,9 +89,27 @@ pub(crate) fn perceive(
         memory.quiet_since = None;
     }
     if !at_goal {
-        p.way = fastest_hidden_gait(map, memory, view, forecast);
+        p.way = fastest_hidden_gait(map, &memory.route, view, forecast);
+        if p.way.is_none() && p.waited_s > DETOUR_AFTER_S {
+            // The usual way has been watched a while: is there another, round through some other room,
+            // that is not? (Taken for good: the route stays until the goal changes.)
+            for via in map.nav.room_centres() {
+                if map.nav.room_at(via) == map.nav.room_at(me) || map.nav.room_at(via) == map.nav.room_at(target) {
+                    continue;
+                }
+                let (Some(mut there), Some(on)) = (map.nav.route(me, via), map.nav.route(via, target)) else {
+                    continue;
+                };
+                there.extend(on);
+                there.reverse();
+                if let Some(gait) = fastest_hidden_gait(map, &there, view, forecast) {
+                    (memory.route, p.way) = (there, Some(gait));
+                    break;
+                }
+            }
+        }
     }
-    p.hidden_here = forecast.hidden_for(me, LOOK_AHEAD_S * 0.5, &map.walls);
+    p.hidden_here = forecast.hidden_for(me, HOLD_S, &map.walls);
     let lure_due = memory.lured_at.is_none_or(|t| memory.clock_s - t > LURE_AFTER_S);
     if lure_due {
         let nearest = view.guards.iter().min_by(|a, b| a.position.distance(me).total_cmp(&b.position.distance(me)));
@@ -123,10 +143,11 @@ fn plan_route(map: &Map, memory: &mut Memory, view: &View<'_>, target: Vec2, rec
     }
 }
 
-/// Run when out of every guard's earshot and the way stays unseen at a run; else walk; else crouch.
-fn fastest_hidden_gait(map: &Map, memory: &Memory, view: &View<'_>, forecast: &Forecast) -> Option<Gait> {
+/// Along `route` (last waypoint first): run when out of every guard's earshot and the way stays unseen
+/// at a run; else walk; else crouch.
+fn fastest_hidden_gait(map: &Map, route: &[Vec2], view: &View<'_>, forecast: &Forecast) -> Option<Gait> {
     let me = view.me.position;
-    let path: Vec<Vec2> = memory.route.iter().rev().copied().collect();
+    let path: Vec<Vec2> = route.iter().rev().copied().collect();
     let hearing = view.tuning.hearing_at(view.alarm);
     let quiet =
         view.guards.iter().all(|g| map.nav.heard_margin(me, g.position, rules::RUN_LOUDNESS * hearing * 1.5) < 0.0);
@@ -162,10 +183,18 @@ pub(crate) fn carry_out(
             let waypoint = memory.route.last().copied().unwrap_or(me);
             ((waypoint - me).normalize_or_zero(), gait, None)
         }
-        Plan::Act(action) => (Vec2::ZERO, Gait::Walk, Some(action)),
+        Plan::Act(action) => {
+            if let ViveMsg::Break(c) = action
+                && let Some(case) = view.cases.iter().find(|cv| cv.id == c)
+            {
+                memory.noises.push((case.position, memory.clock_s));
+            }
+            (Vec2::ZERO, Gait::Walk, Some(action))
+        }
         Plan::Wait => (Vec2::ZERO, Gait::Crouch, None),
         Plan::Throw(item, target) => {
             memory.lured_at = Some(memory.clock_s);
+            memory.noises.push((target, memory.clock_s));
             (Vec2::ZERO, Gait::Crouch, Some(ViveMsg::Throw { item, target }))
         }
         Plan::GiveUp => {
@@ -210,8 +239,7 @@ fn hide(map: &Map, memory: &mut Memory, view: &View<'_>, forecast: &Forecast) ->
         .filter_map(|c| {
             let route = map.nav.route(me, c)?;
             let length = map.nav.route_length(me, c);
-            let horizon = length / speed + 3.0;
-            forecast.path_hidden(me, &route, speed, horizon, near, &map.walls).then_some((length, route))
+            forecast.hiding_place(me, &route, speed, near, &map.walls).then_some((length, route))
         })
         .min_by(|a, b| a.0.total_cmp(&b.0));
     if let Some((_, route)) = best

@@ -141,7 +141,8 @@ fn lure_if_blocked(p: &Perception) -> Option<Plan> {
     (p.hidden_here && p.waited_s > LURE_AFTER_S).then_some(Plan::Throw(item, at))
 }
 
-/// The way has been watched too long: give this item up for a while.
+/// No metre closer to the item for too long (the way watched, or every way round it too): give it up
+/// for a while.
 fn give_up_if_stuck(p: &Perception) -> Option<Plan> {
     (p.fetching && p.waited_s > GIVE_UP_AFTER_S).then_some(Plan::GiveUp)
 }
@@ -169,9 +170,9 @@ pub(crate) const DECISIONS: &[Decision] = &[
     ("lure_if_break_heard", lure_if_break_heard),
     ("give_up_if_break_heard_too_long", give_up_if_break_heard_too_long),
     ("wait_if_at_goal", wait_if_at_goal),
+    ("give_up_if_stuck", give_up_if_stuck),
     ("go_if_way_hidden", go_if_way_hidden),
     ("lure_if_blocked", lure_if_blocked),
-    ("give_up_if_stuck", give_up_if_stuck),
     ("wait_if_hidden", wait_if_hidden),
     ("hide_otherwise", hide_otherwise),
 ];
@@ -265,11 +266,21 @@ mod tests {
         let p = Perception {
             way: Some(Gait::Crouch),
             hidden_here: true,
-            waited_s: 30.0,
+            waited_s: GIVE_UP_AFTER_S - 1.0,
             fetching: true,
             ..Default::default()
         };
         assert_eq!(named(&p), ("go_if_way_hidden", Plan::Go(Gait::Crouch)));
+    }
+
+    #[test]
+    fn no_closer_for_too_long_the_item_is_given_up_even_when_some_way_round_is_open() {
+        // Going round and round (ways that open and close) is no progress either.
+        let p =
+            Perception { way: Some(Gait::Walk), waited_s: GIVE_UP_AFTER_S + 0.1, fetching: true, ..Default::default() };
+        assert_eq!(named(&p), ("give_up_if_stuck", Plan::GiveUp));
+        let delivering = Perception { fetching: false, ..p };
+        assert_eq!(named(&delivering), ("go_if_way_hidden", Plan::Go(Gait::Walk)), "a copy in hand is never given up");
     }
 
     #[test]

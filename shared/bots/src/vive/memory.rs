@@ -5,14 +5,18 @@
 use std::collections::VecDeque;
 
 use glam::Vec2;
+use heist_shared::level::{NavGraph, patrol};
+use heist_shared::protocol::{GuardAlert, GuardId, RadioAbout};
 use heist_shared::protocol::{GuardView, ItemId};
-use heist_shared::rules::GuardTuning;
+use heist_shared::rules;
 
-use crate::forecast::Forecast;
+use crate::forecast::{Forecast, Known};
 
 /// Seconds an alerted guard out of sight is imagined where it was last seen; after that it is
 /// imagined back on its patrol.
 const ALERT_MEMORY_S: f32 = 8.0;
+/// A searching guard seen this close to one of his spots has searched it, metres.
+const SPOT_VISITED_M: f32 = 1.0;
 /// Positions kept of where the bot has been (one a frame): hiding places it knows are reachable.
 const TRAIL_LEN: usize = 900;
 
@@ -43,13 +47,41 @@ pub(crate) struct Memory {
     pub avoid: Vec<(ItemId, f32)>,
     /// Where the bot has been, oldest first.
     pub trail: VecDeque<Vec2>,
+    /// Noises the bot made (glass it broke, props it threw: where, and when), the last few seconds:
+    /// a guard who comes to look is coming to one of them.
+    pub noises: Vec<(Vec2, f32)>,
+    /// The spots each guard was radioed to search (by guard id), those he has not yet been seen at:
+    /// worked out from the call as the server does (`heist_shared::level::patrol::orders`).
+    pub searches: Vec<(GuardId, Vec<Vec2>)>,
     /// Each guard as last seen and when (the server sends only guards Vive can perceive).
     pub remembered: Vec<(GuardView, f32)>,
 }
 
 impl Memory {
-    /// Remembers the guards in sight now.
+    /// Hears a radio call: the guards answering it will search their share of the spots around `at`.
+    pub fn heard_radio(&mut self, nav: &NavGraph, about: RadioAbout, at: Vec2, answering: &[GuardId]) {
+        let limit = match about {
+            RadioAbout::Sighting => rules::SEARCH_SPOTS,
+            RadioAbout::Evidence => rules::EVIDENCE_SPOTS,
+        };
+        for (&id, spots) in answering.iter().zip(patrol::orders(nav, at, limit, answering.len())) {
+            self.searches.retain(|(g, _)| *g != id);
+            self.searches.push((id, spots));
+        }
+    }
+
+    /// Remembers the guards in sight now (and crosses off the search spots they are seen at, and the
+    /// searches of those back on their rounds).
     pub fn see(&mut self, guards: &[&GuardView]) {
+        for g in guards {
+            if let Some((_, spots)) = self.searches.iter_mut().find(|(id, _)| *id == g.id) {
+                spots.retain(|s| s.distance(g.position) > SPOT_VISITED_M);
+            }
+            if matches!(g.alert, GuardAlert::Patrolling | GuardAlert::Returning) {
+                self.searches.retain(|(id, _)| *id != g.id);
+            }
+        }
+        self.searches.retain(|(_, spots)| !spots.is_empty());
         for g in guards {
             self.remembered.retain(|(r, _)| r.id != g.id);
             self.remembered.push(((*g).clone(), self.clock_s));
@@ -57,17 +89,11 @@ impl Memory {
     }
 
     /// The guards out of sight, imagined where they have likely walked since they were last seen.
-    pub fn imagined(
-        &self,
-        in_sight: &[&GuardView],
-        tuning: &GuardTuning,
-        routes: &[Vec<Vec2>],
-        alarm: u8,
-    ) -> Vec<GuardView> {
+    pub fn imagined(&self, in_sight: &[&GuardView], known: &Known<'_>) -> Vec<GuardView> {
         self.remembered
             .iter()
             .filter(|(r, _)| !in_sight.iter().any(|g| g.id == r.id))
-            .map(|(r, at)| Forecast::imagine(tuning, routes, r, alarm, self.clock_s - at, ALERT_MEMORY_S))
+            .map(|(r, at)| Forecast::imagine(known, r, self.clock_s - at, ALERT_MEMORY_S))
             .collect()
     }
 
@@ -106,6 +132,31 @@ impl Memory {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_radio_call_gives_each_answering_guard_the_spots_the_server_gives_him_crossed_off_as_seen() {
+        let level = heist_shared::level::Level::museum();
+        let nav = NavGraph::new(&level);
+        let at = Vec2::new(20.0, 5.0);
+        let mut m = Memory::default();
+        m.heard_radio(&nav, RadioAbout::Sighting, at, &[GuardId(1), GuardId(2)]);
+        let orders = patrol::orders(&nav, at, rules::SEARCH_SPOTS, 2);
+        assert_eq!(m.searches, vec![(GuardId(1), orders[0].clone()), (GuardId(2), orders[1].clone())]);
+        let first = orders[0][0];
+        let seen = |id: u16, position: Vec2, alert: GuardAlert| GuardView {
+            id: GuardId(id),
+            name: String::new(),
+            position,
+            facing: 0.0,
+            alert,
+        };
+        m.see(&[&seen(1, first, GuardAlert::Searching)]);
+        assert_eq!(m.searches[0].1, orders[0][1..].to_vec(), "the spot he was seen at is searched");
+        m.see(&[&seen(2, Vec2::ZERO, GuardAlert::Returning)]);
+        assert!(m.searches.iter().all(|(id, _)| *id != GuardId(2)), "back to his round: his search is over");
+        m.heard_radio(&nav, RadioAbout::Evidence, at, &[GuardId(1)]);
+        assert_eq!(m.searches, vec![(GuardId(1), patrol::orders(&nav, at, rules::EVIDENCE_SPOTS, 1)[0].clone())]);
+    }
 
     #[test]
     fn stepping_forth_and_back_is_no_progress_but_a_metre_closer_is() {

@@ -12,11 +12,14 @@ use bevy::prelude::*;
 use glam::Vec2;
 use heist_client::Inbox;
 use heist_shared::protocol::{
-    CaseView, ClientMsg, Gait, GuardView, ItemView, LobbyMsg, Phase, SessionView, ViveAvatar, ViveMsg,
+    CaseView, ClientMsg, Gait, GameEvent, GuardView, ItemView, LobbyMsg, Phase, SessionView, ViveAvatar, ViveMsg,
 };
 use heist_shared::rules;
 
-use crate::forecast::Forecast;
+use crate::forecast::{Forecast, Heard, Known};
+
+/// Seconds the bot remembers a noise it made (a guard investigating within them came to look at it).
+const NOISE_MEMORY_S: f32 = 15.0;
 
 /// How the Vive bot plays.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -45,6 +48,8 @@ pub struct ViveBrain {
     seq: u32,
     map: Option<map::Map>,
     memory: memory::Memory,
+    /// Game events read so far (of [`Sight::events_received`]).
+    events_read: u32,
     /// Seconds spent under each decision (by index in the decision table) and carrying something.
     spent: (Vec<f32>, f32),
     /// Actions taken, for tests and logs.
@@ -103,6 +108,11 @@ pub struct Sight<'a> {
     pub cases: Vec<&'a CaseView>,
     /// The items.
     pub items: Vec<&'a ItemView>,
+    /// The game events received lately, oldest first (a client may take them away each frame; the
+    /// newest are at the end).
+    pub events: &'a [GameEvent],
+    /// How many game events have been received in all (counts the ones taken away too).
+    pub events_received: u32,
 }
 
 impl ViveBrain {
@@ -141,10 +151,18 @@ impl ViveBrain {
             return turn;
         }
         let memory = &mut self.memory;
+        let fresh = sight.events_received.saturating_sub(self.events_read) as usize;
+        self.events_read = sight.events_received;
+        for event in &sight.events[sight.events.len().saturating_sub(fresh)..] {
+            if let GameEvent::Radio { about, at, answering, .. } = event {
+                memory.heard_radio(&map.nav, *about, *at, answering);
+            }
+        }
         memory.see(&sight.guards);
         let tuning = map.tuning(session);
         let routes = map.patrols(session, &sight.cases, &sight.items);
-        let imagined = memory.imagined(&sight.guards, &tuning, &routes, session.alarm);
+        let known = Known { tuning: &tuning, nav: &map.nav, routes: &routes, alarm: session.alarm };
+        let imagined = memory.imagined(&sight.guards, &known);
         let view = View {
             me,
             alarm: session.alarm,
@@ -159,7 +177,10 @@ impl ViveBrain {
         memory.avoid.retain(|(_, until)| *until > now);
         let goal = goal::choose(&goal::Wants::new(&view, memory, map.workbench));
         memory.committed = goal.item();
-        let forecast = Forecast::new(&view.tuning, &routes, &view.guards, view.alarm, me.position);
+        memory.noises.retain(|(_, at)| now - at < NOISE_MEMORY_S);
+        let noises: Vec<Vec2> = memory.noises.iter().map(|(n, _)| *n).collect();
+        let heard = Heard { noises: &noises, searches: &memory.searches };
+        let forecast = Forecast::new(&known, &view.guards, me.position, &heard);
         let perception = act::perceive(map, memory, &view, &forecast, &goal, self.style == ViveStyle::Reckless);
         let (decision, plan) = decide::decide(&perception);
         let waiting_at_case = perception.at_goal
@@ -213,6 +234,8 @@ impl Seen<'_, '_> {
             guards: self.guards.iter().collect(),
             cases: self.cases.iter().collect(),
             items: self.items.iter().collect(),
+            events: &self.inbox.events,
+            events_received: self.inbox.received.events,
         })
     }
 }

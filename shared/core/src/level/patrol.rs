@@ -67,6 +67,14 @@ pub fn search_spots(nav: &NavGraph, at: Vec2, limit: usize) -> Vec<Vec2> {
     spots
 }
 
+/// The spots each guard answering a radio call about `at` searches, in the order they answer
+/// (nearest to `at` first): the `limit` spots around it ([`search_spots`]) dealt round ([`share_of`]).
+/// The server gives these orders; the Vive bot, which hears the call, works out the same.
+pub fn orders(nav: &NavGraph, at: Vec2, limit: usize, answering: usize) -> Vec<Vec<Vec2>> {
+    let spots = search_spots(nav, at, limit);
+    (0..answering).map(|k| share_of(&spots, k, answering)).collect()
+}
+
 /// The share of `spots` searcher number `k` of `n` takes: the spots are dealt round, starting with
 /// spot `k`, so two searchers never walk to the same spot first.
 pub fn share_of(spots: &[Vec2], k: usize, n: usize) -> Vec<Vec2> {
@@ -81,6 +89,16 @@ pub fn share_of(spots: &[Vec2], k: usize, n: usize) -> Vec<Vec2> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_radio_call_deals_the_spots_around_it_round_the_answering_guards() {
+        let level = Level::museum();
+        let nav = NavGraph::new(&level);
+        let at = Vec2::new(20.0, 5.0);
+        let spots = search_spots(&nav, at, 4);
+        assert_eq!(orders(&nav, at, 4, 2), vec![vec![spots[0], spots[2]], vec![spots[1], spots[3]]]);
+        assert_eq!(orders(&nav, at, 4, 1), vec![spots.clone()], "one guard searches them all");
+    }
 
     #[test]
     fn without_alarm_a_guard_walks_its_route_and_with_it_also_a_gallery_that_holds_targets() {

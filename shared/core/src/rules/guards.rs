@@ -127,6 +127,23 @@ pub const CHASE_SIGHT_FACTOR: f32 = 1.5;
 pub const CHASE_ANGLE_FACTOR: f32 = 2.0;
 /// Sight range on a crouching target, as a multiple of the normal one.
 pub const CROUCH_SIGHT_FACTOR: f32 = 0.6;
+/// Spots a search after a sighting covers at most: the spot and the rooms next to it
+/// (`level::patrol::search_spots`), dealt among the guards who answer the radio (`patrol::orders`).
+pub const SEARCH_SPOTS: usize = 4;
+/// Spots a search for whoever broke a case covers: the case and the room next to it nearest to it.
+pub const EVIDENCE_SPOTS: usize = 2;
+/// How long a searching guard looks around at each spot, seconds.
+pub const SEARCH_LOOK_S: f32 = 2.0;
+
+/// How fast a guard turns, rad/s (a guard at the end of his round sweeps his look round this fast).
+pub const GUARD_TURN_RATE: f32 = 4.0;
+/// How far a guard turns, radians (positive: anticlockwise), to face a direction `diff` (wrapped to
+/// −π..π) away: the short way round, but an about-turn — within 0.05 rad of π either way — always
+/// anticlockwise, so which way a guard sweeps his look at the end of his round is a published rule.
+pub fn about_turn(diff: f32) -> f32 {
+    if diff < 0.05 - std::f32::consts::PI { diff + std::f32::consts::TAU } else { diff }
+}
+
 /// Each alarm level makes the guards walk this much faster (a fraction of their speed).
 pub const ALARM_HASTE_PER_LEVEL: f32 = 0.15;
 /// Each alarm level makes the guards see this much farther (a fraction of their range).

@@ -57,4 +57,6 @@ pub const VIVE_SIGHT_RANGE: f32 = 30.0;
 pub const GUARD_STEP_LOUDNESS: f32 = 15.0;
 
 mod guards;
-pub use guards::{Difficulty, DifficultyTable, GuardTuning};
+pub use guards::{
+    Difficulty, DifficultyTable, EVIDENCE_SPOTS, GUARD_TURN_RATE, GuardTuning, SEARCH_LOOK_S, SEARCH_SPOTS, about_turn,
+};
