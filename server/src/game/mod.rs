@@ -633,11 +633,7 @@ impl Game {
         if self.tuning.radio_range_m <= 0.0 {
             return;
         }
-        // A sighting: the rooms around are searched; evidence: the spot and the nearest room next to it.
-        let spots = match about {
-            heist_shared::protocol::RadioAbout::Sighting => guard::SEARCH_SPOTS,
-            heist_shared::protocol::RadioAbout::Evidence => guard::EVIDENCE_SPOTS,
-        };
+        let spots = about.search_spots();
         let answering = self.radio.call(&self.guards, caller, (at, spots), &self.tuning, self.elapsed_s);
         let g = &self.guards[caller];
         let answering = answering.iter().map(|&i| self.guards[i].id).collect();

@@ -1,9 +1,11 @@
 //! Where guards will be and look in the next seconds, from their public patrol routes (the level's, or
 //! the ones the alarm switches them to: `heist_shared::level::patrol::alert_route`).
 //!
-//! A patrolling guard walks its route at patrol speed; the bot replays that walk ahead of time. A guard
-//! that is not patrolling (staring, investigating, chasing, searching, returning) is unpredictable: the
-//! bot treats it as coming at it and looking every way.
+//! A patrolling guard walks its round at patrol speed, through the doors, turning as the rules say; the
+//! bot replays that walk ahead of time. A returning guard walks back to the nearest waypoint of his
+//! round first; an investigating one walks to the noise the bot made, a searching one round the spots
+//! the radio call gave him. Any other (staring, chasing, investigating something else) is
+//! unpredictable: the bot treats him as coming at it and looking every way.
 
 use glam::Vec2;
 use heist_shared::level::{NavGraph, WallSet};
@@ -41,8 +43,8 @@ pub struct Known<'a> {
 /// the search spots radio calls gave each guard (by guard id).
 #[derive(Clone, Copy, Default)]
 pub struct Heard<'a> {
-    /// Where the bot made a noise lately.
-    pub noises: &'a [Vec2],
+    /// Where the bot made a noise lately (and when: the bot's clock).
+    pub noises: &'a [(Vec2, f32)],
     /// The spots each radioed guard has still to search.
     pub searches: &'a [(GuardId, Vec<Vec2>)],
 }
@@ -76,24 +78,30 @@ fn wrap(a: f32) -> f32 {
     (a + std::f32::consts::PI).rem_euclid(std::f32::consts::TAU) - std::f32::consts::PI
 }
 
+/// Leg `i` of the closed `route` (from waypoint `i` to the next) and how far `p` is from it.
+fn leg(route: &[Vec2], i: usize, p: Vec2) -> (Vec2, Vec2, f32) {
+    let (a, b) = (route[i], route[(i + 1) % route.len()]);
+    let ab = b - a;
+    let along = ((p - a).dot(ab) / ab.length_squared().max(1e-6)).clamp(0.0, 1.0);
+    (a, b, p.distance(a + ab * along))
+}
+
 /// The waypoint a guard at `p` facing `facing` walks to: the far end (in the facing's direction) of
 /// the route's leg nearest to it.
 fn next_waypoint(route: &[Vec2], p: Vec2, facing: f32) -> usize {
     let n = route.len();
     let ahead = Vec2::from_angle(facing);
-    let leg = (0..n)
+    let nearest = (0..n)
         .map(|i| {
-            let (a, b) = (route[i], route[(i + 1) % n]);
-            let ab = b - a;
-            let along = ((p - a).dot(ab) / ab.length_squared().max(1e-6)).clamp(0.0, 1.0);
+            let (a, b, d) = leg(route, i, p);
             // Legs walked the other way are a last resort (the guard may be mid-turn).
-            let against = if ab.dot(ahead) < 0.0 { 0.5 } else { 0.0 };
-            (p.distance(a + ab * along) + against, i)
+            let against = if (b - a).dot(ahead) < 0.0 { 0.5 } else { 0.0 };
+            (d + against, i)
         })
         .min_by(|x, y| x.0.total_cmp(&y.0))
         .map_or(0, |(_, i)| i);
-    let (a, b) = (route[leg], route[(leg + 1) % n]);
-    if (b - a).dot(ahead) >= 0.0 && p.distance(b) > 0.3 { (leg + 1) % n } else { leg }
+    let (a, b, _) = leg(route, nearest, p);
+    if (b - a).dot(ahead) >= 0.0 && p.distance(b) > 0.3 { (nearest + 1) % n } else { nearest }
 }
 
 /// Where a guard who began turning from `from` towards `to` `turning_s` seconds ago looks now: guards
@@ -127,15 +135,7 @@ fn walked(nav: &NavGraph, waypoints: &[Vec2]) -> (Vec<Vec2>, Vec<usize>) {
 
 /// How far `p` is from the nearest leg of `route`, metres.
 fn off_route(route: &[Vec2], p: Vec2) -> f32 {
-    let n = route.len();
-    (0..n)
-        .map(|i| {
-            let (a, b) = (route[i], route[(i + 1) % n]);
-            let ab = b - a;
-            let along = ((p - a).dot(ab) / ab.length_squared().max(1e-6)).clamp(0.0, 1.0);
-            p.distance(a + ab * along)
-        })
-        .fold(f32::INFINITY, f32::min)
+    (0..route.len()).map(|i| leg(route, i, p).2).fold(f32::INFINITY, f32::min)
 }
 
 impl Forecast {
@@ -143,6 +143,8 @@ impl Forecast {
     /// (`known`) and what the bot heard (`heard`); `me` is the bot's position.
     pub fn new(known: &Known<'_>, guards: &[&GuardView], me: Vec2, heard: &Heard<'_>) -> Self {
         let Known { tuning, nav, routes, alarm } = *known;
+        let (patrol_speed, hurry) =
+            (tuning.hasted(tuning.patrol_speed, alarm), tuning.hasted(tuning.investigate_speed, alarm));
         let futures = guards
             .iter()
             .map(|g| {
@@ -160,19 +162,19 @@ impl Forecast {
                         }
                         from = spot;
                     }
-                    let speed = tuning.hasted(tuning.investigate_speed, alarm);
-                    return Future::Goes { path, start: g.position, facing: g.facing, speed };
+                    return Future::Goes { path, start: g.position, facing: g.facing, speed: hurry };
                 }
                 if g.alert == GuardAlert::Investigating {
                     // Coming to look at a noise the bot made (the nearest by the doors), if any.
-                    let noise =
-                        heard.noises.iter().copied().filter_map(|n| Some((nav.route(g.position, n)?, n))).min_by(
-                            |a, b| nav.route_length(g.position, a.1).total_cmp(&nav.route_length(g.position, b.1)),
-                        );
-                    if let Some((path, _)) = noise {
+                    let nearest = heard
+                        .noises
+                        .iter()
+                        .map(|&(n, _)| (nav.route_length(g.position, n), n))
+                        .filter(|(d, _)| d.is_finite())
+                        .min_by(|a, b| a.0.total_cmp(&b.0));
+                    if let Some(path) = nearest.and_then(|(_, n)| nav.route(g.position, n)) {
                         let path = path.into_iter().map(|p| (p, 0.0)).collect();
-                        let speed = tuning.hasted(tuning.investigate_speed, alarm);
-                        return Future::Goes { path, start: g.position, facing: g.facing, speed };
+                        return Future::Goes { path, start: g.position, facing: g.facing, speed: hurry };
                     }
                 }
                 let calm = matches!(g.alert, GuardAlert::Patrolling | GuardAlert::Returning);
@@ -180,8 +182,7 @@ impl Forecast {
                     return Future::Alert(g.position, me);
                 }
                 let (route, at) = walked(nav, waypoints);
-                let speed = tuning.hasted(tuning.patrol_speed, alarm);
-                let lead_speed = tuning.hasted(tuning.investigate_speed, alarm);
+                let (speed, lead_speed) = (patrol_speed, hurry);
                 let (start, facing) = (g.position, g.facing);
                 if g.alert == GuardAlert::Patrolling && off_route(&route, start) < OFF_ROUTE_M {
                     let next = next_waypoint(&route, start, facing);
@@ -514,7 +515,7 @@ mod tests {
         let m = Museum::new();
         let glass = Vec2::new(21.0, 1.2);
         let g = guard(BRUNO, Vec2::new(30.0, 5.0), 0.0, GuardAlert::Investigating);
-        let f = m.forecast(&g, &Heard { noises: &[glass], searches: &[] });
+        let f = m.forecast(&g, &Heard { noises: &[(glass, 0.0)], searches: &[] });
         let (p, facing) = f.pose(0, 2.0);
         assert!(p.x < 30.0 - 2.0, "walks towards the glass: {p:?}");
         assert!(facing.is_some(), "looking where he goes");

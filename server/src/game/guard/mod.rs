@@ -22,7 +22,7 @@ const LOOK_AROUND_S: f32 = 3.0;
 const STARE_S: f32 = 1.5;
 /// Longest a guard stares at all before walking over to check, seconds.
 const MAX_STARE_S: f32 = 4.0;
-pub use heist_shared::rules::{EVIDENCE_SPOTS, SEARCH_LOOK_S, SEARCH_SPOTS};
+pub use heist_shared::rules::{SEARCH_LOOK_S, SEARCH_SPOTS};
 
 /// What a guard is doing and why.
 #[derive(Clone, Debug, PartialEq)]

@@ -93,8 +93,9 @@ pub(crate) fn perceive(
         if p.way.is_none() && p.waited_s > DETOUR_AFTER_S {
             // The usual way has been watched a while: is there another, round through some other room,
             // that is not? (Taken for good: the route stays until the goal changes.)
+            let ends = [map.nav.room_at(me), map.nav.room_at(target)];
             for via in map.nav.room_centres() {
-                if map.nav.room_at(via) == map.nav.room_at(me) || map.nav.room_at(via) == map.nav.room_at(target) {
+                if ends.contains(&map.nav.room_at(via)) {
                     continue;
                 }
                 let (Some(mut there), Some(on)) = (map.nav.route(me, via), map.nav.route(via, target)) else {

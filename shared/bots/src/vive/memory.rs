@@ -4,13 +4,11 @@
 
 use std::collections::VecDeque;
 
+use crate::forecast::{Forecast, Known};
 use glam::Vec2;
 use heist_shared::level::{NavGraph, patrol};
 use heist_shared::protocol::{GuardAlert, GuardId, RadioAbout};
 use heist_shared::protocol::{GuardView, ItemId};
-use heist_shared::rules;
-
-use crate::forecast::{Forecast, Known};
 
 /// Seconds an alerted guard out of sight is imagined where it was last seen; after that it is
 /// imagined back on its patrol.
@@ -60,11 +58,7 @@ pub(crate) struct Memory {
 impl Memory {
     /// Hears a radio call: the guards answering it will search their share of the spots around `at`.
     pub fn heard_radio(&mut self, nav: &NavGraph, about: RadioAbout, at: Vec2, answering: &[GuardId]) {
-        let limit = match about {
-            RadioAbout::Sighting => rules::SEARCH_SPOTS,
-            RadioAbout::Evidence => rules::EVIDENCE_SPOTS,
-        };
-        for (&id, spots) in answering.iter().zip(patrol::orders(nav, at, limit, answering.len())) {
+        for (&id, spots) in answering.iter().zip(patrol::orders(nav, at, about.search_spots(), answering.len())) {
             self.searches.retain(|(g, _)| *g != id);
             self.searches.push((id, spots));
         }
@@ -132,6 +126,7 @@ impl Memory {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use heist_shared::rules;
 
     #[test]
     fn a_radio_call_gives_each_answering_guard_the_spots_the_server_gives_him_crossed_off_as_seen() {

@@ -178,8 +178,7 @@ impl ViveBrain {
         let goal = goal::choose(&goal::Wants::new(&view, memory, map.workbench));
         memory.committed = goal.item();
         memory.noises.retain(|(_, at)| now - at < NOISE_MEMORY_S);
-        let noises: Vec<Vec2> = memory.noises.iter().map(|(n, _)| *n).collect();
-        let heard = Heard { noises: &noises, searches: &memory.searches };
+        let heard = Heard { noises: &memory.noises, searches: &memory.searches };
         let forecast = Forecast::new(&known, &view.guards, me.position, &heard);
         let perception = act::perceive(map, memory, &view, &forecast, &goal, self.style == ViveStyle::Reckless);
         let (decision, plan) = decide::decide(&perception);

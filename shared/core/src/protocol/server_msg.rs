@@ -81,6 +81,18 @@ pub enum RadioAbout {
     Evidence,
 }
 
+impl RadioAbout {
+    /// How many spots the guards who answer such a call search between them: around a sighting the spot
+    /// and the rooms next to it ([`crate::rules::SEARCH_SPOTS`]), around a broken case the case and the
+    /// nearest room next to it ([`crate::rules::EVIDENCE_SPOTS`]).
+    pub fn search_spots(self) -> usize {
+        match self {
+            RadioAbout::Sighting => crate::rules::SEARCH_SPOTS,
+            RadioAbout::Evidence => crate::rules::EVIDENCE_SPOTS,
+        }
+    }
+}
+
 /// Something that happened, for logs, speech and sound.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum GameEvent {
