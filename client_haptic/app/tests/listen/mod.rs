@@ -1,6 +1,7 @@
 //! A small isolated-word recognizer for the tests: it hears which words of a closed vocabulary a
 //! recording says, in order. Words are cut where the speech pauses (energy below the recording's loudest
-//! by 35 dB for 60 ms or more); each cut is compared with every word of the vocabulary as espeak-ng says
+//! by 35 dB for 150 ms or more: the stop inside "victor" is silent for 70 ms, the pause after a comma
+//! at 120 words a minute is 270 ms or more); each cut is compared with every word of the vocabulary as espeak-ng says
 //! it (the same voice and rate the client speaks with) by dynamic time warping over log-mel spectra with
 //! the mean removed (so the binaural placement's colouring and the level do not matter); a cut whose best
 //! match is not clearly better than the second best (below 0.6 of its distance), or not close at all
@@ -22,6 +23,8 @@ const FRAME: usize = 1200; // 25 ms
 const HOP: usize = 480; // 10 ms
 const FFT: usize = 2048;
 const BANDS: usize = 24;
+/// Quiet hops that end an utterance (150 ms).
+const PAUSE_HOPS: usize = 15;
 
 /// Log-mel spectra of a mono signal at [`RATE`], one row per 10 ms.
 pub struct Features {
@@ -135,7 +138,7 @@ pub fn utterances(x: &[f32]) -> Vec<(usize, usize)> {
             (true, Some(_)) => quiet = 0,
             (false, Some(s)) => {
                 quiet += 1;
-                if quiet >= 6 {
+                if quiet >= PAUSE_HOPS {
                     out.push((s * HOP, (i + 1 - quiet) * HOP));
                     start = None;
                 }
