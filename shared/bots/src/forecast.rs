@@ -3,14 +3,16 @@
 //!
 //! A patrolling guard walks its round at patrol speed, through the doors, turning as the rules say; the
 //! bot replays that walk ahead of time. A returning guard walks back to the nearest waypoint of his
-//! round first; an investigating one walks to the noise the bot made, a searching one round the spots
-//! the radio call gave him. Any other (staring, chasing, investigating something else) is
-//! unpredictable: the bot treats him as coming at it and looking every way.
+//! round first; an investigating one walks to the noise the bot made and looks round there, a searching
+//! one goes round the spots the radio call gave him; both then go back to their rounds. Any other
+//! (staring, chasing, investigating something else) is unpredictable: the bot treats him as coming at
+//! it and looking every way. A spot is graded ([`Sighting`]): in a guard's published sight, only
+//! within the bot's caution margins, or unseen.
 
 use glam::Vec2;
 use heist_shared::level::{NavGraph, WallSet};
 use heist_shared::protocol::{GuardAlert, GuardId, GuardView};
-use heist_shared::rules::{GUARD_TURN_RATE, GuardTuning, SEARCH_LOOK_S, about_turn};
+use heist_shared::rules::{self, GUARD_TURN_RATE, GuardTuning, LOOK_AROUND_S, SEARCH_LOOK_S, about_turn};
 
 /// The bot's caution on top of the guards' published sight range, metres.
 const RANGE_MARGIN: f32 = 1.0;
@@ -56,12 +58,28 @@ enum Future {
     /// now (he may still be turning).
     Patrol { lead: Vec<Vec2>, lead_speed: f32, route: Vec<Vec2>, next: usize, start: Vec2, facing: f32, speed: f32 },
     /// Walks `path` (through the doors) at `speed` from `start`, looking where he walks, stopping at
-    /// each point its pause to look every way, and at its end for good (an investigating guard going
-    /// to a noise the bot made, a searching one going round the spots the radio gave him).
-    Goes { path: Vec<(Vec2, f32)>, start: Vec2, facing: f32, speed: f32 },
+    /// each point its pause to look every way (an investigating guard going to a noise the bot made,
+    /// a searching one going round the spots the radio gave him); then goes back to his round
+    /// (`then`), or stays at the end for good when his round is not known.
+    Goes { path: Vec<(Vec2, f32)>, start: Vec2, facing: f32, speed: f32, then: Option<Box<Future>> },
     /// Unpredictable: assumed to walk straight at the bot, looking all round.
     Alert(Vec2, Vec2),
 }
+
+/// How well a spot would be seen, worst first last.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Sighting {
+    /// No guard would see it.
+    Unseen,
+    /// Only within the bot's caution margins (a guard a little off where the forecast has him).
+    Margin,
+    /// Within a guard's published sight.
+    Seen,
+}
+
+/// Where every guard is and looks (`None`: every way) at one moment of a forecast.
+#[derive(Debug)]
+pub struct Moment(Vec<(Vec2, Option<f32>)>);
 
 /// The forecast of every guard.
 pub struct Forecast {
@@ -149,6 +167,47 @@ impl Forecast {
             .iter()
             .map(|g| {
                 let waypoints = routes.get(usize::from(g.id.0)).map_or(&[][..], |r| &r[..]);
+                // Back from `from` to the nearest waypoint of his round, then on along it (as the
+                // server's guards do), or along it from where he is if he is on it.
+                let round = |from: Vec2, facing: f32, on_it: bool| {
+                    if waypoints.len() < 2 {
+                        return None;
+                    }
+                    let (route, at) = walked(nav, waypoints);
+                    let (speed, lead_speed) = (patrol_speed, hurry);
+                    if on_it && off_route(&route, from) < OFF_ROUTE_M {
+                        let next = next_waypoint(&route, from, facing);
+                        return Some(Future::Patrol {
+                            lead: Vec::new(),
+                            lead_speed,
+                            route,
+                            next,
+                            start: from,
+                            facing,
+                            speed,
+                        });
+                    }
+                    let k = (0..waypoints.len())
+                        .min_by(|&a, &b| from.distance(waypoints[a]).total_cmp(&from.distance(waypoints[b])))
+                        .unwrap_or(0);
+                    let mut lead = nav.route(from, waypoints[k]).unwrap_or_default();
+                    lead.pop();
+                    Some(Future::Patrol { lead, lead_speed, route, next: at[k], start: from, facing, speed })
+                };
+                let goes = |mut path: Vec<(Vec2, f32)>| {
+                    // A guard stops to look round as soon as he is within [`rules::ARRIVED_M`] of the
+                    // spot, short of it on his way there.
+                    for i in 0..path.len() {
+                        if path[i].1 > 0.0 {
+                            let before = if i == 0 { g.position } else { path[i - 1].0 };
+                            let back = (before - path[i].0).clamp_length_max(rules::ARRIVED_M - 0.1);
+                            path[i].0 += back;
+                        }
+                    }
+                    let end = path.last().map_or(g.position, |p| p.0);
+                    let then = round(end, g.facing, false).map(Box::new);
+                    Future::Goes { path, start: g.position, facing: g.facing, speed: hurry, then }
+                };
                 if g.alert == GuardAlert::Searching
                     && let Some((_, spots)) = heard.searches.iter().find(|(id, _)| *id == g.id)
                 {
@@ -162,7 +221,7 @@ impl Forecast {
                         }
                         from = spot;
                     }
-                    return Future::Goes { path, start: g.position, facing: g.facing, speed: hurry };
+                    return goes(path);
                 }
                 if g.alert == GuardAlert::Investigating {
                     // Coming to look at a noise the bot made (the nearest by the doors), if any.
@@ -173,28 +232,18 @@ impl Forecast {
                         .filter(|(d, _)| d.is_finite())
                         .min_by(|a, b| a.0.total_cmp(&b.0));
                     if let Some(path) = nearest.and_then(|(_, n)| nav.route(g.position, n)) {
-                        let path = path.into_iter().map(|p| (p, 0.0)).collect();
-                        return Future::Goes { path, start: g.position, facing: g.facing, speed: hurry };
+                        let mut path: Vec<(Vec2, f32)> = path.into_iter().map(|p| (p, 0.0)).collect();
+                        if let Some(last) = path.last_mut() {
+                            last.1 = LOOK_AROUND_S;
+                        }
+                        return goes(path);
                     }
                 }
                 let calm = matches!(g.alert, GuardAlert::Patrolling | GuardAlert::Returning);
-                if !calm || waypoints.len() < 2 {
-                    return Future::Alert(g.position, me);
+                match round(g.position, g.facing, g.alert == GuardAlert::Patrolling) {
+                    Some(future) if calm => future,
+                    _ => Future::Alert(g.position, me),
                 }
-                let (route, at) = walked(nav, waypoints);
-                let (speed, lead_speed) = (patrol_speed, hurry);
-                let (start, facing) = (g.position, g.facing);
-                if g.alert == GuardAlert::Patrolling && off_route(&route, start) < OFF_ROUTE_M {
-                    let next = next_waypoint(&route, start, facing);
-                    return Future::Patrol { lead: Vec::new(), lead_speed, route, next, start, facing, speed };
-                }
-                // Back to the nearest waypoint of his round, then on along it (as the server's guards do).
-                let k = (0..waypoints.len())
-                    .min_by(|&a, &b| start.distance(waypoints[a]).total_cmp(&start.distance(waypoints[b])))
-                    .unwrap_or(0);
-                let mut lead = nav.route(start, waypoints[k]).unwrap_or_default();
-                lead.pop();
-                Future::Patrol { lead, lead_speed, route, next: at[k], start, facing, speed }
             })
             .collect();
         Self { futures, alarm, tuning: *tuning }
@@ -221,13 +270,18 @@ impl Forecast {
 
     /// Pose (position, facing) of guard `i` after `t` seconds.
     fn pose(&self, i: usize, t: f32) -> (Vec2, Option<f32>) {
-        match &self.futures[i] {
+        self.pose_of(&self.futures[i], t)
+    }
+
+    /// Pose (position, facing; `None`: every way) of a guard with `future` after `t` seconds.
+    fn pose_of(&self, future: &Future, t: f32) -> (Vec2, Option<f32>) {
+        match future {
             Future::Alert(p, towards) => {
                 let d = *towards - *p;
                 let walk = (self.tuning.investigate_speed * t.min(ALERT_APPROACH_S)).min((d.length() - 1.0).max(0.0));
                 (*p + d.normalize_or_zero() * walk, None)
             }
-            Future::Goes { path, start, facing, speed } => {
+            Future::Goes { path, start, facing, speed, then } => {
                 let (mut at, mut left) = (*start, t);
                 for (i, &(wp, pause)) in path.iter().enumerate() {
                     let d = at.distance(wp);
@@ -243,7 +297,10 @@ impl Forecast {
                         return (at, None); // looking round there
                     }
                 }
-                (at, None)
+                match then {
+                    Some(then) => self.pose_of(then, left),
+                    None => (at, None),
+                }
             }
             Future::Patrol { lead, lead_speed, route, next, start, facing, speed } => {
                 let n = route.len();
@@ -293,23 +350,54 @@ impl Forecast {
         }
     }
 
-    /// True when some guard could see a person at `p` (crouching or not) `t` seconds from now.
-    pub fn seen(&self, p: Vec2, t: f32, crouching: bool, walls: &WallSet) -> bool {
+    /// Where every guard is and looks `t` seconds from now.
+    pub fn moment(&self, t: f32) -> Moment {
+        Moment((0..self.futures.len()).map(|i| self.pose(i, t)).collect())
+    }
+
+    /// True when some guard at `moment` could see a person at `p` (crouching or not).
+    pub fn sees(&self, moment: &Moment, p: Vec2, crouching: bool, walls: &WallSet) -> bool {
+        self.sighting(moment, p, crouching, walls) != Sighting::Unseen
+    }
+
+    /// How well the guards at `moment` would see a person at `p` (crouching or not): by their
+    /// published numbers, or only within the bot's caution margins, or not at all.
+    pub fn sighting(&self, moment: &Moment, p: Vec2, crouching: bool, walls: &WallSet) -> Sighting {
         let t_ = &self.tuning;
         let margined = GuardTuning { sight_range: t_.sight_range + RANGE_MARGIN, ..*t_ };
-        let range = margined.sight_range_at(self.alarm, false, crouching);
+        let (range, sure_range) =
+            (margined.sight_range_at(self.alarm, false, crouching), t_.sight_range_at(self.alarm, false, crouching));
         let (all_round, half_angle) = (t_.notice_radius + ALL_ROUND_MARGIN, t_.half_angle(false) + ANGLE_MARGIN);
-        (0..self.futures.len()).any(|i| {
-            let (g, facing) = self.pose(i, t);
+        let (sure_all_round, sure_half_angle) = (t_.notice_radius, t_.half_angle(false));
+        let mut worst = Sighting::Unseen;
+        for &(g, facing) in &moment.0 {
             let d = p - g;
             let dist = d.length();
-            let in_view = match facing {
-                _ if dist < all_round => true,
-                None => dist < range,
-                Some(f) => dist < range && wrap(angle_of(d) - f).abs() < half_angle,
+            let off = facing.map_or(0.0, |f| wrap(angle_of(d) - f).abs());
+            let grade = if dist < sure_all_round || (dist < sure_range && off < sure_half_angle) {
+                Sighting::Seen
+            } else if dist < all_round || (dist < range && off < half_angle) {
+                Sighting::Margin
+            } else {
+                continue;
             };
-            in_view && walls.line_of_sight(g, p)
-        })
+            if grade > worst && walls.line_of_sight(g, p) {
+                worst = grade;
+            }
+        }
+        worst
+    }
+
+    /// True when some guard at `moment` could hear Vive running at `p` (straight-line distance, with the
+    /// same caution as the bot's run check: half as far again as the published radius).
+    pub fn hears_running(&self, moment: &Moment, p: Vec2) -> bool {
+        let radius = rules::RUN_LOUDNESS * self.tuning.hearing_at(self.alarm) * 1.5;
+        moment.0.iter().any(|&(g, _)| g.distance(p) < radius)
+    }
+
+    /// True when some guard could see a person at `p` (crouching or not) `t` seconds from now.
+    pub fn seen(&self, p: Vec2, t: f32, crouching: bool, walls: &WallSet) -> bool {
+        self.sees(&self.moment(t), p, crouching, walls)
     }
 
     /// True when `p` stays unseen (crouching) for the next `horizon` seconds.
@@ -353,34 +441,6 @@ impl Forecast {
         Walk::Arrived(at, t)
     }
 
-    /// True when walking the polyline from `from` through `path` at `speed` stays unseen until it
-    /// reaches, within `horizon` seconds, a harbour: a spot that then stays unseen for [`HOLD_S`]
-    /// (checked every second of the walk, and at the end of the path). A way that is clear for the
-    /// next seconds but ends where a guard is about to look is no way.
-    pub fn path_hidden(
-        &self,
-        from: Vec2,
-        path: &[Vec2],
-        speed: f32,
-        horizon: f32,
-        crouching: bool,
-        walls: &WallSet,
-    ) -> bool {
-        let mut next_check = 1.0;
-        let harbour = |at: Vec2, t: f32| {
-            if t + 1e-3 < next_check {
-                return false;
-            }
-            next_check += 1.0;
-            self.holdable_for(at, t, HOLD_S, walls)
-        };
-        match self.walk(from, path, (speed, crouching), horizon, walls, harbour) {
-            Walk::Stopped => true,
-            Walk::Arrived(at, t) => self.holdable_for(at, t, HOLD_S, walls),
-            Walk::Seen | Walk::OutOfTime => false,
-        }
-    }
-
     /// True when the whole walk from `from` through `path` at `speed` stays unseen and its end then
     /// stays unseen for [`HOLD_S`] (a hiding place worth going to).
     pub fn hiding_place(&self, from: Vec2, path: &[Vec2], speed: f32, crouching: bool, walls: &WallSet) -> bool {
@@ -407,6 +467,7 @@ enum Walk {
 mod tests {
     use super::*;
     use heist_shared::level::Level;
+    use heist_shared::rules::ARRIVED_M;
     use std::f32::consts::{FRAC_PI_2, PI};
 
     const BRUNO: usize = 0;
@@ -519,8 +580,14 @@ mod tests {
         let (p, facing) = f.pose(0, 2.0);
         assert!(p.x < 30.0 - 2.0, "walks towards the glass: {p:?}");
         assert!(facing.is_some(), "looking where he goes");
-        let (there, look) = f.pose(0, 30.0);
-        assert!(there.distance(glass) < 1e-3 && look.is_none(), "looks round at the glass: {there:?}");
+        // He stops to look round as soon as he is within reach of it (as the server's guards do), for
+        // LOOK_AROUND_S, then goes back to his round.
+        let speed = m.tuning.investigate_speed;
+        let arrives = (m.nav.route_length(g.position, glass) - (ARRIVED_M - 0.1)) / speed;
+        let (there, look) = f.pose(0, arrives + 0.5 * LOOK_AROUND_S);
+        assert!(there.distance(glass) < ARRIVED_M && look.is_none(), "looks round at the glass: {there:?}");
+        let (back, look) = f.pose(0, arrives + LOOK_AROUND_S + 1.0);
+        assert!(back.distance(there) > 0.5 && look.is_some(), "then walks back to his round: {back:?}");
         let unknown = m.forecast(&g, &Heard::default());
         assert!(unknown.pose(0, 2.0).1.is_none(), "without a noise he is unpredictable: looks every way");
     }
@@ -533,15 +600,19 @@ mod tests {
         let searches = [(GuardId(BRUNO as u16), vec![a, b])];
         let f = m.forecast(&g, &Heard { noises: &[], searches: &searches });
         let speed = m.tuning.investigate_speed;
-        let at_a = 5.0 / speed;
-        assert!(f.pose(0, at_a + 0.5 * SEARCH_LOOK_S).0.distance(a) < 1e-3, "looks round at the first spot");
+        // He stops to look round within reach of each spot, short of it.
+        let short = ARRIVED_M - 0.1;
+        let at_a = (5.0 - short) / speed;
+        assert!(f.pose(0, at_a + 0.5 * SEARCH_LOOK_S).0.distance(a) < ARRIVED_M, "looks round at the first spot");
         assert!(f.pose(0, at_a + 0.5 * SEARCH_LOOK_S).1.is_none());
         let (p, facing) = f.pose(0, at_a + SEARCH_LOOK_S + 1.0);
-        assert!((p.x - (20.0 + speed)).abs() < 1e-3 && facing == Some(0.0), "then on to the next: {p:?}");
+        assert!((p.x - (20.0 - short + speed)).abs() < 1e-3 && facing == Some(0.0), "then on to the next: {p:?}");
+        let (last, look) = f.pose(0, at_a + SEARCH_LOOK_S + (b.x - a.x) / speed + SEARCH_LOOK_S + 3.0);
+        assert!(last.distance(b) > ARRIVED_M && look.is_some(), "after the last, back to his round: {last:?}");
     }
 
     #[test]
-    fn a_way_clear_now_that_ends_where_a_guard_is_about_to_look_is_no_way() {
+    fn a_spot_clear_now_where_a_guard_is_about_to_look_is_no_hiding_place() {
         let m = Museum::new();
         // Clara walks up and down x = 17 between z 13.5 and 19. Creeping to a spot just past the north
         // end of her line is clear while she walks away south, but the spot is no harbour: she comes
@@ -551,7 +622,6 @@ mod tests {
         let on_her_line = [Vec2::new(17.0, 20.2)];
         let from = Vec2::new(14.5, 20.2);
         assert!(f.hidden_for(from, 2.0, &m.walls), "here is fine for now");
-        assert!(!f.path_hidden(from, &on_her_line, rules_crouch(), 6.0, true, &m.walls));
         assert!(!f.hiding_place(from, &on_her_line, rules_crouch(), true, &m.walls));
     }
 

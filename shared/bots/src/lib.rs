@@ -8,6 +8,7 @@
 mod forecast;
 mod phantom;
 mod rounds;
+mod spacetime;
 mod vive;
 
 pub use phantom::{PhantomBotPlugin, PhantomBrain};

@@ -6,7 +6,7 @@ use glam::Vec2;
 use heist_shared::level::{NavGraph, WallSet, patrol};
 use heist_shared::protocol::{GuardAlert, RadioAbout};
 use heist_shared::rules::GUARD_TURN_RATE as TURN_RATE;
-use heist_shared::rules::GuardTuning;
+use heist_shared::rules::{self, GuardTuning};
 
 use super::{Decision, Guard, GuardState, Perception, SEARCH_LOOK_S, angle_of, decide, wrap};
 
@@ -146,7 +146,7 @@ fn search(g: &mut Guard, spots: Vec<Vec2>, t: &GuardTuning, haste: f32, walls: &
         GuardState::Search { spots: old, next, looked } if *old == spots => (*next, *looked),
         _ => (0, 0.0),
     };
-    if spots.get(next).is_some_and(|s| g.position.distance(*s) < 0.8) && looked >= SEARCH_LOOK_S {
+    if spots.get(next).is_some_and(|s| g.position.distance(*s) < rules::ARRIVED_M) && looked >= SEARCH_LOOK_S {
         next += 1;
         looked = 0.0;
     }

@@ -16,13 +16,11 @@ use glam::Vec2;
 use heist_shared::protocol::{GuardAlert, GuardId};
 use heist_shared::rules::{self, GuardTuning};
 
-/// How long a guard looks around at a spot before moving on, seconds.
-const LOOK_AROUND_S: f32 = 3.0;
 /// How long a guard keeps staring at a vanished glimpse before checking the spot, seconds.
 const STARE_S: f32 = 1.5;
 /// Longest a guard stares at all before walking over to check, seconds.
 const MAX_STARE_S: f32 = 4.0;
-pub use heist_shared::rules::{SEARCH_LOOK_S, SEARCH_SPOTS};
+pub use heist_shared::rules::{LOOK_AROUND_S, SEARCH_LOOK_S, SEARCH_SPOTS};
 
 /// What a guard is doing and why.
 #[derive(Clone, Debug, PartialEq)]
@@ -273,7 +271,7 @@ fn report_if_evidence_found(_g: &Guard, p: &Perception) -> Option<Decision> {
 fn continue_investigation_if_started(g: &Guard, p: &Perception) -> Option<Decision> {
     let GuardState::Investigate { at, looked, then_search } = g.state else { return None };
     if looked < LOOK_AROUND_S {
-        return Some(if g.position.distance(at) < 0.8 {
+        return Some(if g.position.distance(at) < rules::ARRIVED_M {
             Decision::LookAround
         } else {
             Decision::Investigate(at, then_search)
@@ -297,7 +295,7 @@ fn converge_if_radioed(_g: &Guard, p: &Perception) -> Option<Decision> {
 fn continue_search_if_started(g: &Guard, _p: &Perception) -> Option<Decision> {
     let GuardState::Search { spots, next, looked } = &g.state else { return None };
     let Some(spot) = spots.get(*next) else { return Some(Decision::Return) };
-    if g.position.distance(*spot) < 0.8 && *looked < SEARCH_LOOK_S {
+    if g.position.distance(*spot) < rules::ARRIVED_M && *looked < SEARCH_LOOK_S {
         return Some(Decision::LookAround);
     }
     Some(Decision::Search(spots.clone()))
@@ -305,7 +303,8 @@ fn continue_search_if_started(g: &Guard, _p: &Perception) -> Option<Decision> {
 
 /// Walk back to the route until close to it.
 fn return_if_off_route(g: &Guard, _p: &Perception) -> Option<Decision> {
-    (g.state == GuardState::Return && g.position.distance(g.route[g.next]) > 0.8).then_some(Decision::Return)
+    (g.state == GuardState::Return && g.position.distance(g.route[g.next]) > rules::ARRIVED_M)
+        .then_some(Decision::Return)
 }
 
 /// Otherwise, patrol.

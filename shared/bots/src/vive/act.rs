@@ -11,9 +11,8 @@ use super::goal::Goal;
 use super::map::Map;
 use super::memory::Memory;
 use crate::forecast::{Forecast, HOLD_S};
+use crate::spacetime::{self, Order, Timed};
 
-/// How far ahead the bot checks that its way stays out of sight, seconds.
-const LOOK_AHEAD_S: f32 = 6.0;
 /// Closer than this beyond a guard's all-round noticing radius counts as exposed, seen or not (walls
 /// and doors are thin), metres.
 const TOO_CLOSE_M: f32 = 1.0;
@@ -22,8 +21,10 @@ const TOO_CLOSE_M: f32 = 1.0;
 const BREAK_HEADSTART_S: f32 = 7.0;
 /// After the last sight of a guard chasing, the bot keeps fleeing this long, seconds.
 const FLEE_ON_S: f32 = 5.0;
-/// Seconds the usual way must have been watched before the bot looks for a way round another room.
-const DETOUR_AFTER_S: f32 = 3.0;
+/// Seconds a timed way that stays unseen is followed before it is made again from what the bot sees then.
+const REPLAN_S: f32 = 3.0;
+/// Seconds a timed way is followed at least before it is made again because it will be seen.
+const QUICK_REPLAN_S: f32 = 0.25;
 /// How long an item given up on stays given up, seconds.
 const AVOID_FOR_S: f32 = 60.0;
 
@@ -67,6 +68,28 @@ pub(crate) fn perceive(
     if reckless || p.chased {
         return p;
     }
+    // The timed way: to the goal, or, at it, whether staying is safe (else away and back later).
+    memory.step_to = None;
+    let now = memory.clock_s;
+    // A plan is kept while it stays unseen by what the bot sees now (made again now and then, to
+    // find a quicker way as guards move on); one that was seen anyway (the least seen there was) is
+    // made again every time.
+    let stale = memory.timed.as_ref().is_none_or(|t| {
+        t.goal.distance(target) > 0.3
+            || now - t.made_at >= REPLAN_S
+            || (now - t.made_at >= QUICK_REPLAN_S
+                && (t.way.seen_s > 0.0 || t.seen_ahead(forecast, &map.walls, now, me)))
+    });
+    if stale {
+        let reach = rules::REACH * 0.8 - 0.2;
+        memory.timed =
+            spacetime::plan(&map.grid, forecast, &map.walls, me, target, reach).map(|w| Timed::new(w, now, target));
+    }
+    match memory.timed.as_mut().map(|t| t.order(now, me)) {
+        Some(Order::Go(to, gait)) => (p.way, memory.step_to, memory.timed_gait) = (Some(gait), Some(to), gait),
+        Some(Order::Hold) => p.hold = true,
+        None => {}
+    }
     let close = view.tuning.notice_radius + TOO_CLOSE_M;
     let crowded = view.guards.iter().any(|g| g.position.distance(me) < close);
     p.exposed = crowded || forecast.seen(me, 0.0, true, &map.walls);
@@ -87,28 +110,6 @@ pub(crate) fn perceive(
         p.quiet_s = memory.clock_s - since;
     } else {
         memory.quiet_since = None;
-    }
-    if !at_goal {
-        p.way = fastest_hidden_gait(map, &memory.route, view, forecast);
-        if p.way.is_none() && p.waited_s > DETOUR_AFTER_S {
-            // The usual way has been watched a while: is there another, round through some other room,
-            // that is not? (Taken for good: the route stays until the goal changes.)
-            let ends = [map.nav.room_at(me), map.nav.room_at(target)];
-            for via in map.nav.room_centres() {
-                if ends.contains(&map.nav.room_at(via)) {
-                    continue;
-                }
-                let (Some(mut there), Some(on)) = (map.nav.route(me, via), map.nav.route(via, target)) else {
-                    continue;
-                };
-                there.extend(on);
-                there.reverse();
-                if let Some(gait) = fastest_hidden_gait(map, &there, view, forecast) {
-                    (memory.route, p.way) = (there, Some(gait));
-                    break;
-                }
-            }
-        }
     }
     p.hidden_here = forecast.hidden_for(me, HOLD_S, &map.walls);
     let lure_due = memory.lured_at.is_none_or(|t| memory.clock_s - t > LURE_AFTER_S);
@@ -144,28 +145,6 @@ fn plan_route(map: &Map, memory: &mut Memory, view: &View<'_>, target: Vec2, rec
     }
 }
 
-/// Along `route` (last waypoint first): run when out of every guard's earshot and the way stays unseen
-/// at a run; else walk; else crouch.
-fn fastest_hidden_gait(map: &Map, route: &[Vec2], view: &View<'_>, forecast: &Forecast) -> Option<Gait> {
-    let me = view.me.position;
-    let path: Vec<Vec2> = route.iter().rev().copied().collect();
-    let hearing = view.tuning.hearing_at(view.alarm);
-    let quiet =
-        view.guards.iter().all(|g| map.nav.heard_margin(me, g.position, rules::RUN_LOUDNESS * hearing * 1.5) < 0.0);
-    let hidden = |speed: f32, horizon: f32, crouching: bool| {
-        forecast.path_hidden(me, &path, speed, horizon, crouching, &map.walls)
-    };
-    if quiet && hidden(rules::RUN_SPEED, LOOK_AHEAD_S, false) {
-        Some(Gait::Run)
-    } else if hidden(rules::WALK_SPEED, LOOK_AHEAD_S, false) {
-        Some(Gait::Walk)
-    } else if hidden(rules::CROUCH_SPEED, LOOK_AHEAD_S * 0.5, true) {
-        Some(Gait::Crouch)
-    } else {
-        None
-    }
-}
-
 /// Carries `plan` out: (direction, gait, action). Updates the memory's timers.
 pub(crate) fn carry_out(
     plan: Plan,
@@ -181,7 +160,7 @@ pub(crate) fn carry_out(
     memory.walked(me);
     match plan {
         Plan::Go(gait) => {
-            let waypoint = memory.route.last().copied().unwrap_or(me);
+            let waypoint = memory.step_to.or(memory.route.last().copied()).unwrap_or(me);
             ((waypoint - me).normalize_or_zero(), gait, None)
         }
         Plan::Act(action) => {
@@ -207,7 +186,12 @@ pub(crate) fn carry_out(
             (Vec2::ZERO, Gait::Crouch, None)
         }
         Plan::Hide => {
-            let (direction, gait) = hide(map, memory, view, forecast);
+            // The timed way is the least seen there is; without one, the nearest hiding place.
+            let (direction, gait) = match (memory.timed.as_ref().map(|t| t.way.steps.is_empty()), memory.step_to) {
+                (_, Some(to)) => ((to - me).normalize_or_zero(), memory.timed_gait),
+                (Some(_), None) => (Vec2::ZERO, Gait::Crouch),
+                (None, None) => hide(map, memory, view, forecast),
+            };
             (direction, gait, None)
         }
         Plan::Flee => {

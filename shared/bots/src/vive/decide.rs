@@ -35,8 +35,11 @@ pub(crate) struct Perception {
     pub break_heard: bool,
     /// Seconds the case has been out of every guard's earshot (a break waits for a settled quiet).
     pub quiet_s: f32,
-    /// The fastest gait that keeps the next seconds of the way unseen (running only out of earshot).
+    /// The timed way (`crate::spacetime`) says: step on now, at this gait (running only out of
+    /// earshot). At the goal: leave it, a guard will see this spot.
     pub way: Option<Gait>,
+    /// The timed way says: wait here, crouching, for the way ahead to clear.
+    pub hold: bool,
     /// Standing (crouching) here stays unseen for the next seconds.
     pub hidden_here: bool,
     /// A carried prop and where to throw it so it draws the nearest guard away, when a lure is due.
@@ -104,6 +107,11 @@ fn act_if_in_reach(p: &Perception) -> Option<Plan> {
     }
 }
 
+/// At the goal but a guard will see this spot soon, and the timed way leads away: go (and come back).
+fn leave_goal_if_watched(p: &Perception) -> Option<Plan> {
+    p.way.filter(|_| p.at_goal).map(Plan::Go)
+}
+
 /// At the case and no guard would hear the glass (for a settled moment, not one hopeful frame): break it.
 fn break_if_unheard(p: &Perception) -> Option<Plan> {
     match &p.action {
@@ -130,7 +138,7 @@ fn wait_if_at_goal(p: &Perception) -> Option<Plan> {
     p.at_goal.then_some(Plan::Wait)
 }
 
-/// The way stays unseen at some gait: go, as fast as that allows.
+/// The timed way says step on: go, at its gait.
 fn go_if_way_hidden(p: &Perception) -> Option<Plan> {
     p.way.map(Plan::Go)
 }
@@ -145,6 +153,11 @@ fn lure_if_blocked(p: &Perception) -> Option<Plan> {
 /// for a while.
 fn give_up_if_stuck(p: &Perception) -> Option<Plan> {
     (p.fetching && p.waited_s > GIVE_UP_AFTER_S).then_some(Plan::GiveUp)
+}
+
+/// The timed way waits here for a guard to pass: wait.
+fn wait_if_way_timed(p: &Perception) -> Option<Plan> {
+    p.hold.then_some(Plan::Wait)
 }
 
 /// The way is watched but here is safe: wait for it to clear.
@@ -166,6 +179,7 @@ pub(crate) const DECISIONS: &[Decision] = &[
     ("flee_if_chased", flee_if_chased),
     ("hide_if_seen_soon", hide_if_seen_soon),
     ("act_if_in_reach", act_if_in_reach),
+    ("leave_goal_if_watched", leave_goal_if_watched),
     ("break_if_unheard", break_if_unheard),
     ("lure_if_break_heard", lure_if_break_heard),
     ("give_up_if_break_heard_too_long", give_up_if_break_heard_too_long),
@@ -173,6 +187,7 @@ pub(crate) const DECISIONS: &[Decision] = &[
     ("give_up_if_stuck", give_up_if_stuck),
     ("go_if_way_hidden", go_if_way_hidden),
     ("lure_if_blocked", lure_if_blocked),
+    ("wait_if_way_timed", wait_if_way_timed),
     ("wait_if_hidden", wait_if_hidden),
     ("hide_otherwise", hide_otherwise),
 ];
@@ -262,7 +277,7 @@ mod tests {
     }
 
     #[test]
-    fn the_bot_goes_at_the_fastest_gait_that_stays_unseen() {
+    fn the_bot_steps_on_when_its_timed_way_says_so_at_its_gait() {
         let p = Perception {
             way: Some(Gait::Crouch),
             hidden_here: true,
@@ -293,6 +308,28 @@ mod tests {
         assert_eq!(named(&longer), ("give_up_if_stuck", Plan::GiveUp));
         let not_fetching = Perception { fetching: false, ..longer };
         assert_eq!(named(&not_fetching), ("wait_if_hidden", Plan::Wait));
+    }
+
+    #[test]
+    fn when_the_timed_way_waits_for_a_guard_to_pass_the_bot_waits_a_prop_in_hand_or_not() {
+        let p = Perception { hold: true, ..Default::default() };
+        assert_eq!(named(&p), ("wait_if_way_timed", Plan::Wait));
+        let long = Perception { hidden_here: true, waited_s: LURE_AFTER_S + 0.1, lure: Some(PROP), ..p.clone() };
+        assert_eq!(named(&long), ("lure_if_blocked", Plan::Throw(PROP.0, PROP.1)), "a long wait hidden: a lure first");
+    }
+
+    #[test]
+    fn at_the_goal_the_bot_leaves_a_spot_a_guard_will_see_before_breaking_or_waiting_there() {
+        let p = Perception { way: Some(Gait::Crouch), ..at_case() };
+        assert_eq!(named(&p), ("leave_goal_if_watched", Plan::Go(Gait::Crouch)));
+        let bench = Perception { at_goal: true, way: Some(Gait::Walk), ..Default::default() };
+        assert_eq!(named(&bench), ("leave_goal_if_watched", Plan::Go(Gait::Walk)));
+        let item = Perception { way: Some(Gait::Walk), ..in_reach_of_an_item() };
+        assert_eq!(named(&item), ("act_if_in_reach", Plan::Act(ViveMsg::PickUp(ItemId(4)))), "a quiet grab first");
+    }
+
+    fn in_reach_of_an_item() -> Perception {
+        Perception { at_goal: true, action: Some(ViveMsg::PickUp(ItemId(4))), ..Default::default() }
     }
 
     #[test]

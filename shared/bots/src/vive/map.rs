@@ -6,17 +6,23 @@ use heist_shared::level::{Level, NavGraph, WallSet, patrol};
 use heist_shared::protocol::{CaseView, ItemKind, ItemPlace, ItemView, SessionView};
 use heist_shared::rules::GuardTuning;
 
+use crate::spacetime::Grid;
+
 /// The museum as the bot knows it.
 pub(crate) struct Map {
     pub level: Level,
     pub nav: NavGraph,
     pub walls: WallSet,
     pub workbench: Vec2,
+    /// The floor as cells, for ways through space and time.
+    pub grid: Grid,
 }
 
 impl Map {
     pub fn new(level: &Level) -> Self {
-        Self { nav: NavGraph::new(level), walls: WallSet::new(level), workbench: level.workbench, level: level.clone() }
+        let walls = WallSet::new(level);
+        let grid = Grid::new(level, &walls);
+        Self { nav: NavGraph::new(level), walls, grid, workbench: level.workbench, level: level.clone() }
     }
 
     /// What the guards can do on the session's difficulty (the published numbers).

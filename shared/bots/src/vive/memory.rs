@@ -5,10 +5,12 @@
 use std::collections::VecDeque;
 
 use crate::forecast::{Forecast, Known};
+use crate::spacetime::Timed;
 use glam::Vec2;
-use heist_shared::level::{NavGraph, patrol};
+use heist_shared::level::{Level, NavGraph, patrol};
+use heist_shared::protocol::{Gait, GuardView, ItemId};
 use heist_shared::protocol::{GuardAlert, GuardId, RadioAbout};
-use heist_shared::protocol::{GuardView, ItemId};
+use heist_shared::rules::GuardTuning;
 
 /// Seconds an alerted guard out of sight is imagined where it was last seen; after that it is
 /// imagined back on its patrol.
@@ -26,6 +28,11 @@ pub(crate) struct Memory {
     pub route: Vec<Vec2>,
     /// The target `route` leads to.
     pub route_goal: Option<Vec2>,
+    /// The timed way (space and time) it is carrying out, if any.
+    pub timed: Option<Timed>,
+    /// Where the timed way says to head this frame, and at which gait.
+    pub step_to: Option<Vec2>,
+    pub timed_gait: Gait,
     /// Progress towards the goal: (goal, the closest the bot has come to it, when it last came a metre
     /// closer). Waiting and hiding make none; a frame's step forward and back again does not count.
     pub progress: Option<(Vec2, f32, f32)>,
@@ -79,6 +86,22 @@ impl Memory {
         for g in guards {
             self.remembered.retain(|(r, _)| r.id != g.id);
             self.remembered.push(((*g).clone(), self.clock_s));
+        }
+    }
+
+    /// Learns the guards on duty before the heist starts, as any player can from the level: each one at
+    /// the start of his round, walking to its second waypoint (until seen, each is imagined along it).
+    pub fn brief(&mut self, level: &Level, tuning: &GuardTuning) {
+        let on_duty = level.guards.iter().take(tuning.guards.unwrap_or(usize::MAX)).enumerate();
+        for (i, g) in on_duty.filter(|(_, g)| !g.route.is_empty()) {
+            let id = GuardId(i as u16);
+            if self.remembered.iter().any(|(r, _)| r.id == id) {
+                continue;
+            }
+            let (start, next) = (g.route[0], g.route.get(1).copied().unwrap_or(g.route[0]));
+            let facing = (next - start).y.atan2((next - start).x);
+            let view = GuardView { id, name: g.name.clone(), position: start, facing, alert: GuardAlert::Patrolling };
+            self.remembered.push((view, self.clock_s));
         }
     }
 
@@ -151,6 +174,34 @@ mod tests {
         assert!(m.searches.iter().all(|(id, _)| *id != GuardId(2)), "back to his round: his search is over");
         m.heard_radio(&nav, RadioAbout::Evidence, at, &[GuardId(1)]);
         assert_eq!(m.searches, vec![(GuardId(1), patrol::orders(&nav, at, rules::EVIDENCE_SPOTS, 1)[0].clone())]);
+    }
+
+    #[test]
+    fn before_a_guard_is_ever_seen_each_one_on_duty_is_imagined_along_his_round_from_its_start() {
+        let level = heist_shared::level::Level::museum();
+        let nav = NavGraph::new(&level);
+        let easy = heist_shared::rules::Difficulty::Easy.tuning(); // two guards on duty
+        let mut m = Memory::default();
+        m.brief(&level, &easy);
+        assert_eq!(m.remembered.len(), 2);
+        let (bruno, _) = &m.remembered[0];
+        assert_eq!(
+            (bruno.position, bruno.facing, bruno.alert),
+            (level.guards[0].route[0], 0.0, GuardAlert::Patrolling)
+        );
+        // Ten seconds in, never seen: imagined ten seconds' walk along his round.
+        m.clock_s = 10.0;
+        let routes: Vec<Vec<Vec2>> = level.guards.iter().map(|g| g.route.clone()).collect();
+        let known = Known { tuning: &easy, nav: &nav, routes: &routes, alarm: 0 };
+        let imagined = m.imagined(&[], &known);
+        let walked = imagined[0].position.distance(level.guards[0].route[0]);
+        assert!((walked - 10.0 * easy.patrol_speed).abs() < 0.05, "walked {walked} m");
+        // Seen once, a guard is remembered as seen, not as briefed.
+        let clara = GuardView { position: Vec2::new(17.0, 15.0), ..m.remembered[1].0.clone() };
+        m.see(&[&clara]);
+        m.brief(&level, &easy);
+        assert_eq!(m.remembered.len(), 2, "briefing again adds nobody");
+        assert!(m.remembered.iter().any(|(g, at)| g.position == clara.position && *at == 10.0));
     }
 
     #[test]

@@ -1,12 +1,14 @@
-//! The Vive bot: plans routes over the room graph, keeps out of guards' sight, breaks cases, carries
-//! copies to the workbench and throws a prop to lure a guard that blocks the way.
+//! The Vive bot: plans timed ways through the museum that keep out of guards' sight (where to step and
+//! when to wait: `crate::spacetime`), breaks cases, carries copies to the workbench and throws a prop
+//! to lure a guard that blocks the way.
 //!
 //! Each frame: what it sees (the replicated state: [`Sight`]) and remembers ([`memory`]) becomes a
 //! [`View`]; an ordered table of choices picks the goal ([`goal`]); the [`decide::Perception`] of
 //! the moment ([`act::perceive`]) goes through the ordered decision table ([`decide`]); the plan is
 //! carried out as a movement and maybe an action ([`act::carry_out`]). The museum it knows
 //! ([`map`]) is built once and kept apart from its memory. It plans only with what a player could
-//! know: the published patrol routes and guard numbers (`heist_shared::rules`), and what it saw.
+//! know: the published patrol routes and guard numbers (`heist_shared::rules`), where each guard on
+//! duty starts, and what it saw and heard since.
 
 use bevy::prelude::*;
 use glam::Vec2;
@@ -158,8 +160,11 @@ impl ViveBrain {
                 memory.heard_radio(&map.nav, *about, *at, answering);
             }
         }
-        memory.see(&sight.guards);
         let tuning = map.tuning(session);
+        if memory.clock_s == 0.0 {
+            memory.brief(&map.level, &tuning);
+        }
+        memory.see(&sight.guards);
         let routes = map.patrols(session, &sight.cases, &sight.items);
         let known = Known { tuning: &tuning, nav: &map.nav, routes: &routes, alarm: session.alarm };
         let imagined = memory.imagined(&sight.guards, &known);

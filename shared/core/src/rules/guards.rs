@@ -134,6 +134,11 @@ pub const SEARCH_SPOTS: usize = 4;
 pub const EVIDENCE_SPOTS: usize = 2;
 /// How long a searching guard looks around at each spot, seconds.
 pub const SEARCH_LOOK_S: f32 = 2.0;
+/// A guard walking to a spot (a noise, a search spot, his round's waypoint) is there this close, metres.
+pub const ARRIVED_M: f32 = 0.8;
+/// How long a guard looks around where he heard or glimpsed something before going back to his round
+/// (or searching), seconds.
+pub const LOOK_AROUND_S: f32 = 3.0;
 
 /// How fast a guard turns, rad/s (a guard at the end of his round sweeps his look round this fast).
 pub const GUARD_TURN_RATE: f32 = 4.0;

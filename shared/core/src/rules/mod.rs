@@ -58,5 +58,6 @@ pub const GUARD_STEP_LOUDNESS: f32 = 15.0;
 
 mod guards;
 pub use guards::{
-    Difficulty, DifficultyTable, EVIDENCE_SPOTS, GUARD_TURN_RATE, GuardTuning, SEARCH_LOOK_S, SEARCH_SPOTS, about_turn,
+    ARRIVED_M, Difficulty, DifficultyTable, EVIDENCE_SPOTS, GUARD_TURN_RATE, GuardTuning, LOOK_AROUND_S, SEARCH_LOOK_S,
+    SEARCH_SPOTS, about_turn,
 };
