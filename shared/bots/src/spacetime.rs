@@ -370,6 +370,18 @@ pub fn plan(grid: &Grid, forecast: &Forecast, walls: &WallSet, from: Vec2, goal:
     Some(Way { steps, arrives, seen_s: (seen_s * TICK_S * 4.0).floor() / 4.0 })
 }
 
+/// The gait to go at now: the plan's, unless Vive standing at `me` would be in a guard's plain sight
+/// within half a second (the plan's cells and ticks are coarse at the edge of a guard's view): then it
+/// creeps on (and the plan is made again if that makes it late).
+pub fn safe_gait(forecast: &Forecast, walls: &WallSet, me: Vec2, gait: Gait) -> Gait {
+    let in_plain_sight = |t: f32| forecast.sighting(&forecast.moment(t), me, false, walls) == Sighting::Seen;
+    if gait != Gait::Crouch && [0.0, TICK_S, 2.0 * TICK_S].into_iter().any(in_plain_sight) {
+        Gait::Crouch
+    } else {
+        gait
+    }
+}
+
 /// What a plan says to do now.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Order {
@@ -613,6 +625,18 @@ mod tests {
         assert!(!timed.seen_ahead(&m.forecast(&[], from), &m.walls, 0.0, from));
         let clara = guard(CLARA, Vec2::new(17.0, 19.0), -std::f32::consts::FRAC_PI_2);
         assert!(timed.seen_ahead(&m.forecast(&[clara], from), &m.walls, 0.0, from), "Clara looks down the way");
+    }
+
+    #[test]
+    fn vive_never_stands_up_in_a_guards_plain_sight_whatever_the_plan_says() {
+        let m = Museum::new();
+        let clara = guard(CLARA, Vec2::new(17.0, 19.0), -std::f32::consts::FRAC_PI_2);
+        let f = m.forecast(&[clara], Vec2::ZERO);
+        let (close, far) = (Vec2::new(17.0, 16.0), Vec2::new(17.0, 19.0 - m.tuning.sight_range - 2.0));
+        assert_eq!(safe_gait(&f, &m.walls, close, Gait::Walk), Gait::Crouch);
+        assert_eq!(safe_gait(&f, &m.walls, close, Gait::Run), Gait::Crouch);
+        assert_eq!(safe_gait(&f, &m.walls, far, Gait::Walk), Gait::Walk, "out of her sight it walks");
+        assert_eq!(safe_gait(&f, &m.walls, far, Gait::Crouch), Gait::Crouch);
     }
 
     #[test]

@@ -86,7 +86,10 @@ pub(crate) fn perceive(
             spacetime::plan(&map.grid, forecast, &map.walls, me, target, reach).map(|w| Timed::new(w, now, target));
     }
     match memory.timed.as_mut().map(|t| t.order(now, me)) {
-        Some(Order::Go(to, gait)) => (p.way, memory.step_to, memory.timed_gait) = (Some(gait), Some(to), gait),
+        Some(Order::Go(to, gait)) => {
+            let gait = spacetime::safe_gait(forecast, &map.walls, me, gait);
+            (p.way, memory.step_to, memory.timed_gait) = (Some(gait), Some(to), gait);
+        }
         Some(Order::Hold) => p.hold = true,
         None => {}
     }
