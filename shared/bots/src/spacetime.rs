@@ -413,9 +413,9 @@ impl Timed {
         Self { way, made_at: now, goal, done: 0 }
     }
 
-    /// What to do at `now` standing at `me`: a step is done once Vive is there and its time has come;
-    /// the next one is waited for until its leaving time (never early: the guards' timing is what
-    /// keeps the way unseen), then walked (late Vive just goes on).
+    /// What to do at `now` standing at `me`: a step is done once Vive is there; the next one is
+    /// waited for until its leaving time (a tick early at most, and only straight on from the last:
+    /// the guards' timing is what keeps the way unseen), then walked (late Vive just goes on).
     pub fn order(&mut self, now: f32, me: Vec2) -> Order {
         let t = now - self.made_at;
         while let Some(step) = self.way.steps.get(self.done) {
@@ -435,40 +435,35 @@ impl Timed {
 
     /// True when, by `forecast` (made at `now`), Vive following the rest of this plan from `me` would
     /// be seen on the way or while it stays at the end: time to plan again. Vive is taken to be where
-    /// the plan has it each quarter second (crouching while it waits, at the step's gait while it
-    /// moves), and checked a tick either side.
+    /// the plan has it each quarter second ([`pose_at`]), and checked a tick either side.
     pub fn seen_ahead(&self, forecast: &Forecast, walls: &WallSet, now: f32, me: Vec2) -> bool {
         let t0 = now - self.made_at;
         let steps = &self.way.steps[self.done.min(self.way.steps.len())..];
         let end = steps.last().map_or(t0, |s| s.arrive_s) + HOLD_S;
-        let mut at = me;
-        let mut t = t0;
-        while t <= end {
-            // Where the plan has Vive at plan time `t`, and whether crouching.
-            let mut pose = (at, true);
-            let mut from = me;
-            for step in steps {
-                if t < step.leave_s {
-                    pose = (from, true);
-                    break;
-                }
-                if t < step.arrive_s {
-                    let f = (t - step.leave_s) / (step.arrive_s - step.leave_s).max(1e-3);
-                    pose = (from.lerp(step.to, f), step.gait == Gait::Crouch);
-                    break;
-                }
-                from = step.to;
-                pose = (from, true);
-            }
-            at = pose.0;
-            let (dt, crouching) = (t - t0, pose.1);
-            if [dt - TICK_S, dt, dt + TICK_S].iter().any(|&d| forecast.seen(at, d.max(0.0), crouching, walls)) {
-                return true;
-            }
-            t += TICK_S;
-        }
-        false
+        let ticks = ((end - t0) / TICK_S).floor().max(0.0) as usize;
+        let moments: Vec<Moment> = (0..=ticks + 1).map(|k| forecast.moment(k as f32 * TICK_S)).collect();
+        (0..=ticks).any(|k| {
+            let (at, crouching) = pose_at(steps, me, t0 + k as f32 * TICK_S);
+            moments[k.saturating_sub(1)..=k + 1].iter().any(|m| forecast.sees(m, at, crouching, walls))
+        })
     }
+}
+
+/// Where `steps`, walked from `from`, have Vive at plan time `t`, and whether it crouches then (while
+/// it waits, and on a crouching step).
+fn pose_at(steps: &[Step], from: Vec2, t: f32) -> (Vec2, bool) {
+    let mut at = from;
+    for step in steps {
+        if t < step.leave_s {
+            return (at, true);
+        }
+        if t < step.arrive_s {
+            let f = (t - step.leave_s) / (step.arrive_s - step.leave_s).max(1e-3);
+            return (at.lerp(step.to, f), step.gait == Gait::Crouch);
+        }
+        at = step.to;
+    }
+    (at, true)
 }
 
 #[cfg(test)]
@@ -512,27 +507,13 @@ mod tests {
     /// Where `way` has Vive every tick from `from` (and whether crouching), to its end and the hold.
     fn walked(way: &Way, from: Vec2) -> Vec<(f32, Vec2, bool)> {
         let end = way.steps.last().map_or(0.0, |s| s.arrive_s) + HOLD_S;
-        let mut out = Vec::new();
-        let mut t = 0.0;
-        while t <= end {
-            let (mut at, mut pose) = (from, (from, true));
-            for step in &way.steps {
-                if t < step.leave_s {
-                    pose = (at, true);
-                    break;
-                }
-                if t < step.arrive_s {
-                    let f = (t - step.leave_s) / (step.arrive_s - step.leave_s);
-                    pose = (at.lerp(step.to, f), step.gait == Gait::Crouch);
-                    break;
-                }
-                at = step.to;
-                pose = (at, true);
-            }
-            out.push((t, pose.0, pose.1));
-            t += TICK_S;
-        }
-        out
+        (0..=(end / TICK_S) as usize)
+            .map(|k| {
+                let t = k as f32 * TICK_S;
+                let (at, crouching) = pose_at(&way.steps, from, t);
+                (t, at, crouching)
+            })
+            .collect()
     }
 
     #[test]

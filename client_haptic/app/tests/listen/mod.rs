@@ -1,12 +1,13 @@
 //! A small isolated-word recognizer for the tests: it hears which words of a closed vocabulary a
 //! recording says, in order. Words are cut where the speech pauses (energy below the recording's loudest
 //! by 35 dB for 150 ms or more: the stop inside "victor" is silent for 70 ms, the pause after a comma
-//! at 120 words a minute is 270 ms or more); each cut is compared with every word of the vocabulary as espeak-ng says
-//! it (the same voice and rate the client speaks with) by dynamic time warping over log-mel spectra with
-//! the mean removed (so the binaural placement's colouring and the level do not matter); a cut whose best
-//! match is not clearly better than the second best (below 0.6 of its distance), or not close at all
-//! (a distance of 7 or more), is no word. Measured on espeak-ng's own sentences: a word of the vocabulary
-//! scores 1.3–4.9 against its template and 9 or more against every other.
+//! at 120 words a minute is 270 ms or more); each cut is compared with every word of the vocabulary as
+//! espeak-ng says it (the same voice and rate the client speaks with) by dynamic time warping over
+//! log-mel spectra with the mean removed (so the binaural placement's colouring and the level do not
+//! matter); a cut whose best match is not clearly better than the second best (below 0.6 of its
+//! distance), or not close at all (a distance of 7 or more), is no word. Measured on espeak-ng's own
+//! sentences: a word of the vocabulary scores 1.3–4.9 against its template and 9 or more against every
+//! other.
 //!
 //! You need this module to check what the client *said* from its audio alone (`--wav`), not from what it
 //! printed.

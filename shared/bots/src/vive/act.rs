@@ -69,7 +69,7 @@ pub(crate) fn perceive(
         return p;
     }
     // The timed way: to the goal, or, at it, whether staying is safe (else away and back later).
-    memory.step_to = None;
+    memory.step = None;
     let now = memory.clock_s;
     // A plan is kept while it stays unseen by what the bot sees now (made again now and then, to
     // find a quicker way as guards move on); one that was seen anyway (the least seen there was) is
@@ -88,7 +88,7 @@ pub(crate) fn perceive(
     match memory.timed.as_mut().map(|t| t.order(now, me)) {
         Some(Order::Go(to, gait)) => {
             let gait = spacetime::safe_gait(forecast, &map.walls, me, gait);
-            (p.way, memory.step_to, memory.timed_gait) = (Some(gait), Some(to), gait);
+            (p.way, memory.step) = (Some(gait), Some((to, gait)));
         }
         Some(Order::Hold) => p.hold = true,
         None => {}
@@ -163,7 +163,7 @@ pub(crate) fn carry_out(
     memory.walked(me);
     match plan {
         Plan::Go(gait) => {
-            let waypoint = memory.step_to.or(memory.route.last().copied()).unwrap_or(me);
+            let waypoint = memory.step.map(|(to, _)| to).or(memory.route.last().copied()).unwrap_or(me);
             ((waypoint - me).normalize_or_zero(), gait, None)
         }
         Plan::Act(action) => {
@@ -190,9 +190,9 @@ pub(crate) fn carry_out(
         }
         Plan::Hide => {
             // The timed way is the least seen there is; without one, the nearest hiding place.
-            let (direction, gait) = match (memory.timed.as_ref().map(|t| t.way.steps.is_empty()), memory.step_to) {
-                (_, Some(to)) => ((to - me).normalize_or_zero(), memory.timed_gait),
-                (Some(_), None) => (Vec2::ZERO, Gait::Crouch),
+            let (direction, gait) = match (memory.step, &memory.timed) {
+                (Some((to, gait)), _) => ((to - me).normalize_or_zero(), gait),
+                (None, Some(_)) => (Vec2::ZERO, Gait::Crouch),
                 (None, None) => hide(map, memory, view, forecast),
             };
             (direction, gait, None)

@@ -31,8 +31,7 @@ pub(crate) struct Memory {
     /// The timed way (space and time) it is carrying out, if any.
     pub timed: Option<Timed>,
     /// Where the timed way says to head this frame, and at which gait.
-    pub step_to: Option<Vec2>,
-    pub timed_gait: Gait,
+    pub step: Option<(Vec2, Gait)>,
     /// Progress towards the goal: (goal, the closest the bot has come to it, when it last came a metre
     /// closer). Waiting and hiding make none; a frame's step forward and back again does not count.
     pub progress: Option<(Vec2, f32, f32)>,
@@ -99,7 +98,7 @@ impl Memory {
                 continue;
             }
             let (start, next) = (g.route[0], g.route.get(1).copied().unwrap_or(g.route[0]));
-            let facing = (next - start).y.atan2((next - start).x);
+            let facing = (next - start).to_angle();
             let view = GuardView { id, name: g.name.clone(), position: start, facing, alert: GuardAlert::Patrolling };
             self.remembered.push((view, self.clock_s));
         }
