@@ -122,21 +122,7 @@ impl Game {
             return Err(Refusal::NotCarried);
         }
         self.take_from_hands(id)?;
-        let from = self.vive.position;
-        let mut aim = target - from;
-        if aim.length() > rules::THROW_RANGE {
-            aim = aim.normalize() * rules::THROW_RANGE;
-        }
-        // The object flies until it would hit a wall; it lands just before it.
-        let mut landing = from;
-        let steps = (aim.length() / 0.25).ceil().max(1.0) as usize;
-        for s in 1..=steps {
-            let p = from + aim * (s as f32 / steps as f32);
-            if self.walls.walls.iter().any(|w| w.intersects(landing, p)) || self.level.room_at(p).is_none() {
-                break;
-            }
-            landing = p;
-        }
+        let landing = rules::throw_landing(&self.level, &self.walls, self.vive.position, target);
         self.items[usize::from(id.0)].place = ItemPlace::Floor(landing);
         self.noise(NoiseKind::Thud, landing, rules::THUD_LOUDNESS);
         Ok(())

@@ -25,6 +25,8 @@ const FLEE_ON_S: f32 = 5.0;
 const REPLAN_S: f32 = 3.0;
 /// Seconds a timed way is followed at least before it is made again because it will be seen.
 const QUICK_REPLAN_S: f32 = 0.25;
+/// A lure lands at least this much farther from Vive than the guard it draws, metres.
+const LURE_BEYOND_M: f32 = 1.0;
 /// How long an item given up on stays given up, seconds.
 const AVOID_FOR_S: f32 = 60.0;
 
@@ -125,10 +127,32 @@ pub(crate) fn perceive(
             .copied()
             .find(|&i| view.items.iter().any(|it| it.id == i && matches!(it.kind, ItemKind::Prop)));
         if let (Some(g), Some(prop)) = (nearest, prop) {
-            p.lure = Some((prop, g.position + (g.position - me).normalize_or_zero() * 7.0));
+            let hearing = view.tuning.hearing_at(view.alarm);
+            p.lure = lure_aim(map, me, g.position, hearing).map(|aim| (prop, aim));
         }
     }
     p
+}
+
+/// Where to throw a prop so that a guard at `guard` walks away from Vive at `me`: of a few aims past
+/// him, the one that lands farthest from Vive, of those that land beyond him (seen from Vive) and
+/// within his hearing. `None` when every throw would hit a wall short of him (a thud by Vive's feet
+/// would draw him to her).
+fn lure_aim(map: &Map, me: Vec2, guard: Vec2, hearing: f32) -> Option<Vec2> {
+    let ahead = guard - me;
+    if ahead.length() < 0.1 {
+        return None;
+    }
+    [0.0f32, 0.3, -0.3, 0.6, -0.6]
+        .into_iter()
+        .map(|turn| me + Vec2::from_angle(turn).rotate(ahead.normalize()) * rules::THROW_RANGE)
+        .map(|aim| (aim, rules::throw_landing(&map.level, &map.walls, me, aim)))
+        .filter(|(_, landing)| {
+            landing.distance(me) > ahead.length() + LURE_BEYOND_M
+                && map.nav.heard_margin(*landing, guard, rules::THUD_LOUDNESS * hearing) >= 0.0
+        })
+        .max_by(|a, b| a.1.distance(me).total_cmp(&b.1.distance(me)))
+        .map(|(aim, _)| aim)
 }
 
 /// Keeps a route to `target` in memory, away from rooms with guards in them (straight for a reckless
@@ -302,4 +326,25 @@ fn points_along(from: Vec2, route: &[Vec2]) -> Vec<Vec2> {
         at = wp;
     }
     points
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use heist_shared::level::Level;
+
+    #[test]
+    fn a_lure_lands_beyond_the_guard_never_at_vives_feet() {
+        let map = Map::new(&Level::museum());
+        // In the workshop by the wall to the sculpture hall, the guard beyond that wall: every throw
+        // towards him hits the wall at Vive's side and would bring him to her.
+        let (me, guard) = (Vec2::new(8.5, 11.5), Vec2::new(19.0, 12.3));
+        assert_eq!(lure_aim(&map, me, guard, 1.0), None);
+        // In the open gallery: the prop lands past him, where he hears it.
+        let (me, guard) = (Vec2::new(13.0, 3.0), Vec2::new(17.0, 4.0));
+        let aim = lure_aim(&map, me, guard, 1.0).expect("a throw past him");
+        let landing = rules::throw_landing(&map.level, &map.walls, me, aim);
+        assert!(landing.distance(me) > guard.distance(me) + LURE_BEYOND_M, "lands at {landing}");
+        assert!(map.nav.heard_margin(landing, guard, rules::THUD_LOUDNESS) >= 0.0);
+    }
 }
