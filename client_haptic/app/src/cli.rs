@@ -109,6 +109,10 @@ pub struct ClientArgs {
     /// Device preset the sim device copies (e.g. touch, falcon, premium); default Phantom Desktop.
     #[arg(long)]
     pub preset: Option<String>,
+    /// Record the device's every tick (state read, force commanded) to this trace file (`haptico trace
+    /// v2`, docs/haptics.md): replay it with `--device trace:FILE` or `haptic-bench --replay FILE`.
+    #[arg(long)]
+    pub record: Option<PathBuf>,
     /// No window: sound and touch only.
     #[arg(long)]
     pub headless: bool,
@@ -191,6 +195,7 @@ impl ClientArgs {
             haptics: HapticsSettings {
                 device: self.device.clone(),
                 preset: self.preset.clone(),
+                record: self.record.clone(),
                 spheres: self.spheres,
                 cache_dir: cache,
                 realtime_priority: self.realtime,

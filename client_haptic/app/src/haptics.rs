@@ -17,6 +17,7 @@ use forcecomp::Material;
 use glam::Vec3;
 use haptic_common::Pose;
 use haptic_rig::{ForceSample, HapticRig, ObjectSpec, RigConfig, StepTiming, ToolSpec, WorkspaceMap};
+use haptico::trace::TraceWriter;
 use haptico::{Device, DeviceSpecs, HapticEvents, TickTiming};
 use heist_shared::artifact::{self, HapticMesh};
 use heist_shared::protocol::{ItemId, WorkbenchCopy};
@@ -42,6 +43,8 @@ pub struct HapticsSettings {
     pub device: DeviceChoice,
     /// Device preset the sim device copies (default the Phantom Desktop).
     pub preset: Option<String>,
+    /// Record the device's ticks to this trace file (default none).
+    pub record: Option<PathBuf>,
     /// Spheres per copy's tree (default 3000).
     pub spheres: usize,
     /// Where built trees are cached (default none).
@@ -52,7 +55,14 @@ pub struct HapticsSettings {
 
 impl Default for HapticsSettings {
     fn default() -> Self {
-        Self { device: DeviceChoice::Sim, preset: None, spheres: 3000, cache_dir: None, realtime_priority: None }
+        Self {
+            device: DeviceChoice::Sim,
+            preset: None,
+            record: None,
+            spheres: 3000,
+            cache_dir: None,
+            realtime_priority: None,
+        }
     }
 }
 
@@ -89,6 +99,11 @@ type BuiltTree = Result<(InnerSphereTree, bool), String>;
 /// is the game thread's handle).
 pub struct Haptics {
     rig: HapticRig<Box<dyn Device>>,
+    /// Writes the recorded ticks (`--record`); declared after the rig, so that it is dropped after the
+    /// haptic thread stopped and writes every tick.
+    recording: Option<TraceWriter>,
+    /// Ticks the recording had lost when last told.
+    recording_lost: u64,
     /// Moves the simulated hand (sim device only).
     pub hand: Option<HandControl>,
     /// The device's limits.
@@ -115,6 +130,14 @@ impl Haptics {
     pub fn start(settings: HapticsSettings) -> Result<Self, ClientError> {
         let specs = device::preset(settings.preset.as_deref())?;
         let (device, hand) = device::open(&settings.device, specs.clone())?;
+        let (device, recording): (Box<dyn Device>, _) = match &settings.record {
+            Some(path) => {
+                let (device, writer) = haptico::trace::record(device, path)
+                    .map_err(|e| ClientError::Device(format!("recording the device: {e}")))?;
+                (Box::new(device), Some(writer))
+            }
+            None => (device, None),
+        };
         let specs = device.specs().clone();
         let gem = collette::scene::brilliant_cut(TOOL_DIAMETER_M);
         let (tree, _) = collette::build(&gem, &BuildOptions::spheres(TOOL_SPHERES), &mut |_| {})
@@ -132,6 +155,8 @@ impl Haptics {
         let rig = HapticRig::start(device, tool, config, HapticEvents::default(), haptic_common::Delegator::new())?;
         Ok(Self {
             rig,
+            recording,
+            recording_lost: 0,
             hand,
             specs,
             map,
@@ -197,6 +222,16 @@ impl Haptics {
         self.samples.clear();
         self.rig.drain_force_samples(&mut self.samples);
         self.drain_rates();
+        if let Some(writer) = &self.recording
+            && writer.dropped() > self.recording_lost
+        {
+            self.recording_lost = writer.dropped();
+            log::warn!(
+                "the trace {} has lost {} ticks: the disk is too slow",
+                writer.path().display(),
+                self.recording_lost
+            );
+        }
         let (item, rx, material) = self.building.as_ref()?;
         let (item, material) = (*item, *material);
         let built = match rx.try_recv() {

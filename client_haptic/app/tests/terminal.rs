@@ -11,8 +11,10 @@ mod common;
 use common::{headless, headless_with_cache, hear, host_with_a_vive_bot, wait};
 
 #[test]
-fn headless_practice_prints_each_spoken_line_once_and_nothing_else() {
-    let (mut child, mut stdin, rx) = headless(&["practice", "--kind", "crown", "--seed", "3"]);
+fn headless_practice_prints_each_spoken_line_once_and_nothing_else_and_records_the_device() {
+    let trace = std::env::temp_dir().join(format!("phantom-practice-{}.trace", std::process::id()));
+    let trace_arg = trace.to_str().expect("utf-8 path");
+    let (mut child, mut stdin, rx) = headless(&["practice", "--kind", "crown", "--seed", "3", "--record", trace_arg]);
     let mut stderr = child.stderr.take().expect("stderr");
     let log = std::thread::spawn(move || {
         let mut s = String::new();
@@ -79,6 +81,13 @@ fn headless_practice_prints_each_spoken_line_once_and_nothing_else() {
     for noise in ["INFO", "DEBUG", "haptic loop", "SAY", "said:", "\u{1b}["] {
         assert!(!log.contains(noise), "the log is quiet by default, yet has {noise:?}: {log}");
     }
+    // `--record`: the device's every tick of the practice, in the documented format, to its end.
+    let recorded = haptico::trace::load_trace(&trace).expect("the trace reads back");
+    let states = &recorded.states;
+    let span_s = (states.last().expect("ticks").timestamp_us - states[0].timestamp_us) as f64 * 1e-6;
+    assert!(span_s > 3.0 && states.len() as f64 > 0.8 * 1000.0 * span_s, "{} ticks over {span_s:.1} s", states.len());
+    assert_eq!(recorded.commands.map(|c| c.len()), Some(states.len()));
+    std::fs::remove_file(&trace).ok();
 }
 
 #[test]

@@ -10,10 +10,13 @@ use anyhow::Context;
 use clap::Parser;
 use collette::scene;
 use forcecomp::Material;
-use haptic_common::{Delegator, Pose};
+use glam::Vec3;
+use haptic_common::{Delegator, ForceTorque, Pose};
+use haptic_rig::lockstep::Lockstep;
 use haptic_rig::{CollisionConfig, HapticRig, ObjectSpec, RigConfig, ToolSpec, bench};
 use haptico::sim::{Keyframe, SimConfig, SimDevice, TargetPath};
-use haptico::{HapticConfig, HapticEvents, presets};
+use haptico::trace::{self, Trace, TraceDevice, TraceWriter};
+use haptico::{Device, HapticConfig, HapticEvents, presets};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -61,6 +64,18 @@ struct Args {
     /// Print the summary as one JSON object, last.
     #[arg(long)]
     json: bool,
+    /// Record the device's every tick (state read, force commanded) to this trace file (`haptico trace
+    /// v2`, docs/haptics.md).
+    #[arg(long)]
+    record: Option<PathBuf>,
+    /// Drive the loop with a recorded trace instead of the scripted hand (at most `--seconds` of it).
+    /// With `--lockstep`, the forces are compared with the recorded ones, tick by tick.
+    #[arg(long)]
+    replay: Option<PathBuf>,
+    /// Run both stages in one thread on simulated time, exact queries every tick (deterministic: a
+    /// replay of a lockstep recording gives the recorded forces to the bit). Prints forces, no rates.
+    #[arg(long)]
+    lockstep: bool,
 }
 
 /// Errors end the program on one line (`error: what: why`), never with a backtrace, even with
@@ -100,13 +115,30 @@ fn run() -> anyhow::Result<()> {
         gem.spheres().len()
     );
 
-    // The hand follows the scripted tool path; the device frame is the scene frame (metres).
-    let path = scene::trajectory(&bunny_mesh);
-    let keyframes: Vec<Keyframe> = path.iter().map(|s| Keyframe { t_s: s.time_s, pose: s.tool }).collect();
-    let device = SimDevice::new(
-        SimConfig { jitter_us: args.jitter_us, ..SimConfig::new(specs.clone()) },
-        TargetPath::Keyframes(keyframes),
-    );
+    // The hand follows the scripted tool path (or a recorded trace); the device frame is the scene
+    // frame (metres).
+    let replay = match &args.replay {
+        Some(file) => Some(trace::load_trace(file).with_context(|| format!("reading the trace {}", file.display()))?),
+        None => None,
+    };
+    let device: Box<dyn Device> = match &replay {
+        Some(t) => Box::new(TraceDevice::new(specs.clone(), t.states.clone(), false).context("the trace")?),
+        None => {
+            let path = scene::trajectory(&bunny_mesh);
+            let keyframes: Vec<Keyframe> = path.iter().map(|s| Keyframe { t_s: s.time_s, pose: s.tool }).collect();
+            Box::new(SimDevice::new(
+                SimConfig { jitter_us: args.jitter_us, ..SimConfig::new(specs.clone()) },
+                TargetPath::Keyframes(keyframes),
+            ))
+        }
+    };
+    let (device, recording): (Box<dyn Device>, _) = match &args.record {
+        Some(file) => {
+            let (device, writer) = trace::record(device, file).context("recording")?;
+            (Box::new(device), Some(writer))
+        }
+        None => (device, None),
+    };
     let ticks = (args.seconds * args.rate_hz as f64) as usize + 1000;
     let config = RigConfig {
         haptic: HapticConfig {
@@ -131,6 +163,9 @@ fn run() -> anyhow::Result<()> {
     let tool = ToolSpec::new(Arc::new(gem), Material { stiffness_n_per_m3: 5e8, damping_ns_per_m: 4.0, friction: 0.3 });
     let bunny_material = Material { stiffness_n_per_m3: 5e7, damping_ns_per_m: 4.0, friction: 0.3 };
     let bunny = ObjectSpec { id: 1, tree: Arc::new(bunny), pose: Pose::IDENTITY, material: bunny_material };
+    if args.lockstep {
+        return lockstep(&args, device, tool, bunny, &config, replay.as_ref(), recording);
+    }
     let collette_mode = match args.collision.as_str() {
         "rig" => false,
         "collette" => true,
@@ -168,6 +203,9 @@ fn run() -> anyhow::Result<()> {
     rig.drain_collision_timings(&mut collision);
     rig.drain_force_samples(&mut forces);
     rig.stop();
+    if let Some(writer) = recording {
+        say_recorded(writer)?;
+    }
 
     if collette_mode {
         collision = bench::steps_from_sequences(&forces);
@@ -254,6 +292,88 @@ fn run() -> anyhow::Result<()> {
         });
         println!("{json}");
     }
+    Ok(())
+}
+
+/// The run on simulated time (`--lockstep`): every tick of the scripted path, or of the replayed
+/// trace at its own times; with a replay of a trace holding commands, how many ticks' forces are the
+/// recorded ones to the bit.
+fn lockstep(
+    args: &Args,
+    device: Box<dyn Device>,
+    tool: ToolSpec,
+    bunny: ObjectSpec,
+    config: &RigConfig,
+    replay: Option<&Trace>,
+    recording: Option<TraceWriter>,
+) -> anyhow::Result<()> {
+    let period_us = (1e6 / args.rate_hz as f64).round() as u64;
+    let last_us = (args.seconds * 1e6) as u64;
+    let times: Vec<u64> = match replay {
+        Some(t) => {
+            let first = t.states[0].timestamp_us;
+            t.states.iter().map(|s| s.timestamp_us).take_while(|&t| t - first < last_us).collect()
+        }
+        None => (0..last_us / period_us).map(|i| i * period_us).collect(),
+    };
+    let mut rig = Lockstep::new(device, tool, config, 1, None)?;
+    rig.add_object(bunny)?;
+    let started = Instant::now();
+    let forces: Vec<ForceTorque> = times.iter().map(|&t| rig.tick(t)).collect();
+    let elapsed = started.elapsed();
+    let safety = rig.telemetry().safety;
+    drop(rig);
+    if let Some(writer) = recording {
+        say_recorded(writer)?;
+    }
+    let max_f = forces.iter().map(|f| f.force.length()).fold(0.0f32, f32::max);
+    let max_tau = forces.iter().map(|f| f.torque.length()).fold(0.0f32, f32::max);
+    let in_contact = forces.iter().filter(|f| f.force != Vec3::ZERO).count();
+    println!(
+        "haptic-bench --lockstep: {} ticks in {:.2} s ({:.0} us per tick, exact queries); ticks with a force {}; max |F| {:.2} N, max |tau| {:.3} N.m; safety {:?}",
+        forces.len(),
+        elapsed.as_secs_f64(),
+        elapsed.as_secs_f64() * 1e6 / forces.len().max(1) as f64,
+        in_contact,
+        max_f,
+        max_tau,
+        safety
+    );
+    let compared = replay.and_then(|t| t.commands.as_deref()).map(|recorded| {
+        let same = forces.iter().zip(recorded).filter(|(a, b)| bits(a) == bits(b)).count();
+        let worst = forces.iter().zip(recorded).map(|(a, b)| (a.force - b.force).length()).fold(0.0f32, f32::max);
+        println!(
+            "replay: {same} of {} ticks' forces are the recorded ones to the bit; largest force difference {worst:.3e} N",
+            forces.len()
+        );
+        (same, worst)
+    });
+    if args.json {
+        let json = serde_json::json!({
+            "lockstep": true,
+            "ticks": forces.len(),
+            "seconds_wall": elapsed.as_secs_f64(),
+            "ticks_with_force": in_contact,
+            "max_force_n": max_f,
+            "max_torque_nm": max_tau,
+            "replay_identical_ticks": compared.map(|c| c.0),
+            "replay_max_force_difference_n": compared.map(|c| c.1),
+        });
+        println!("{json}");
+    }
+    Ok(())
+}
+
+/// The bits of a force and torque (so that -0.0 and 0.0 differ, as they would in a file).
+fn bits(f: &ForceTorque) -> [u32; 6] {
+    [f.force.x, f.force.y, f.force.z, f.torque.x, f.torque.y, f.torque.z].map(f32::to_bits)
+}
+
+/// Closes a recording and says what it wrote.
+fn say_recorded(writer: TraceWriter) -> anyhow::Result<()> {
+    let path = writer.path().to_owned();
+    let stats = writer.finish().context("recording")?;
+    eprintln!("haptic-bench: recorded {} ticks to {} ({} lost)", stats.written, path.display(), stats.dropped);
     Ok(())
 }
 
