@@ -2,7 +2,7 @@
 //!
 //! - [`penalty`]: the volumetric penalty force (Eq. 1) and torque (Eq. 2) from an Inner Sphere Tree
 //!   contact set, with per-object [`Material`]s;
-//! - [`proxy`]: the 3-DOF proxy force for point tools;
+//! - [`proxy`]: the 3-DOF god-object (proxy) force for point tools on an Inner Sphere Tree's spheres;
 //! - [`coupling`]: virtual coupling between the device and a simulated tool, for stable 6-DOF rendering;
 //! - [`safety`]: the layer applied last, always — clamps, force-rate limit, start-up engagement,
 //!   watchdog, NaN/inf removal.
@@ -23,5 +23,5 @@ pub use coupling::{CouplingConfig, VirtualCoupling};
 pub use error::{ForceCompError, Result};
 pub use material::{BodyMotion, Material};
 pub use penalty::volumetric_penalty;
-pub use proxy::{Proxy3Dof, ProxyConfig};
+pub use proxy::{Ball, GodObject, ProxyConfig};
 pub use safety::{SafetyConfig, SafetyLayer, SafetyPhase, SafetyStats};

@@ -1,32 +1,51 @@
-//! The 3-DOF proxy (god-object) force for point tools.
+//! The 3-DOF god-object (proxy) force for point tools on an Inner Sphere Tree's spheres.
 //!
-//! You need this module when the tool is a point (a stylus tip). The proxy stays on the surface while
-//! the device point sinks in; a spring pulls the device towards the proxy. Friction keeps the proxy in
-//! place while the tangential pull stays inside the friction cone.
+//! You need this module for 3-DOF devices (Touch, Omni, Falcon, Inverse3: a stylus tip, force only).
+//! The object is given as its inner spheres near the tip ([`Ball`]s, from the collision thread). The
+//! tip is a small ball of radius `tip_radius`; the surface it is held on is where the tip's overlap with
+//! the inner spheres is a small fixed volume (a cap [`SURFACE_CAP`] × `tip_radius` high). That surface
+//! is smooth (the lens volume is C¹ in the tip's position, as in the volumetric force), so the proxy
+//! slides over an inner-sphere packing without catching in the gaps between spheres, as a point on the
+//! union of the spheres would.
 //!
-//! Point-probe contacts use [`haptic_common::Contact`] this way: `point` is the probe position,
-//! `normal` the outward surface normal, `depth` the penetration, so the surface point is
-//! `point + depth · normal`.
+//! Each tick the proxy slides along that surface towards the device point (tangential steps, each
+//! followed by a Newton step back onto the surface); friction keeps it in place while the pull along the
+//! surface stays inside the friction cone. A spring from the device to the proxy is the force, so the
+//! force grows with the penetration and points out of the object; the proxy leaves the surface only
+//! when the way back to the device is free, so a thin part cannot be pushed through.
+
+use std::f32::consts::PI;
 
 use glam::Vec3;
-use haptic_common::ContactSet;
 
 use crate::error::{Result, non_negative, positive};
+
+/// A sphere of the object, in the frame the device point is given in.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Ball {
+    /// Centre.
+    pub center: Vec3,
+    /// Radius.
+    pub radius: f32,
+}
 
 /// Parameters of the proxy force.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ProxyConfig {
-    /// Spring between proxy and device, N/m (default 300).
+    /// Spring between proxy and device, N/m (default 300); clamp it to the device's stiffness limit.
     pub stiffness_n_per_m: f32,
-    /// Damping of the approach speed along the contact normal, N·s/m (default 0.5).
+    /// Damping of the device's speed into the surface, N·s/m (default 0.5).
     pub damping_ns_per_m: f32,
-    /// Static friction coefficient (default 0.3).
+    /// Coulomb friction coefficient (default 0.3).
     pub friction: f32,
+    /// Radius of the tip ball, in the balls' units (default 0.002); make it at least the spacing of
+    /// the inner spheres near the surface, so that the surface it feels is smooth.
+    pub tip_radius: f32,
 }
 
 impl Default for ProxyConfig {
     fn default() -> Self {
-        Self { stiffness_n_per_m: 300.0, damping_ns_per_m: 0.5, friction: 0.3 }
+        Self { stiffness_n_per_m: 300.0, damping_ns_per_m: 0.5, friction: 0.3, tip_radius: 0.002 }
     }
 }
 
@@ -35,147 +54,375 @@ impl ProxyConfig {
     pub fn validate(&self) -> Result<()> {
         positive("stiffness_n_per_m", self.stiffness_n_per_m)?;
         non_negative("damping_ns_per_m", self.damping_ns_per_m)?;
-        non_negative("friction", self.friction)
+        non_negative("friction", self.friction)?;
+        positive("tip_radius", self.tip_radius)
     }
 }
 
+/// The surface is where the tip overlaps the object by a cap this high, as a fraction of its radius.
+pub const SURFACE_CAP: f32 = 0.2;
+/// Tangential steps per update, each at most half the tip's radius (so the proxy follows the device at
+/// up to 4 tip radii per tick) and followed by Newton steps back onto the surface.
+const SLIDE_STEPS: usize = 8;
+/// Points checked on the way from the proxy back to the device before it lets go of the surface.
+const RELEASE_SAMPLES: usize = 8;
+
 /// The proxy's state.
-#[derive(Clone, Debug)]
-pub struct Proxy3Dof {
-    config: ProxyConfig,
-    proxy: Vec3,
+#[derive(Clone, Debug, Default)]
+pub struct GodObject {
+    /// Where the proxy was last tick (`None` before the first update).
+    last: Option<Vec3>,
     in_contact: bool,
 }
 
-impl Proxy3Dof {
-    /// A proxy that starts on the device.
-    pub fn new(config: ProxyConfig) -> Self {
-        Self { config, proxy: Vec3::ZERO, in_contact: false }
+impl GodObject {
+    /// A proxy not yet in contact (it starts on the device).
+    pub fn new() -> Self {
+        Self::default()
     }
 
-    /// The proxy position, m.
+    /// The proxy position (the device point while free).
     pub fn proxy(&self) -> Vec3 {
-        self.proxy
+        self.last.unwrap_or(Vec3::ZERO)
     }
 
-    /// True when the last update found contact.
+    /// True while the proxy is held on a surface.
     pub fn in_contact(&self) -> bool {
         self.in_contact
     }
 
-    /// Updates the proxy for a device point at `device` moving at `velocity` against `contacts`, and
-    /// returns the force on the device, N. Allocation-free; non-finite contacts are ignored.
-    pub fn update(&mut self, device: Vec3, velocity: Vec3, contacts: &ContactSet) -> Vec3 {
-        if !device.is_finite() {
+    /// Moves the proxy for the device point `device` against `balls` (both in the balls' frame) and
+    /// returns the force on the device along that frame's axes, N: k × (proxy − device) / `scale`, where
+    /// `scale` is how many of the balls' units make one metre at the device, plus damping of the device's
+    /// `velocity` (m/s, along the same axes) into the surface. Allocation-free; non-finite or empty balls
+    /// are ignored.
+    pub fn update(&mut self, config: &ProxyConfig, device: Vec3, velocity: Vec3, balls: &[Ball], scale: f32) -> Vec3 {
+        if !device.is_finite() || config.tip_radius.is_nan() || config.tip_radius <= 0.0 {
             return Vec3::ZERO;
         }
-        let planes = || {
-            contacts.as_slice().iter().filter_map(|c| {
-                let n = c.normal.try_normalize()?;
-                let s = c.point + n * c.depth;
-                (s.is_finite() && c.depth.is_finite()).then_some((n, s))
-            })
+        let surface = Surface {
+            balls,
+            tip: config.tip_radius,
+            level: cap_volume(config.tip_radius, SURFACE_CAP * config.tip_radius),
         };
-        // Project the device point out of every constraint half-space (a few sweeps settle corners).
-        let project = |mut p: Vec3| {
-            for _ in 0..4 {
-                for (n, s) in planes() {
-                    let d = (p - s).dot(n);
-                    if d < 0.0 {
-                        p -= d * n;
-                    }
-                }
+        let last = self.last.filter(|p| p.is_finite()).unwrap_or(device);
+        let start = if self.in_contact {
+            if surface.volume(device) <= surface.level && surface.way_is_free(last, device) {
+                return self.release(device);
             }
-            p
+            surface.project(last)
+        } else {
+            if surface.volume(device) <= surface.level {
+                return self.release(device);
+            }
+            // Coming from free space: the proxy meets the surface where the path from last tick's
+            // position (outside) entered it.
+            surface.entry(last, device)
         };
-        let candidate = project(device);
-        if candidate == device {
-            self.proxy = device;
-            self.in_contact = false;
-            return Vec3::ZERO;
+        let free = surface.slide(start, device);
+        let mut proxy = free;
+        if self.in_contact {
+            // Friction: stay put while the slide is inside the cone mu × penetration; else slide by
+            // what exceeds it.
+            let penetration = (free - device).length();
+            let slide = free - start;
+            let (len, cone) = (slide.length(), config.friction * penetration);
+            proxy = if len <= cone { start } else { surface.slide(start, start + slide * ((len - cone) / len)) };
         }
-        let mut proxy = candidate;
-        if self.in_contact && self.proxy.is_finite() {
-            // Friction: stay put while the tangential offset is inside the cone mu * penetration.
-            let held = project(self.proxy);
-            let penetration = (candidate - device).length();
-            let slide = candidate - held;
-            let cone = self.config.friction * penetration;
-            let len = slide.length();
-            proxy = if len <= cone { held } else { held + slide * ((len - cone) / len) };
-        }
-        self.proxy = proxy;
+        self.last = Some(proxy);
         self.in_contact = true;
-        let spring = self.config.stiffness_n_per_m * (proxy - device);
+        let spring = (proxy - device) * (config.stiffness_n_per_m / scale.max(f32::MIN_POSITIVE));
         let n = spring.normalize_or_zero();
-        let approach = velocity.dot(n).min(0.0); // only damp motion into the surface
-        let force = spring - self.config.damping_ns_per_m * approach * n;
+        let into = velocity.dot(n).min(0.0); // damp only motion into the surface
+        let force = spring - config.damping_ns_per_m * into * n;
         if force.is_finite() { force } else { Vec3::ZERO }
     }
+
+    fn release(&mut self, device: Vec3) -> Vec3 {
+        self.last = Some(device);
+        self.in_contact = false;
+        Vec3::ZERO
+    }
+}
+
+/// The surface the tip is held on: where its overlap volume with the balls is `level`.
+struct Surface<'a> {
+    balls: &'a [Ball],
+    tip: f32,
+    level: f32,
+}
+
+impl Surface<'_> {
+    fn valid(&self) -> impl Iterator<Item = &Ball> {
+        self.balls.iter().filter(|b| b.center.is_finite() && b.radius.is_finite() && b.radius > 0.0)
+    }
+
+    /// The tip's overlap volume with the balls at `p`.
+    fn volume(&self, p: Vec3) -> f32 {
+        self.valid().map(|b| lens_volume(self.tip, b.radius, p.distance(b.center))).sum()
+    }
+
+    /// The overlap volume at `p` and its gradient (pointing into the object).
+    fn volume_and_gradient(&self, p: Vec3) -> (f32, Vec3) {
+        let (mut v, mut g) = (0.0, Vec3::ZERO);
+        for b in self.valid() {
+            let delta = p - b.center;
+            let d = delta.length();
+            v += lens_volume(self.tip, b.radius, d);
+            if d > 1e-12 {
+                g -= delta / d * (PI * lens_circle_sq(self.tip, b.radius, d));
+            }
+        }
+        (v, g)
+    }
+
+    /// `p` moved onto the surface along the gradient (up to five Newton steps of at most half the tip's radius;
+    /// unchanged where the volume has no gradient).
+    fn project(&self, mut p: Vec3) -> Vec3 {
+        for _ in 0..5 {
+            let (v, g) = self.volume_and_gradient(p);
+            let gg = g.length_squared();
+            if !(gg > 0.0 && v.is_finite()) {
+                break;
+            }
+            p -= (g * ((v - self.level) / gg)).clamp_length_max(0.5 * self.tip);
+        }
+        p
+    }
+
+    /// True when `p` is on the surface (within 5 % of the level).
+    fn on_surface(&self, p: Vec3) -> bool {
+        (self.volume(p) - self.level).abs() <= 0.05 * self.level
+    }
+
+    /// Slides from `from` (on the surface) towards `goal` along the surface: the tangential part of
+    /// the way (at most half the tip's radius at a time), then back onto the surface, a few times;
+    /// a step that does not come back onto the surface (a crease) is not taken. Ends at the surface
+    /// point nearest `goal` around `from`.
+    fn slide(&self, from: Vec3, goal: Vec3) -> Vec3 {
+        let mut p = from;
+        for _ in 0..SLIDE_STEPS {
+            let (_, g) = self.volume_and_gradient(p);
+            let Some(n) = (-g).try_normalize() else { break };
+            let way = goal - p;
+            let mut step = (way - way.dot(n) * n).clamp_length_max(0.5 * self.tip);
+            // Over a crease the Newton steps may not come back onto the surface: try shorter steps.
+            let mut next = None;
+            for _ in 0..4 {
+                if step.length_squared() < 1e-18 {
+                    break;
+                }
+                let candidate = self.project(p + step);
+                if self.on_surface(candidate) {
+                    next = Some(candidate);
+                    break;
+                }
+                step *= 0.5;
+            }
+            match next {
+                Some(q) => p = q,
+                None => break,
+            }
+        }
+        p
+    }
+
+    /// Where the way from `outside` (under the level) to `inside` (over it) crosses the surface
+    /// (bisection).
+    fn entry(&self, outside: Vec3, inside: Vec3) -> Vec3 {
+        if self.volume(outside) > self.level {
+            return self.project(outside);
+        }
+        let (mut a, mut b) = (outside, inside);
+        for _ in 0..20 {
+            let m = (a + b) * 0.5;
+            if self.volume(m) > self.level { b = m } else { a = m }
+        }
+        a
+    }
+
+    /// True when no point on the way from `from` to `to` is inside the surface.
+    fn way_is_free(&self, from: Vec3, to: Vec3) -> bool {
+        (1..RELEASE_SAMPLES).all(|i| self.volume(from.lerp(to, i as f32 / RELEASE_SAMPLES as f32)) <= self.level)
+    }
+}
+
+/// Volume of a cap of height `h` cut from a ball of radius `r`.
+fn cap_volume(r: f32, h: f32) -> f32 {
+    PI * h * h * (3.0 * r - h) / 3.0
+}
+
+/// Overlap volume of balls of radii `r1` and `r2` whose centres are `d` apart.
+fn lens_volume(r1: f32, r2: f32, d: f32) -> f32 {
+    let s = r1 + r2;
+    if d >= s {
+        return 0.0;
+    }
+    let diff = (r1 - r2).abs();
+    if d <= diff {
+        let r = r1.min(r2);
+        return 4.0 / 3.0 * PI * r * r * r;
+    }
+    let t = s - d;
+    (PI * t * t * (d * d + 2.0 * d * s - 3.0 * diff * diff) / (12.0 * d)).max(0.0)
+}
+
+/// Squared radius of the circle where the two balls' surfaces meet (minus the derivative of the lens
+/// volume over the centre distance, divided by π); 0 when apart or nested.
+fn lens_circle_sq(r1: f32, r2: f32, d: f32) -> f32 {
+    if d >= r1 + r2 || d <= (r1 - r2).abs() {
+        return 0.0;
+    }
+    ((-d + r1 + r2) * (d - r1 + r2) * (d + r1 - r2) * (d + r1 + r2) / (4.0 * d * d)).max(0.0)
 }
 
 #[cfg(test)]
 mod tests {
-    use haptic_common::Contact;
-
     use super::*;
 
-    fn floor_contact(device: Vec3) -> ContactSet {
-        let mut s = ContactSet::new();
-        if device.y < 0.0 {
-            s.push(Contact { point: device, normal: Vec3::Y, volume: 0.0, depth: -device.y });
+    const R: f32 = 0.002;
+    const K: ProxyConfig =
+        ProxyConfig { stiffness_n_per_m: 500.0, damping_ns_per_m: 0.0, friction: 0.0, tip_radius: R };
+    /// Where the tip's centre rests above a flat face: the cap it overlaps is SURFACE_CAP × R high.
+    const REST: f32 = R * (1.0 - SURFACE_CAP);
+
+    /// A flat floor at y = 0 (a 10 m ball: its curvature is 5 µm over a centimetre).
+    fn floor() -> Vec<Ball> {
+        vec![Ball { center: Vec3::new(0.0, -10.0, 0.0), radius: 10.0 }]
+    }
+
+    fn touch(g: &mut GodObject, config: &ProxyConfig, balls: &[Ball], at: Vec3) -> Vec3 {
+        g.update(config, at + Vec3::Y * 0.01, Vec3::ZERO, balls, 1.0);
+        g.update(config, at, Vec3::ZERO, balls, 1.0)
+    }
+
+    #[test]
+    fn a_tip_pressed_into_a_floor_is_pushed_up_by_the_stiffness_times_the_depth() {
+        let (mut g, balls) = (GodObject::new(), floor());
+        assert_eq!(g.update(&K, Vec3::new(0.0, 0.01, 0.0), Vec3::ZERO, &balls, 1.0), Vec3::ZERO);
+        let f = g.update(&K, Vec3::new(0.0, REST - 0.002, 0.0), Vec3::ZERO, &balls, 1.0);
+        assert!((f - Vec3::new(0.0, 1.0, 0.0)).length() < 0.02, "{f}");
+        assert!((g.proxy().y - REST).abs() < 2e-5 && g.in_contact(), "{}", g.proxy());
+        // Deeper: more force, never a pop-through.
+        let f = g.update(&K, Vec3::new(0.0, -0.5, 0.0), Vec3::ZERO, &balls, 1.0);
+        assert!((f.y - 500.0 * (0.5 + REST)).abs() < 0.5, "{f}");
+        // Back out: no force.
+        assert_eq!(g.update(&K, Vec3::new(0.0, REST + 0.001, 0.0), Vec3::ZERO, &balls, 1.0), Vec3::ZERO);
+        assert!(!g.in_contact());
+    }
+
+    #[test]
+    fn the_force_is_in_newtons_per_metre_at_the_device_when_the_scene_is_scaled() {
+        let (mut g, balls) = (GodObject::new(), floor());
+        g.update(&K, Vec3::new(0.0, 0.01, 0.0), Vec3::ZERO, &balls, 2.0);
+        // 2 mm deep in the balls' frame is 1 mm at the device.
+        let f = g.update(&K, Vec3::new(0.0, REST - 0.002, 0.0), Vec3::ZERO, &balls, 2.0);
+        assert!((f.y - 0.5).abs() < 0.01, "{f}");
+    }
+
+    #[test]
+    fn without_friction_it_slides_and_with_friction_it_holds_until_the_cone_is_left() {
+        let balls = floor();
+        let deep = REST - 0.002;
+        let mut g = GodObject::new();
+        touch(&mut g, &K, &balls, Vec3::new(0.0, deep, 0.0));
+        let f = g.update(&K, Vec3::new(0.005, deep, 0.0), Vec3::ZERO, &balls, 1.0);
+        assert!(f.x.abs() < 0.01 && (g.proxy().x - 0.005).abs() < 1e-4, "slid along: {f} {}", g.proxy());
+
+        let sticky = ProxyConfig { friction: 0.5, ..K };
+        let mut g = GodObject::new();
+        touch(&mut g, &sticky, &balls, Vec3::new(0.0, deep, 0.0));
+        // 0.5 mm sideways at 2 mm deep is inside the cone (0.5 × 2 mm = 1 mm): held, pulled back.
+        let f = g.update(&sticky, Vec3::new(0.0005, deep, 0.0), Vec3::ZERO, &balls, 1.0);
+        assert!(g.proxy().x.abs() < 1e-5 && f.x < -0.2, "held: {f} {}", g.proxy());
+        // 3 mm sideways leaves it: the proxy slides to the cone's edge, the drag is mu times the push.
+        let f = g.update(&sticky, Vec3::new(0.003, deep, 0.0), Vec3::ZERO, &balls, 1.0);
+        assert!((g.proxy().x - 0.002).abs() < 1e-4, "slid to the cone's edge: {}", g.proxy());
+        assert!((-f.x / f.y - 0.5).abs() < 0.03, "drag over push = mu: {f}");
+    }
+
+    #[test]
+    fn an_inside_corner_pushes_out_along_both_walls() {
+        let mut balls = floor();
+        balls.push(Ball { center: Vec3::new(-10.0, 0.0, 0.0), radius: 10.0 });
+        let mut g = GodObject::new();
+        g.update(&K, Vec3::new(0.01, 0.01, 0.0), Vec3::ZERO, &balls, 1.0);
+        let f = g.update(&K, Vec3::new(-0.001, -0.001, 0.0), Vec3::ZERO, &balls, 1.0);
+        assert!(f.x > 0.5 && f.y > 0.5, "{f}");
+        assert!(g.proxy().x > 0.0 && g.proxy().y > 0.0, "{}", g.proxy());
+    }
+
+    #[test]
+    fn a_thin_plate_is_not_pushed_through() {
+        // A plate 2 mm thick: small balls in a row at y = 0.
+        let balls: Vec<Ball> =
+            (-40..=40).map(|i| Ball { center: Vec3::new(i as f32 * 5e-4, 0.0, 0.0), radius: 1e-3 }).collect();
+        let mut g = GodObject::new();
+        g.update(&K, Vec3::new(0.0, 0.01, 0.0), Vec3::ZERO, &balls, 1.0);
+        for y in [0.002, 0.0, -0.002, -0.004, -0.008] {
+            let f = g.update(&K, Vec3::new(0.0, y, 0.0), Vec3::ZERO, &balls, 1.0);
+            assert!(f.y > 0.0 && g.proxy().y > 0.001, "at {y}: {f}, proxy {}", g.proxy());
         }
-        s
     }
 
     #[test]
-    fn a_point_below_a_floor_is_pushed_up_by_stiffness_times_depth() {
-        let mut p = Proxy3Dof::new(ProxyConfig { friction: 0.0, ..Default::default() });
-        let dev = Vec3::new(0.0, -0.002, 0.0);
-        let f = p.update(dev, Vec3::ZERO, &floor_contact(dev));
-        assert!((f - Vec3::new(0.0, 0.6, 0.0)).length() < 1e-5, "{f:?}");
-        assert!(p.proxy().y.abs() < 1e-7);
+    fn a_point_slips_between_two_balls_and_a_wider_tip_glides_over_the_gap() {
+        // Two 1 cm balls whose surfaces leave a 1 mm gap at x = 0.
+        let balls = [
+            Ball { center: Vec3::new(-0.0105, -0.01, 0.0), radius: 0.01 },
+            Ball { center: Vec3::new(0.0105, -0.01, 0.0), radius: 0.01 },
+        ];
+        let point = ProxyConfig { tip_radius: 1e-4, ..K };
+        let mut g = GodObject::new();
+        assert_eq!(touch(&mut g, &point, &balls, Vec3::new(0.0, -0.009, 0.0)), Vec3::ZERO);
+        let tip = ProxyConfig { tip_radius: 0.001, ..K };
+        let mut g = GodObject::new();
+        let f = touch(&mut g, &tip, &balls, Vec3::new(0.0, -0.009, 0.0));
+        assert!(f.y > 0.5 && g.proxy().y > -0.008, "held above the gap: {f}, proxy {}", g.proxy());
+        // And slides across it without catching: the force stays upright on the way.
+        for i in 1..=20 {
+            let x = i as f32 * 1e-4 - 0.001;
+            let f = g.update(&tip, Vec3::new(x, -0.009, 0.0), Vec3::ZERO, &balls, 1.0);
+            assert!(f.y > 0.5 && f.x.abs() < f.y, "at {x}: {f}");
+        }
     }
 
     #[test]
-    fn free_space_gives_no_force() {
-        let mut p = Proxy3Dof::new(ProxyConfig::default());
-        let dev = Vec3::new(0.0, 0.01, 0.0);
-        assert_eq!(p.update(dev, Vec3::ONE, &floor_contact(dev)), Vec3::ZERO);
-        assert!(!p.in_contact());
+    fn damping_resists_only_motion_into_the_surface() {
+        let balls = floor();
+        let damped = ProxyConfig { damping_ns_per_m: 2.0, ..K };
+        let deep = Vec3::new(0.0, REST - 0.002, 0.0);
+        let mut g = GodObject::new();
+        touch(&mut g, &damped, &balls, deep);
+        let pressing = g.update(&damped, deep, Vec3::new(0.0, -0.1, 0.0), &balls, 1.0);
+        let leaving = g.update(&damped, deep, Vec3::new(0.0, 0.1, 0.0), &balls, 1.0);
+        assert!((pressing.y - leaving.y - 0.2).abs() < 1e-3, "{pressing} {leaving}");
     }
 
     #[test]
-    fn friction_holds_the_proxy_until_the_pull_leaves_the_cone() {
-        let mut p = Proxy3Dof::new(ProxyConfig { friction: 0.5, ..Default::default() });
-        let d0 = Vec3::new(0.0, -0.002, 0.0);
-        p.update(d0, Vec3::ZERO, &floor_contact(d0));
-        let d1 = Vec3::new(0.0005, -0.002, 0.0); // inside the cone: 0.5 * 2 mm = 1 mm
-        let f = p.update(d1, Vec3::ZERO, &floor_contact(d1));
-        assert!(f.x < 0.0, "friction pulls back: {f:?}");
-        assert!(p.proxy().x.abs() < 1e-7);
-        let d2 = Vec3::new(0.003, -0.002, 0.0);
-        p.update(d2, Vec3::ZERO, &floor_contact(d2));
-        assert!((p.proxy().x - 0.002).abs() < 1e-6, "slides to the cone's edge: {:?}", p.proxy());
+    fn bad_balls_and_a_bad_device_point_give_no_nan_force() {
+        let mut g = GodObject::new();
+        let balls = [
+            Ball { center: Vec3::splat(f32::NAN), radius: 1.0 },
+            Ball { center: Vec3::ZERO, radius: f32::INFINITY },
+            Ball { center: Vec3::ZERO, radius: -1.0 },
+        ];
+        assert_eq!(g.update(&K, Vec3::ZERO, Vec3::ZERO, &balls, 1.0), Vec3::ZERO);
+        assert_eq!(g.update(&K, Vec3::splat(f32::NAN), Vec3::ZERO, &floor(), 1.0), Vec3::ZERO);
+        let no_tip = ProxyConfig { tip_radius: 0.0, ..K };
+        assert_eq!(g.update(&no_tip, Vec3::new(0.0, -0.01, 0.0), Vec3::ZERO, &floor(), 1.0), Vec3::ZERO);
     }
 
     #[test]
-    fn a_corner_pushes_out_along_both_walls() {
-        let mut p = Proxy3Dof::new(ProxyConfig { friction: 0.0, ..Default::default() });
-        let dev = Vec3::new(-0.001, -0.001, 0.0);
-        let mut s = ContactSet::new();
-        s.push(Contact { point: dev, normal: Vec3::Y, volume: 0.0, depth: 0.001 });
-        s.push(Contact { point: dev, normal: Vec3::X, volume: 0.0, depth: 0.001 });
-        let f = p.update(dev, Vec3::ZERO, &s);
-        assert!((f - Vec3::new(0.3, 0.3, 0.0)).length() < 1e-5, "{f:?}");
-    }
-
-    #[test]
-    fn nan_contacts_give_no_nan_force() {
-        let mut p = Proxy3Dof::new(ProxyConfig::default());
-        let mut s = ContactSet::new();
-        s.push(Contact { point: Vec3::splat(f32::NAN), normal: Vec3::Y, volume: 0.0, depth: 1.0 });
-        s.push(Contact { point: Vec3::ZERO, normal: Vec3::Y, volume: 0.0, depth: f32::INFINITY });
-        assert!(p.update(Vec3::ZERO, Vec3::ZERO, &s).is_finite());
+    fn the_gradient_is_the_derivative_of_the_volume() {
+        let balls = [Ball { center: Vec3::new(0.001, -0.002, 0.0005), radius: 0.003 }];
+        let surface = Surface { balls: &balls, tip: R, level: 0.0 };
+        let p = Vec3::new(0.0, 0.002, 0.0);
+        let (_, g) = surface.volume_and_gradient(p);
+        let h = 1e-5;
+        for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
+            let numeric = (surface.volume(p + axis * h) - surface.volume(p - axis * h)) / (2.0 * h);
+            assert!((numeric - g.dot(axis)).abs() < 1e-3 * g.length() + 1e-12, "{axis}: {numeric} vs {}", g.dot(axis));
+        }
     }
 }

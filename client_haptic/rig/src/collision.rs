@@ -8,8 +8,8 @@
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use collette::query::{Budget, QueryWorkspace, overlap_budgeted};
-use forcecomp::BodyMotion;
+use collette::query::{Budget, QueryWorkspace, overlap_budgeted, spheres_near};
+use forcecomp::{Ball, BodyMotion};
 use haptic_common::{Delegator, OnCollision};
 use haptico::HapticClock;
 use haptico::timing::{next_deadline, wait_until};
@@ -106,6 +106,8 @@ pub(crate) struct CollisionWorld {
     pub(crate) garbage: rtrb::Producer<WorldGarbage>,
     pub(crate) timings: rtrb::Producer<StepTiming>,
     pub(crate) on_collision: Delegator<OnCollision>,
+    /// Proxy rendering: gather each object's spheres near the tip instead of overlapping the tool.
+    pub(crate) proxy: bool,
     pub(crate) paused: bool,
     pub(crate) sequence: u64,
     pub(crate) last_start_us: Option<u64>,
@@ -166,7 +168,32 @@ impl CollisionWorld {
         let mut count = 0;
         let mut contacts = 0u32;
         let mut budget_hit = false;
-        for object in &self.objects {
+        frame.balls.clear();
+        let proxy = self.proxy;
+        for object in self.objects.iter().filter(|_| proxy) {
+            let spec = &object.spec;
+            let before = frame.balls.len() + frame.balls.overflow as usize;
+            let balls = &mut frame.balls;
+            spheres_near(
+                &spec.tree,
+                &spec.pose,
+                pose.pose.translation,
+                pose.reach,
+                &mut self.workspace,
+                |center, radius| balls.push(Ball { center, radius }, count),
+            );
+            if frame.balls.len() + frame.balls.overflow as usize == before {
+                continue;
+            }
+            let slot = &mut frame.objects[count];
+            slot.object_id = spec.id;
+            slot.material = spec.material;
+            slot.motion = object.motion;
+            slot.contacts.clear();
+            count += 1;
+        }
+        contacts += frame.balls.len() as u32;
+        for object in self.objects.iter().filter(|_| !proxy) {
             let slot = &mut frame.objects[count];
             let budget = deadline.map_or(Budget::Unlimited, Budget::Deadline);
             let spec = &object.spec;

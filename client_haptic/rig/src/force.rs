@@ -5,7 +5,9 @@
 //! per tick is preallocated: the triple buffers' frames, the force-sample ring, the coupling and safety
 //! state.
 
-use forcecomp::{BodyMotion, SafetyLayer, SafetyPhase, SafetyStats, VirtualCoupling, volumetric_penalty};
+use forcecomp::{
+    BodyMotion, GodObject, ProxyConfig, SafetyLayer, SafetyPhase, SafetyStats, VirtualCoupling, volumetric_penalty,
+};
 use glam::Vec3;
 use haptic_common::{DeviceState, ForceOnHapticTick, ForceTorque, Pose};
 
@@ -79,6 +81,34 @@ pub enum Rendering {
     Coupled,
     /// The contact force straight to the device (for comparison; unstable when stiff).
     Direct,
+    /// 3-DOF god-object: the tool is its tip (the device point), held outside the objects' inner
+    /// spheres by a proxy on their surface; force only, no torque (`forcecomp::proxy`).
+    Proxy,
+}
+
+/// How the 3-DOF proxy feels a material.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProxyRendering {
+    /// The proxy's spring is the tool-and-object material's volumetric stiffness times this, m²
+    /// (default 1e-5: 3e6 N/m³ feels like 30 N/m), capped at the device's stiffness limit. Set it to
+    /// the tool's overlap volume per depth at a flat face, and a copy feels as stiff as with the
+    /// volumetric rendering at that depth.
+    pub volume_per_depth_m2: f32,
+    /// Damping of the tip's speed into the surface, N·s/m (default 0.5).
+    pub damping_ns_per_m: f32,
+    /// Spheres are handed to the proxy this far beyond its distance from the tip, scene units
+    /// (default 0.01: the tip may move that far between collision steps).
+    pub margin: f32,
+    /// Radius of the tip, scene units (default 0.004): a few times the radius of an Inner Sphere
+    /// Tree's spheres near the surface (1–3 mm for a 10 cm object of a few thousand spheres), so that
+    /// the surface it feels is smooth (`forcecomp::proxy`).
+    pub tip_radius: f32,
+}
+
+impl Default for ProxyRendering {
+    fn default() -> Self {
+        Self { volume_per_depth_m2: 1e-5, damping_ns_per_m: 0.5, margin: 0.01, tip_radius: 0.004 }
+    }
 }
 
 /// Where the force stage gets contacts from and sends the tool pose to.
@@ -105,6 +135,10 @@ pub struct ForceStage {
     pub(crate) rendering: Rendering,
     pub(crate) coupling: VirtualCoupling,
     pub(crate) safety: SafetyLayer,
+    pub(crate) god: GodObject,
+    pub(crate) proxy: ProxyRendering,
+    /// The device's stiffness limit, N/m (the proxy's spring never exceeds it).
+    pub(crate) max_stiffness_n_per_m: f32,
     pub(crate) source: Source,
     pub(crate) telemetry: triple_buffer::Input<RigTelemetry>,
     pub(crate) samples: rtrb::Producer<ForceSample>,
@@ -114,16 +148,19 @@ impl ForceStage {
     /// One tick: adds the safe contact force to whatever earlier delegates added, then replaces the
     /// tick's total with the safety layer's output. Allocation-free.
     pub fn on_tick(&mut self, tick: &ForceOnHapticTick) {
+        if self.rendering == Rendering::Proxy {
+            return self.on_proxy_tick(tick);
+        }
         let device = tick.device;
 
         // The tool as the force law sees it: the simulated tool (or the device itself when direct).
         let tool_device = match self.rendering {
             Rendering::Coupled => self.coupling.tool_pose(),
-            Rendering::Direct => device.pose,
+            Rendering::Direct | Rendering::Proxy => device.pose,
         };
         let (v, w) = match self.rendering {
             Rendering::Coupled => (self.coupling.tool_velocity(), self.coupling.tool_angular_velocity()),
-            Rendering::Direct => (device.linear_velocity, device.angular_velocity),
+            Rendering::Direct | Rendering::Proxy => (device.linear_velocity, device.angular_velocity),
         };
         let tool_scene = self.map.to_scene(&tool_device);
         let (tool_com_local, tool_material) = match &mut self.source {
@@ -186,7 +223,7 @@ impl ForceStage {
         let dt = tick.dt_s;
         let wanted = match self.rendering {
             Rendering::Coupled => self.coupling.step(&device, contact_device, dt),
-            Rendering::Direct => contact_device,
+            Rendering::Direct | Rendering::Proxy => contact_device,
         };
         let age_s = if age_us == u64::MAX { f32::INFINITY } else { age_us as f32 * 1e-6 };
         let before = tick.total();
@@ -196,7 +233,7 @@ impl ForceStage {
 
         let tool_now = match self.rendering {
             Rendering::Coupled => self.map.to_scene(&self.coupling.tool_pose()),
-            Rendering::Direct => self.map.to_scene(&device.pose),
+            Rendering::Direct | Rendering::Proxy => self.map.to_scene(&device.pose),
         };
         match &mut self.source {
             Source::Rig { poses, .. } => poses.write(ToolPoseMsg {
@@ -205,6 +242,7 @@ impl ForceStage {
                 linear_velocity: tool_motion.linear_velocity,
                 angular_velocity: tool_motion.angular_velocity,
                 timestamp_us: device.timestamp_us,
+                reach: 0.0,
             }),
             Source::Collette(c) => c.tool.set(tool_now, device.timestamp_us),
         }
@@ -221,6 +259,82 @@ impl ForceStage {
         self.telemetry.write(RigTelemetry {
             device,
             tool_pose: tool_now,
+            output: out,
+            contacts,
+            collision_sequence: sequence,
+            data_age_us: age_us,
+            safety_phase: self.safety.phase(),
+            safety_gain: self.safety.gain(),
+            safety: self.safety.stats(),
+        });
+    }
+
+    /// One tick of 3-DOF proxy rendering: the tip against the spheres near it, no coupling, no torque.
+    fn on_proxy_tick(&mut self, tick: &ForceOnHapticTick) {
+        let device = tick.device;
+        let tip = self.map.to_scene(&device.pose);
+        let Source::Rig { frames, poses } = &mut self.source else {
+            return; // refused at start: collette's pipeline gives overlaps, not the spheres near the tip
+        };
+        frames.update();
+        let frame = frames.output_buffer();
+        let balls = frame.balls.as_slice();
+        // The spring of the material the proxy rests on: the object of the sphere nearest to it.
+        let near = if self.god.in_contact() { self.god.proxy() } else { tip.translation };
+        let slot = balls
+            .iter()
+            .enumerate()
+            .min_by(|a, b| {
+                (a.1.center.distance(near) - a.1.radius).total_cmp(&(b.1.center.distance(near) - b.1.radius))
+            })
+            .map(|(i, _)| i);
+        let material = slot.map(|i| frame.tool_material.combine(&frame.objects[frame.balls.object_of(i)].material));
+        let config = ProxyConfig {
+            stiffness_n_per_m: material
+                .map_or(0.0, |m| m.stiffness_n_per_m3 * self.proxy.volume_per_depth_m2)
+                .min(self.max_stiffness_n_per_m)
+                .max(f32::MIN_POSITIVE),
+            damping_ns_per_m: self.proxy.damping_ns_per_m,
+            friction: material.map_or(0.0, |m| m.friction),
+            tip_radius: self.proxy.tip_radius,
+        };
+        let scale = self.map.scale.max(f32::MIN_POSITIVE);
+        let velocity = self.map.velocity_to_scene(device.linear_velocity) / scale;
+        let force_scene = self.god.update(&config, tip.translation, velocity, balls, scale);
+        let contact_device = self.map.wrench_to_device(ForceTorque { force: force_scene, torque: Vec3::ZERO });
+        let (sequence, age_us) = if frame.sequence == 0 {
+            (0, u64::MAX)
+        } else {
+            (frame.sequence, device.timestamp_us.saturating_sub(frame.pose_timestamp_us))
+        };
+        let contacts = balls.len() as u32;
+        let age_s = if age_us == u64::MAX { f32::INFINITY } else { age_us as f32 * 1e-6 };
+        let before = tick.total();
+        let requested = ForceTorque { force: before.force + contact_device.force, torque: before.torque };
+        let out = self.safety.apply(requested, tick.dt_s, age_s);
+        tick.set(out);
+        let proxy_pose = Pose::new(self.god.proxy(), tip.rotation);
+        poses.write(ToolPoseMsg {
+            tick: tick.tick,
+            pose: tip,
+            linear_velocity: velocity * scale,
+            angular_velocity: Vec3::ZERO,
+            timestamp_us: device.timestamp_us,
+            reach: self.god.proxy().distance(tip.translation) + self.proxy.margin + self.proxy.tip_radius,
+        });
+        let _ = self.samples.push(ForceSample {
+            t_us: device.timestamp_us,
+            force: out.force,
+            torque: out.torque,
+            contact_force: contact_device.force,
+            tool_position: proxy_pose.translation,
+            contacts,
+            data_age_us: age_us.min(u32::MAX as u64) as u32,
+            collision_sequence: sequence,
+        });
+        self.telemetry.write(RigTelemetry {
+            device,
+            tool_pose: proxy_pose,
             output: out,
             contacts,
             collision_sequence: sequence,

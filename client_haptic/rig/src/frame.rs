@@ -5,12 +5,14 @@
 
 use std::sync::Arc;
 
-use forcecomp::{BodyMotion, Material};
+use forcecomp::{Ball, BodyMotion, Material};
 use glam::Vec3;
 use haptic_common::{ContactSet, Pose};
 
 /// Most objects watched at once (each holds a full contact set in every frame buffer).
 pub const MAX_OBJECTS: usize = 4;
+/// Most spheres near the tip handed to the 3-DOF proxy in one frame (more are counted, not kept).
+pub const MAX_BALLS: usize = 1024;
 
 /// The tool's pose, sent by the haptic thread every tick (latest value wins).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -25,6 +27,8 @@ pub struct ToolPoseMsg {
     pub angular_velocity: Vec3,
     /// Time of the device sample it follows, µs on the haptic clock.
     pub timestamp_us: u64,
+    /// Proxy rendering: how far from the tip (the pose's origin) the proxy may need spheres, scene units.
+    pub reach: f32,
 }
 
 /// Contacts of the tool with one object, with what the force law needs to know about the object.
@@ -38,6 +42,61 @@ pub struct ObjectContacts {
     pub motion: BodyMotion,
     /// The overlapping sphere pairs (tool = A, object = B).
     pub contacts: ContactSet,
+}
+
+/// The objects' spheres near the tool tip, for the 3-DOF proxy (fixed capacity, allocated once).
+#[derive(Clone, Debug)]
+pub struct Balls {
+    balls: Box<[Ball]>,
+    objects: Box<[u8]>,
+    len: usize,
+    /// Spheres found but not kept because the set was full.
+    pub overflow: u32,
+}
+
+impl Default for Balls {
+    fn default() -> Self {
+        Self { balls: vec![Ball::default(); MAX_BALLS].into(), objects: vec![0; MAX_BALLS].into(), len: 0, overflow: 0 }
+    }
+}
+
+impl Balls {
+    /// Empties the set (keeps its memory).
+    pub fn clear(&mut self) {
+        self.len = 0;
+        self.overflow = 0;
+    }
+
+    /// Adds a sphere of the object in slot `object` of the frame; counts it as overflow when full.
+    pub fn push(&mut self, ball: Ball, object: usize) {
+        if self.len == self.balls.len() {
+            self.overflow += 1;
+            return;
+        }
+        self.balls[self.len] = ball;
+        self.objects[self.len] = object as u8;
+        self.len += 1;
+    }
+
+    /// The spheres (scene frame).
+    pub fn as_slice(&self) -> &[Ball] {
+        &self.balls[..self.len]
+    }
+
+    /// The frame slot of the object sphere `i` belongs to.
+    pub fn object_of(&self, i: usize) -> usize {
+        usize::from(self.objects[i])
+    }
+
+    /// Number of spheres.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// True when no sphere is near.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
 }
 
 /// One collision step's result, published by the collision thread.
@@ -59,6 +118,8 @@ pub struct CollisionFrame {
     pub count: usize,
     /// Per-object contacts, `MAX_OBJECTS` preallocated.
     pub objects: Vec<ObjectContacts>,
+    /// Proxy rendering: the touched objects' spheres near the tool tip (scene frame).
+    pub balls: Balls,
 }
 
 impl Default for CollisionFrame {
@@ -72,6 +133,7 @@ impl Default for CollisionFrame {
             step_us: 0,
             count: 0,
             objects: (0..MAX_OBJECTS).map(|_| ObjectContacts::default()).collect(),
+            balls: Balls::default(),
         }
     }
 }
@@ -82,9 +144,9 @@ impl CollisionFrame {
         &self.objects[..self.count]
     }
 
-    /// Number of contacts over all objects.
+    /// Number of contacts over all objects (spheres near the tip, with proxy rendering).
     pub fn contact_count(&self) -> usize {
-        self.touched().iter().map(|o| o.contacts.len()).sum()
+        self.touched().iter().map(|o| o.contacts.len()).sum::<usize>() + self.balls.len()
     }
 }
 

@@ -22,7 +22,7 @@ pub mod workspace;
 
 pub use collision::{CollisionConfig, StepTiming};
 pub use error::{Result, RigError};
-pub use force::{ForceSample, Rendering, RigTelemetry};
-pub use frame::{CollisionFrame, MAX_OBJECTS, ObjectContacts, ObjectSpec, ToolPoseMsg, ToolSpec};
+pub use force::{ForceSample, ProxyRendering, Rendering, RigTelemetry};
+pub use frame::{Balls, CollisionFrame, MAX_BALLS, MAX_OBJECTS, ObjectContacts, ObjectSpec, ToolPoseMsg, ToolSpec};
 pub use rig::{HapticRig, RigConfig};
 pub use workspace::WorkspaceMap;

@@ -6,12 +6,12 @@
 use std::sync::Mutex;
 use std::thread::JoinHandle;
 
-use forcecomp::{CouplingConfig, SafetyConfig, SafetyLayer, VirtualCoupling};
+use forcecomp::{CouplingConfig, GodObject, SafetyConfig, SafetyLayer, VirtualCoupling};
 use haptic_common::{Delegator, OnCollision};
 use haptico::{Device, HapticClock, HapticConfig, HapticEvents, HapticHandle, HapticTelemetry, TickTiming};
 
 use crate::collision::{CollisionConfig, CollisionWorld, StepTiming, WatchedObject, WorldCommand, WorldGarbage};
-use crate::force::{ForceSample, ForceStage, Rendering, RigTelemetry};
+use crate::force::{ForceSample, ForceStage, ProxyRendering, Rendering, RigTelemetry};
 use crate::frame::{CollisionFrame, MAX_OBJECTS, ObjectSpec, ToolPoseMsg, ToolSpec};
 use crate::{Result, RigError, WorkspaceMap};
 
@@ -28,8 +28,10 @@ pub struct RigConfig {
     pub coupling: Option<CouplingConfig>,
     /// Safety limits (None: the device's peak force and torque with the default habits).
     pub safety: Option<SafetyConfig>,
-    /// Coupled or direct rendering (default coupled).
+    /// Coupled, direct or 3-DOF proxy rendering (default coupled).
     pub rendering: Rendering,
+    /// How the 3-DOF proxy feels materials (with `Rendering::Proxy`).
+    pub proxy: ProxyRendering,
     /// Capacity of the per-tick force-sample ring (default 65 536).
     pub force_sample_capacity: usize,
 }
@@ -43,6 +45,7 @@ impl Default for RigConfig {
             coupling: None,
             safety: None,
             rendering: Rendering::Coupled,
+            proxy: ProxyRendering::default(),
             force_sample_capacity: 1 << 16,
         }
     }
@@ -96,6 +99,7 @@ impl Parts {
             garbage: garbage_tx,
             timings: timings_tx,
             on_collision,
+            proxy: config.rendering == Rendering::Proxy,
             paused: false,
             sequence: 0,
             last_start_us: None,
@@ -105,6 +109,9 @@ impl Parts {
             rendering: config.rendering,
             coupling: VirtualCoupling::new(coupling),
             safety: SafetyLayer::new(safety),
+            god: GodObject::new(),
+            proxy: config.proxy,
+            max_stiffness_n_per_m: specs.max_stiffness_n_per_m,
             source: crate::force::Source::Rig { frames: frame_out, poses: pose_in },
             telemetry: telemetry_in,
             samples: samples_tx,
@@ -178,6 +185,11 @@ impl<D: Device + 'static> HapticRig<D> {
         config: RigConfig,
         mut events: HapticEvents,
     ) -> Result<Self> {
+        if config.rendering == Rendering::Proxy {
+            return Err(RigError::Unsupported(
+                "with proxy rendering on collette's pipeline (it gives overlaps, not spheres)",
+            ));
+        }
         let clock = HapticClock::new();
         let Parts { mut stage, world, inner } = Parts::new(device.specs(), tool.clone(), &config, Delegator::new())?;
         drop(world);

@@ -1,5 +1,6 @@
 //! The whole per-tick work of both threads (collision step with collette's query, penalty force,
-//! coupling, safety, buffers) neither allocates nor frees once warmed up.
+//! coupling, safety, buffers; or, for the 3-DOF proxy, the spheres near the tip and the god-object)
+//! neither allocates nor frees once warmed up.
 
 mod utils;
 
@@ -8,7 +9,7 @@ use forcecomp::Material;
 use glam::Vec3;
 use haptic_common::Pose;
 use haptic_rig::lockstep::Lockstep;
-use haptic_rig::{ObjectSpec, RigConfig, ToolSpec};
+use haptic_rig::{ObjectSpec, Rendering, RigConfig, ToolSpec};
 use haptico::presets;
 use haptico::sim::{SimConfig, SimDevice, TargetPath};
 
@@ -17,12 +18,22 @@ static ALLOCATOR: AllocDisabler = AllocDisabler;
 
 #[test]
 fn a_steady_state_rig_tick_neither_allocates_nor_frees() {
+    steady_state_ticks_do_not_allocate(presets::phantom_premium_6dof(), Rendering::Coupled);
+}
+
+#[test]
+fn a_steady_state_proxy_tick_neither_allocates_nor_frees() {
+    steady_state_ticks_do_not_allocate(presets::touch(), Rendering::Proxy);
+}
+
+fn steady_state_ticks_do_not_allocate(specs: haptico::DeviceSpecs, rendering: Rendering) {
     let device = SimDevice::new(
-        SimConfig::new(presets::phantom_premium_6dof()),
+        SimConfig::new(specs),
         TargetPath::line(Vec3::new(0.0, 0.01, 0.0), Vec3::new(0.003, -0.003, 0.002), 2.0),
     );
     let tool = ToolSpec::new(utils::ball_tool(), Material::default());
-    let mut rig = Lockstep::new(device, tool, &RigConfig::default(), 1, None).expect("rig");
+    let config = RigConfig { rendering, ..RigConfig::default() };
+    let mut rig = Lockstep::new(device, tool, &config, 1, None).expect("rig");
     let slab = ObjectSpec {
         id: 1,
         tree: utils::slab(),

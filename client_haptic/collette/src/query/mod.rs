@@ -12,7 +12,7 @@ mod workspace;
 
 pub use distance::{Separation, separation};
 pub use overlap::{Budget, OverlapResult, overlap, overlap_budgeted, overlap_volume};
-pub use probe::{ProbeHit, probe};
+pub use probe::{ProbeHit, probe, spheres_near};
 pub use workspace::QueryWorkspace;
 
 pub use haptic_common::{Contact, ContactSet, Pose};

@@ -13,7 +13,7 @@ use forcecomp::Material;
 use glam::Vec3;
 use haptic_common::{Delegator, ForceTorque, Pose};
 use haptic_rig::lockstep::Lockstep;
-use haptic_rig::{CollisionConfig, HapticRig, ObjectSpec, RigConfig, ToolSpec, bench};
+use haptic_rig::{CollisionConfig, HapticRig, ObjectSpec, Rendering, RigConfig, ToolSpec, bench};
 use haptico::sim::{Keyframe, SimConfig, SimDevice, TargetPath};
 use haptico::trace::{self, Trace, TraceDevice, TraceWriter};
 use haptico::{Device, HapticConfig, HapticEvents, presets};
@@ -61,6 +61,10 @@ struct Args {
     /// its rate is then read from the contact sets' sequence numbers seen by the haptic thread).
     #[arg(long, default_value = "rig")]
     collision: String,
+    /// Force rendering: "volumetric" (the gemstone's inner spheres against the bunny's, coupled, 6-DOF)
+    /// or "proxy" (3-DOF god-object: the gemstone's centre as a point tip held on the bunny's spheres).
+    #[arg(long, default_value = "volumetric")]
+    rendering: String,
     /// Print the summary as one JSON object, last.
     #[arg(long)]
     json: bool,
@@ -157,6 +161,11 @@ fn run() -> anyhow::Result<()> {
             ..CollisionConfig::default()
         },
         force_sample_capacity: ticks,
+        rendering: match args.rendering.as_str() {
+            "volumetric" => Rendering::Coupled,
+            "proxy" => Rendering::Proxy,
+            other => anyhow::bail!("--rendering must be volumetric or proxy, not {other:?}"),
+        },
         ..RigConfig::default()
     };
     // Stiff enough for newtons at a few millimetres, soft enough that the deep stretch really goes deep.
@@ -227,8 +236,9 @@ fn run() -> anyhow::Result<()> {
     bench::write_csv(&mut csv, &windows)?;
     drop(csv);
     let title = format!(
-        "{} on the gemstone-over-bunny path, {} collision thread: 100 ms windows",
+        "{} on the gemstone-over-bunny path, {} rendering, {} collision thread: 100 ms windows",
         specs.name,
+        args.rendering,
         if collette_mode { "collette's" } else { "the rig's" }
     );
     let png_path = args.out_dir.join("haptic_bench.png");
@@ -281,6 +291,7 @@ fn run() -> anyhow::Result<()> {
             "windows": s.windows,
             "device": specs.name,
             "collision_thread": args.collision,
+            "rendering": args.rendering,
             "realtime": haptic_telemetry.realtime,
             "memory_locked": locked,
             "windows_below_target_haptic": low_haptic,
@@ -351,6 +362,7 @@ fn lockstep(
     if args.json {
         let json = serde_json::json!({
             "lockstep": true,
+            "rendering": args.rendering,
             "ticks": forces.len(),
             "seconds_wall": elapsed.as_secs_f64(),
             "ticks_with_force": in_contact,

@@ -21,6 +21,23 @@ pub struct ProbeHit {
     pub volume: f32,
 }
 
+/// Calls `f` with every inner sphere of `tree` at `pose` that reaches within `radius` of the world point
+/// `center`, as its world centre and radius: what a god-object proxy near `center` can meet (see
+/// `forcecomp::proxy`). Allocation-free once `ws` has grown to the tree's depth.
+pub fn spheres_near(
+    tree: &crate::InnerSphereTree,
+    pose: &Pose,
+    center: Vec3,
+    radius: f32,
+    ws: &mut QueryWorkspace,
+    mut f: impl FnMut(Vec3, f32),
+) {
+    let local = pose.inverse().transform_point(center);
+    for_each_leaf_in_sphere(tree, local, radius.max(0.0), &mut ws.nodes, |_, s| {
+        f(pose.transform_point(s.center), s.radius);
+    });
+}
+
 /// Probes `tree` at `pose` with a ball of `radius` (0 for a point) centred at world `center`.
 ///
 /// Returns `None` when the probe touches no inner sphere. When `out` is given it is cleared and filled
