@@ -9,7 +9,7 @@
 use clap::Parser;
 use client_haptic::cli::KindArg;
 use client_haptic::explore::feel;
-use client_haptic::haptics::{Haptics, HapticsSettings};
+use client_haptic::haptics::{Haptics, HapticsSettings, RenderingChoice};
 use heist_shared::artifact::{ArtifactKind, build_mesh, copy_mesh_seed, generate_copies, target_seed};
 use heist_shared::level::Level;
 use heist_shared::protocol::{ItemId, WorkbenchCopy};
@@ -26,6 +26,12 @@ struct Args {
     /// of the copies generated from the seed itself.
     #[arg(long)]
     heist: bool,
+    /// How forces are rendered (auto: the 3-DOF proxy for the default Phantom Desktop preset).
+    #[arg(long, value_enum, default_value_t = RenderingChoice::Auto)]
+    rendering: RenderingChoice,
+    /// Device preset the sim device copies (default the Phantom Desktop).
+    #[arg(long)]
+    preset: Option<String>,
     /// Feel each copy this many times.
     #[arg(long, default_value_t = 1)]
     repeat: u32,
@@ -37,7 +43,11 @@ struct Args {
 fn main() -> anyhow::Result<()> {
     let args = Args::parse();
     let museum = Level::museum();
-    let mut h = Haptics::start(HapticsSettings::default())?;
+    let mut h = Haptics::start(HapticsSettings {
+        rendering: args.rendering,
+        preset: args.preset.clone(),
+        ..HapticsSettings::default()
+    })?;
     std::thread::sleep(std::time::Duration::from_millis(2500));
     println!(
         "kind,seed,count,material,felt_count,felt_material,stiffness_n_per_m,pressure_n_per_m2,friction,\

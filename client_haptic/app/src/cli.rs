@@ -16,7 +16,7 @@ use heist_shared::protocol::{Phase, Role, SessionView, TICK_HZ};
 use crate::audio::{AudioOutput, AudioSettings, SpatialMode};
 use crate::client::{PhantomSettings, PhantomState};
 use crate::device::DeviceChoice;
-use crate::haptics::HapticsSettings;
+use crate::haptics::{HapticsSettings, RenderingChoice};
 
 /// The command line.
 #[derive(Parser, Debug)]
@@ -109,6 +109,10 @@ pub struct ClientArgs {
     /// Device preset the sim device copies (e.g. touch, falcon, premium); default Phantom Desktop.
     #[arg(long)]
     pub preset: Option<String>,
+    /// How forces are rendered: auto (the 3-DOF proxy on a device that renders no torque, else
+    /// volumetric), volumetric or proxy.
+    #[arg(long, value_enum, default_value_t = RenderingChoice::Auto)]
+    pub rendering: RenderingChoice,
     /// Record the device's every tick (state read, force commanded) to this trace file (`haptico trace
     /// v2`, docs/haptics.md): replay it with `--device trace:FILE` or `haptic-bench --replay FILE`.
     #[arg(long)]
@@ -196,6 +200,7 @@ impl ClientArgs {
                 device: self.device.clone(),
                 preset: self.preset.clone(),
                 record: self.record.clone(),
+                rendering: self.rendering,
                 spheres: self.spheres,
                 cache_dir: cache,
                 realtime_priority: self.realtime,

@@ -56,7 +56,7 @@ pub enum HandGoal {
         start_rad: f32,
         /// Seconds per turn.
         period_s: f32,
-        /// Turns to make.
+        /// Turns to make (negative: clockwise, seen from above).
         turns: f32,
         /// Haptic-clock time of the start, µs.
         start_us: u64,
@@ -98,7 +98,7 @@ impl HandGoal {
         match *self {
             Self::Hold(p) => p,
             Self::Orbit { centre, radius, start_rad, period_s, turns, start_us } => {
-                let done = (since(start_us) / period_s.max(1e-3)).min(turns.max(0.0));
+                let done = (since(start_us) / period_s.max(1e-3)).min(turns.abs()) * turns.signum();
                 let phi = start_rad + TAU * done;
                 Pose::from_translation(centre + radius * Vec3::new(phi.cos(), 0.0, -phi.sin()))
             }
@@ -129,7 +129,7 @@ impl HandGoal {
         let since = |start_us: u64| t_us.saturating_sub(start_us) as f32 * 1e-6;
         match *self {
             Self::Hold(_) => true,
-            Self::Orbit { period_s, turns, start_us, .. } => since(start_us) >= period_s * turns,
+            Self::Orbit { period_s, turns, start_us, .. } => since(start_us) >= period_s * turns.abs(),
             Self::Line { duration_s, start_us, .. } => since(start_us) >= duration_s,
             Self::Taps { n, tap_s, start_us, .. } => since(start_us) >= n as f32 * tap_s,
         }
@@ -267,6 +267,23 @@ mod tests {
         assert!((at(3.0) - Vec3::new(0.1, 1.0, 0.0)).length() < 1e-4);
         assert!((at(9.0) - at(3.0)).length() < 1e-4, "holds after one turn");
         assert!(!goal.finished(2_900_000) && goal.finished(3_000_000));
+    }
+
+    #[test]
+    fn an_orbit_of_negative_turns_goes_clockwise() {
+        let goal = HandGoal::Orbit {
+            centre: Vec3::ZERO,
+            radius: 0.1,
+            start_rad: 0.0,
+            period_s: 2.0,
+            turns: -0.25,
+            start_us: 0,
+        };
+        let at = |s: f64| goal.sample((s * 1e6) as u64).translation;
+        assert!(at(0.25).z > 0.05 && at(0.25).x > 0.05, "halfway, clockwise: {}", at(0.25));
+        assert!((at(0.5) - Vec3::new(0.0, 0.0, 0.1)).length() < 1e-4, "a quarter turn clockwise: {}", at(0.5));
+        assert!((at(5.0) - at(0.5)).length() < 1e-6, "then holds");
+        assert!(!goal.finished(400_000) && goal.finished(500_000));
     }
 
     #[test]

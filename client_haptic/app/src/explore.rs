@@ -174,6 +174,8 @@ enum Stage {
     /// Round the ring of pokes to where they start.
     Return,
     Taps,
+    /// Round the ring of pokes, the short way, to the angle of the press (never across the copy).
+    Round,
     Approach,
     Press,
     SlideDown,
@@ -228,6 +230,8 @@ pub struct Exploration {
     disturbed: bool,
     attempts: u32,
     findings: Option<Findings>,
+    /// With 3-DOF proxy rendering: resting force over depth (N/m) above which a copy feels hard.
+    hard_above_n_per_m: Option<f32>,
 }
 
 impl Exploration {
@@ -260,7 +264,16 @@ impl Exploration {
             disturbed: false,
             attempts: 1,
             findings: None,
+            hard_above_n_per_m: None,
         }
+    }
+
+    /// Judges hardness by the resting force over the depth against `threshold` (N/m) instead of the
+    /// volumetric rendering's force over depth²: with 3-DOF proxy rendering the force is a spring,
+    /// k × depth (see [`crate::haptics::Haptics::hard_above_n_per_m`]).
+    pub fn judging_springs(mut self, threshold: Option<f32>) -> Self {
+        self.hard_above_n_per_m = threshold;
+        self
     }
 
     /// Where the hand should go now (scene frame).
@@ -325,8 +338,12 @@ impl Exploration {
                 let touches = self.touches();
                 let near = (n + k - PRESS_SPAN..=n + k + PRESS_SPAN).filter_map(|i| touches[i % n]).collect();
                 self.surface = median(near).unwrap_or(r_in + 0.007);
-                (Stage::Approach, line(at, axis + self.press_normal * r_out, 0.4), 0.5)
+                let start_rad = (-at.z).atan2(at.x);
+                let turns = ((self.press_angle - start_rad) / TAU + 0.5).rem_euclid(1.0) - 0.5;
+                let round = HandGoal::Orbit { centre, radius: r_out, start_rad, period_s: 3.0, turns, start_us: start };
+                (Stage::Round, round, 3.0 * turns.abs() + 0.05)
             }
+            Stage::Round => (Stage::Approach, line(at, axis + self.press_normal * r_out, 0.4), 0.5),
             Stage::Approach => {
                 let reach = REACH_M + DEEPER_M * (self.presses - 1) as f32;
                 (Stage::Press, line(at, axis + self.press_normal * (self.surface - reach), 0.5), 0.8)
@@ -505,7 +522,11 @@ impl Exploration {
         let pressure_n_per_m2 = median(rests.iter().map(|(d, f)| f / (d * d)).collect()).unwrap_or(0.0);
         let friction = if self.slide.1 > 0.0 { self.slide.0 / self.slide.1 } else { 0.0 };
         let rough = friction > ROUGH_ABOVE;
-        let material = match (pressure_n_per_m2 > hard_above_n_per_m2(self.kind, rough), rough) {
+        let hard = match self.hard_above_n_per_m {
+            Some(threshold) => stiffness_n_per_m > threshold,
+            None => pressure_n_per_m2 > hard_above_n_per_m2(self.kind, rough),
+        };
+        let material = match (hard, rough) {
             (true, false) => MaterialClass::HardSmooth,
             (true, true) => MaterialClass::HardRough,
             (false, false) => MaterialClass::SoftSmooth,
@@ -546,7 +567,7 @@ pub fn feel(
         }
         std::thread::sleep(Duration::from_millis(5));
     }
-    let mut ex = Exploration::new(kind, h.now_us());
+    let mut ex = Exploration::new(kind, h.now_us()).judging_springs(h.hard_above_n_per_m());
     let map = h.map;
     let hand = |h: &mut crate::haptics::Haptics, goal| {
         h.hand.as_mut().map(|c| c.set(to_device(&map, goal))).ok_or("the device has no steerable hand")
@@ -695,11 +716,19 @@ mod tests {
             if ex.step(now, &samples) {
                 stages.push((ex.stage, ex.stage_start_us));
                 let (_, r_out, ..) = ring(ArtifactKind::Idol);
-                if ex.stage == Stage::Return {
+                if matches!(ex.stage, Stage::Return | Stage::Round) {
                     for dt in (0..3_000_000).step_by(100_000) {
                         let p = ex.goal().sample(ex.stage_start_us + dt).translation;
                         assert!((Vec3::new(p.x, 0.0, p.z).length() - r_out).abs() < 1e-4, "round the ring");
                     }
+                }
+                if ex.stage == Stage::Round {
+                    // It ends at the press's angle: the approach then only moves along the axis.
+                    let end = ex.goal().sample(ex.stage_end_us).translation;
+                    let angle = (-end.z).atan2(end.x).rem_euclid(TAU);
+                    let off = (angle - ex.press_angle.rem_euclid(TAU) + 3.0 * std::f32::consts::PI).rem_euclid(TAU)
+                        - std::f32::consts::PI;
+                    assert!(off.abs() < 1e-3, "ends {off} rad from the press's angle");
                 }
             }
             if let Some(f) = ex.findings() {
@@ -714,6 +743,7 @@ mod tests {
         let (findings, stages) = run(|_| Some(1_000));
         assert_eq!((findings.attempts, findings.disturbed, findings.presses), (1, false, 1), "{stages:?}");
         assert!(!stages.iter().any(|(s, _)| *s == Stage::Retreat), "{stages:?}");
+        assert!(stages.iter().any(|(s, _)| *s == Stage::Round), "goes round the ring to press: {stages:?}");
         assert!(findings.stroke_contact > 0.9, "{findings:?}");
         let r = body_radius();
         let (body, notch) = (r - 0.001..r, r - 0.006..r - 0.005);

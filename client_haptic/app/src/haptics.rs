@@ -16,7 +16,9 @@ use collette::{BuildOptions, InnerSphereTree, TriMesh};
 use forcecomp::Material;
 use glam::Vec3;
 use haptic_common::Pose;
-use haptic_rig::{ForceSample, HapticRig, ObjectSpec, RigConfig, StepTiming, ToolSpec, WorkspaceMap};
+use haptic_rig::{
+    ForceSample, HapticRig, ObjectSpec, ProxyRendering, Rendering, RigConfig, StepTiming, ToolSpec, WorkspaceMap,
+};
 use haptico::trace::TraceWriter;
 use haptico::{Device, DeviceSpecs, HapticEvents, TickTiming};
 use heist_shared::artifact::{self, HapticMesh};
@@ -36,6 +38,26 @@ const COPY_OBJECT: u32 = 1;
 /// Length of a rate window, µs.
 const WINDOW_US: u64 = 1_000_000;
 
+/// The stiffest material a copy can have, N/m (`artifact::MaterialClass`: hard 800, soft 300, within
+/// 200–1000): a 3-DOF device that cannot render it gets every copy's stiffness scaled down by the same
+/// factor, so hard stays as much harder than soft.
+pub const STIFFEST_COPY_N_PER_M: f32 = 1000.0;
+/// With proxy rendering, a copy whose briefed stiffness is above this (N/m, before the device's scaling)
+/// feels hard: between soft (300) and hard (800).
+pub const HARD_ABOVE_N_PER_M: f32 = 550.0;
+
+/// How forces are rendered.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum RenderingChoice {
+    /// By the device: the 3-DOF proxy when it renders no torque, else volumetric.
+    #[default]
+    Auto,
+    /// The gemstone's inner spheres against the copy's (force and torque, through a virtual coupling).
+    Volumetric,
+    /// The 3-DOF god-object: the stylus tip held on the copy's surface (force only).
+    Proxy,
+}
+
 /// How the haptic side is set up.
 #[derive(Resource, Clone, Debug)]
 pub struct HapticsSettings {
@@ -45,6 +67,8 @@ pub struct HapticsSettings {
     pub preset: Option<String>,
     /// Record the device's ticks to this trace file (default none).
     pub record: Option<PathBuf>,
+    /// How forces are rendered (default: by the device).
+    pub rendering: RenderingChoice,
     /// Spheres per copy's tree (default 3000).
     pub spheres: usize,
     /// Where built trees are cached (default none).
@@ -59,6 +83,7 @@ impl Default for HapticsSettings {
             device: DeviceChoice::Sim,
             preset: None,
             record: None,
+            rendering: RenderingChoice::Auto,
             spheres: 3000,
             cache_dir: None,
             realtime_priority: None,
@@ -108,6 +133,11 @@ pub struct Haptics {
     pub hand: Option<HandControl>,
     /// The device's limits.
     pub specs: DeviceSpecs,
+    /// How forces are rendered (the choice resolved for the device).
+    pub rendering: Rendering,
+    /// With proxy rendering: every copy's stiffness is scaled by this to fit the device (1 when the
+    /// device renders [`STIFFEST_COPY_N_PER_M`]).
+    pub stiffness_scale: f32,
     /// Device frame to scene (the workbench frame).
     pub map: WorkspaceMap,
     /// The gem's packed volume [`REFERENCE_DEPTH_M`] deep in a flat face, m³ (see [`haptic_material`]).
@@ -149,7 +179,19 @@ impl Haptics {
             ToolSpec::new(Arc::new(tree), Material { stiffness_n_per_m3: 1e12, damping_ns_per_m: 1e6, friction: 1.0 });
         let scale = if specs.workspace_radius_m > 0.0 { (0.08 / specs.workspace_radius_m).max(1.0) } else { 1.0 };
         let map = WorkspaceMap { origin: Pose::IDENTITY, scale };
-        let mut config = RigConfig { map, ..RigConfig::default() };
+        let rendering = match settings.rendering {
+            RenderingChoice::Volumetric => Rendering::Coupled,
+            RenderingChoice::Proxy => Rendering::Proxy,
+            RenderingChoice::Auto if specs.renders_torque() => Rendering::Coupled,
+            RenderingChoice::Auto => Rendering::Proxy,
+        };
+        let stiffness_scale = (specs.max_stiffness_n_per_m / STIFFEST_COPY_N_PER_M).clamp(f32::MIN_POSITIVE, 1.0);
+        // The proxy's spring is ε_c × this: the briefed stiffness (see `haptic_material`), scaled to the device.
+        let proxy = ProxyRendering {
+            volume_per_depth_m2: tool_reference_volume_m3 / REFERENCE_DEPTH_M * stiffness_scale,
+            ..ProxyRendering::default()
+        };
+        let mut config = RigConfig { map, rendering, proxy, ..RigConfig::default() };
         config.haptic.realtime_priority = settings.realtime_priority;
         config.collision.realtime_priority = settings.realtime_priority.map(|p| (p - 1).max(1));
         let rig = HapticRig::start(device, tool, config, HapticEvents::default(), haptic_common::Delegator::new())?;
@@ -159,6 +201,8 @@ impl Haptics {
             recording_lost: 0,
             hand,
             specs,
+            rendering,
+            stiffness_scale,
             map,
             tool_reference_volume_m3,
             building: None,
@@ -184,7 +228,13 @@ impl Haptics {
 
     /// Whether 6-DOF torques reach the device.
     pub fn renders_torque(&self) -> bool {
-        self.specs.renders_torque()
+        self.specs.renders_torque() && self.rendering != Rendering::Proxy
+    }
+
+    /// With proxy rendering, the resting force over depth (N/m) above which a copy feels hard; `None`
+    /// with volumetric rendering (the touch bot then judges by force over depth²).
+    pub fn hard_above_n_per_m(&self) -> Option<f32> {
+        (self.rendering == Rendering::Proxy).then_some(HARD_ABOVE_N_PER_M * self.stiffness_scale)
     }
 
     /// Starts building the tree of `copy` (replacing whatever was on the bench).

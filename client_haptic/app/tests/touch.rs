@@ -1,16 +1,24 @@
 //! The touch bot judges copies from what it feels through the real haptic loop (sim device, collision
-//! thread, force stage), never from their data.
+//! thread, force stage), never from their data: through the 3-DOF proxy the default Phantom Desktop gets
+//! (it renders no torque), and through the volumetric rendering a 6-DOF device gets.
 
+use std::sync::Mutex;
 use std::time::Duration;
 
 use client_haptic::explore::feel;
-use client_haptic::haptics::{Haptics, HapticsSettings};
+use client_haptic::haptics::{Haptics, HapticsSettings, RenderingChoice};
+use haptic_rig::Rendering;
 use heist_shared::artifact::{ArtifactKind, build_mesh, generate_copies};
 use heist_shared::protocol::{ItemId, WorkbenchCopy};
 
-#[test]
-fn the_touch_bot_tells_every_copy_of_each_kind_by_touch() {
-    let mut h = Haptics::start(HapticsSettings::default()).expect("the haptic loop starts");
+/// One haptic loop at a time: two would share the two cores and disturb each other's explorations.
+static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+
+fn every_copy_is_told_right(rendering: RenderingChoice, expect: Rendering) {
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|p| p.into_inner());
+    let mut h =
+        Haptics::start(HapticsSettings { rendering, ..HapticsSettings::default() }).expect("the haptic loop starts");
+    assert_eq!(h.rendering, expect);
     std::thread::sleep(Duration::from_millis(2500)); // the safety layer ramps forces in
     let mut wrong = Vec::new();
     let mut item = 0;
@@ -33,4 +41,14 @@ fn the_touch_bot_tells_every_copy_of_each_kind_by_touch() {
     }
     h.stop();
     assert!(wrong.is_empty(), "misjudged: {wrong:?}");
+}
+
+#[test]
+fn the_touch_bot_tells_every_copy_of_each_kind_by_touch_through_the_3dof_proxy() {
+    every_copy_is_told_right(RenderingChoice::Auto, Rendering::Proxy);
+}
+
+#[test]
+fn the_touch_bot_tells_every_copy_of_each_kind_by_touch_through_volumetric_rendering() {
+    every_copy_is_told_right(RenderingChoice::Volumetric, Rendering::Coupled);
 }

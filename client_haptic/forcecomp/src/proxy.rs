@@ -176,13 +176,13 @@ impl Surface<'_> {
         (v, g)
     }
 
-    /// `p` moved onto the surface along the gradient (up to five Newton steps of at most half the tip's radius;
-    /// unchanged where the volume has no gradient).
+    /// `p` moved onto the surface along the gradient (up to five Newton steps of at most half the tip's
+    /// radius, until the volume is within 0.1 % of the level; unchanged where it has no gradient).
     fn project(&self, mut p: Vec3) -> Vec3 {
         for _ in 0..5 {
             let (v, g) = self.volume_and_gradient(p);
             let gg = g.length_squared();
-            if !(gg > 0.0 && v.is_finite()) {
+            if !(gg > 0.0 && v.is_finite()) || (v - self.level).abs() <= 1e-3 * self.level {
                 break;
             }
             p -= (g * ((v - self.level) / gg)).clamp_length_max(0.5 * self.tip);
@@ -209,7 +209,7 @@ impl Surface<'_> {
             // Over a crease the Newton steps may not come back onto the surface: try shorter steps.
             let mut next = None;
             for _ in 0..4 {
-                if step.length_squared() < 1e-18 {
+                if step.length_squared() < (1e-4 * self.tip).powi(2) {
                     break;
                 }
                 let candidate = self.project(p + step);

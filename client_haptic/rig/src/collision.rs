@@ -172,17 +172,27 @@ impl CollisionWorld {
         let proxy = self.proxy;
         for object in self.objects.iter().filter(|_| proxy) {
             let spec = &object.spec;
-            let before = frame.balls.len() + frame.balls.overflow as usize;
-            let balls = &mut frame.balls;
-            spheres_near(
-                &spec.tree,
-                &spec.pose,
-                pose.pose.translation,
-                pose.reach,
-                &mut self.workspace,
-                |center, radius| balls.push(Ball { center, radius }, count),
-            );
-            if frame.balls.len() + frame.balls.overflow as usize == before {
+            let first = frame.balls.len();
+            // Too many spheres within reach (a fine packing): gather again nearer the tip, so that the
+            // nearest are never the ones left out.
+            let mut reach = pose.reach;
+            for _ in 0..4 {
+                frame.balls.truncate(first);
+                let balls = &mut frame.balls;
+                spheres_near(
+                    &spec.tree,
+                    &spec.pose,
+                    pose.pose.translation,
+                    reach,
+                    &mut self.workspace,
+                    |center, radius| balls.push(Ball { center, radius }, count),
+                );
+                if frame.balls.overflow == 0 {
+                    break;
+                }
+                reach *= 0.6;
+            }
+            if frame.balls.len() == first {
                 continue;
             }
             let slot = &mut frame.objects[count];

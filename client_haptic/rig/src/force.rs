@@ -25,7 +25,8 @@ pub struct ForceSample {
     pub torque: Vec3,
     /// Contact force on the simulated tool before coupling and safety (device frame), N.
     pub contact_force: Vec3,
-    /// Where the simulated tool was (scene frame), m.
+    /// Where the simulated tool was (scene frame), m; with proxy rendering the tip (the device point,
+    /// which sinks in; the proxy on the surface is the telemetry's `tool_pose`).
     pub tool_position: Vec3,
     /// Contacts used.
     pub contacts: u32,
@@ -96,8 +97,8 @@ pub struct ProxyRendering {
     pub volume_per_depth_m2: f32,
     /// Damping of the tip's speed into the surface, N·s/m (default 0.5).
     pub damping_ns_per_m: f32,
-    /// Spheres are handed to the proxy this far beyond its distance from the tip, scene units
-    /// (default 0.01: the tip may move that far between collision steps).
+    /// Spheres are handed to the proxy this far beyond its distance from the tip and its radius, scene
+    /// units (default 0.003: the tip moves less than that between collision steps below 3 m/s).
     pub margin: f32,
     /// Radius of the tip, scene units (default 0.004): a few times the radius of an Inner Sphere
     /// Tree's spheres near the surface (1–3 mm for a 10 cm object of a few thousand spheres), so that
@@ -107,7 +108,7 @@ pub struct ProxyRendering {
 
 impl Default for ProxyRendering {
     fn default() -> Self {
-        Self { volume_per_depth_m2: 1e-5, damping_ns_per_m: 0.5, margin: 0.01, tip_radius: 0.004 }
+        Self { volume_per_depth_m2: 1e-5, damping_ns_per_m: 0.5, margin: 0.003, tip_radius: 0.004 }
     }
 }
 
@@ -327,7 +328,7 @@ impl ForceStage {
             force: out.force,
             torque: out.torque,
             contact_force: contact_device.force,
-            tool_position: proxy_pose.translation,
+            tool_position: tip.translation,
             contacts,
             data_age_us: age_us.min(u32::MAX as u64) as u32,
             collision_sequence: sequence,

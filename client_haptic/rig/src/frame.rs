@@ -78,6 +78,12 @@ impl Balls {
         self.len += 1;
     }
 
+    /// Drops the spheres from the `len`-th on and forgets the overflow (to gather again, nearer).
+    pub fn truncate(&mut self, len: usize) {
+        self.len = self.len.min(len);
+        self.overflow = 0;
+    }
+
     /// The spheres (scene frame).
     pub fn as_slice(&self) -> &[Ball] {
         &self.balls[..self.len]
