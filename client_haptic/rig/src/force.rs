@@ -247,27 +247,8 @@ impl ForceStage {
             }),
             Source::Collette(c) => c.tool.set(tool_now, device.timestamp_us),
         }
-        let _ = self.samples.push(ForceSample {
-            t_us: device.timestamp_us,
-            force: out.force,
-            torque: out.torque,
-            contact_force: contact_device.force,
-            tool_position: tool_now.translation,
-            contacts,
-            data_age_us: age_us.min(u32::MAX as u64) as u32,
-            collision_sequence: sequence,
-        });
-        self.telemetry.write(RigTelemetry {
-            device,
-            tool_pose: tool_now,
-            output: out,
-            contacts,
-            collision_sequence: sequence,
-            data_age_us: age_us,
-            safety_phase: self.safety.phase(),
-            safety_gain: self.safety.gain(),
-            safety: self.safety.stats(),
-        });
+        let used = Used { contacts, sequence, age_us };
+        self.report(device, out, contact_device.force, tool_now.translation, tool_now, used);
     }
 
     /// One tick of 3-DOF proxy rendering: the tip against the spheres near it, no coupling, no torque.
@@ -323,19 +304,34 @@ impl ForceStage {
             timestamp_us: device.timestamp_us,
             reach: self.god.proxy().distance(tip.translation) + self.proxy.margin + self.proxy.tip_radius,
         });
+        let used = Used { contacts, sequence, age_us };
+        self.report(device, out, contact_device.force, tip.translation, proxy_pose, used);
+    }
+
+    /// Records the tick's force sample and publishes the telemetry.
+    fn report(
+        &mut self,
+        device: DeviceState,
+        out: ForceTorque,
+        contact_force: Vec3,
+        tool_position: Vec3,
+        tool_pose: Pose,
+        used: Used,
+    ) {
+        let Used { contacts, sequence, age_us } = used;
         let _ = self.samples.push(ForceSample {
             t_us: device.timestamp_us,
             force: out.force,
             torque: out.torque,
-            contact_force: contact_device.force,
-            tool_position: tip.translation,
+            contact_force,
+            tool_position,
             contacts,
             data_age_us: age_us.min(u32::MAX as u64) as u32,
             collision_sequence: sequence,
         });
         self.telemetry.write(RigTelemetry {
             device,
-            tool_pose: proxy_pose,
+            tool_pose,
             output: out,
             contacts,
             collision_sequence: sequence,
@@ -345,4 +341,13 @@ impl ForceStage {
             safety: self.safety.stats(),
         });
     }
+}
+
+/// The contact data a tick used: how many contacts (or spheres near the tip), the collision step's
+/// sequence, and its age in µs (`u64::MAX` before the first step).
+#[derive(Clone, Copy)]
+struct Used {
+    contacts: u32,
+    sequence: u64,
+    age_us: u64,
 }

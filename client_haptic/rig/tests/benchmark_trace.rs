@@ -2,8 +2,9 @@
 //! no command ever exceeds the device's clamps, no tick changes the force by more than the rate limit,
 //! and nothing is ever NaN.
 
-use std::sync::Arc;
 use std::time::Duration;
+
+mod utils;
 
 use collette::scene;
 use forcecomp::{Material, SafetyConfig};
@@ -15,15 +16,7 @@ use haptico::sim::{Keyframe, SimConfig, SimDevice, TargetPath};
 
 #[test]
 fn clamps_and_force_rate_hold_along_the_whole_benchmark_trace() {
-    let bunny_mesh = scene::load_bunny(scene::default_bunny_path()).expect("bunny");
-    let (bunny, _) =
-        collette::build(&bunny_mesh, &collette::BuildOptions::spheres(1500), &mut |_| {}).expect("bunny tree");
-    let (gem, _) = collette::build(
-        &scene::brilliant_cut(scene::TOOL_DIAMETER),
-        &collette::BuildOptions::spheres(150),
-        &mut |_| {},
-    )
-    .expect("gem tree");
+    let (bunny_mesh, bunny, gem) = utils::small_bunny_scene();
     let path = scene::trajectory(&bunny_mesh);
     let keyframes = path.iter().map(|s| Keyframe { t_s: s.time_s, pose: s.tool }).collect();
     let specs = presets::phantom_premium_6dof();
@@ -37,9 +30,8 @@ fn clamps_and_force_rate_hold_along_the_whole_benchmark_trace() {
     // Very stiff materials, so that the deep stretch asks for more than the device's peak force.
     let stiff = Material { stiffness_n_per_m3: 1e10, damping_ns_per_m: 4.0, friction: 0.3 };
     let mut rig =
-        Lockstep::new(device, ToolSpec::new(Arc::new(gem), stiff), &config, 2, Some(Duration::from_micros(400)))
-            .expect("rig");
-    rig.add_object(ObjectSpec { id: 1, tree: Arc::new(bunny), pose: Pose::IDENTITY, material: stiff }).expect("bunny");
+        Lockstep::new(device, ToolSpec::new(gem, stiff), &config, 2, Some(Duration::from_micros(400))).expect("rig");
+    rig.add_object(ObjectSpec { id: 1, tree: bunny, pose: Pose::IDENTITY, material: stiff }).expect("bunny");
 
     let mut previous = haptic_common::ForceTorque::ZERO;
     let (mut max_f, mut max_tau, mut max_step, mut touched) = (0.0f32, 0.0f32, 0.0f32, 0u32);

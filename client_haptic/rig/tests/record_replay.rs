@@ -6,7 +6,6 @@ mod utils;
 
 use std::path::PathBuf;
 use std::process::Command;
-use std::sync::Arc;
 use std::time::Duration;
 
 use collette::scene;
@@ -27,19 +26,10 @@ fn temp(name: &str) -> PathBuf {
 
 /// The bunny scene with small trees, in lockstep with exact queries, ticked at `times`.
 fn run_bunny_scene(device: impl Device, times: &[u64]) -> Vec<ForceTorque> {
-    let bunny_mesh = scene::load_bunny(scene::default_bunny_path()).expect("bunny");
-    let (bunny, _) =
-        collette::build(&bunny_mesh, &collette::BuildOptions::spheres(1500), &mut |_| {}).expect("bunny tree");
-    let (gem, _) = collette::build(
-        &scene::brilliant_cut(scene::TOOL_DIAMETER),
-        &collette::BuildOptions::spheres(150),
-        &mut |_| {},
-    )
-    .expect("gem tree");
+    let (_, bunny, gem) = utils::small_bunny_scene();
     let material = Material { stiffness_n_per_m3: 5e8, damping_ns_per_m: 4.0, friction: 0.3 };
-    let mut rig =
-        Lockstep::new(device, ToolSpec::new(Arc::new(gem), material), &RigConfig::default(), 1, None).expect("rig");
-    rig.add_object(ObjectSpec { id: 1, tree: Arc::new(bunny), pose: Pose::IDENTITY, material }).expect("bunny");
+    let mut rig = Lockstep::new(device, ToolSpec::new(gem, material), &RigConfig::default(), 1, None).expect("rig");
+    rig.add_object(ObjectSpec { id: 1, tree: bunny, pose: Pose::IDENTITY, material }).expect("bunny");
     times.iter().map(|&t| rig.tick(t)).collect()
 }
 
@@ -49,7 +39,7 @@ fn bits(f: &ForceTorque) -> [u32; 6] {
 
 #[test]
 fn a_lockstep_replay_of_a_recorded_trace_renders_the_recorded_forces_to_the_bit() {
-    let bunny_mesh = scene::load_bunny(scene::default_bunny_path()).expect("bunny");
+    let (bunny_mesh, ..) = utils::small_bunny_scene();
     let keyframes = scene::trajectory(&bunny_mesh).iter().map(|s| Keyframe { t_s: s.time_s, pose: s.tool }).collect();
     let device = SimDevice::new(SimConfig::new(presets::phantom_premium_6dof()), TargetPath::Keyframes(keyframes));
     let path = temp("bunny.trace");
@@ -86,13 +76,7 @@ fn every_tick_of_the_real_threads_reaches_the_file() {
     let tool = ToolSpec::new(utils::ball_tool(), Material::default());
     let rig =
         HapticRig::start(device, tool, RigConfig::default(), HapticEvents::default(), Delegator::new()).expect("rig");
-    rig.add_object(ObjectSpec {
-        id: 3,
-        tree: utils::slab(),
-        pose: Pose::from_translation(Vec3::new(0.0, -0.01, 0.0)),
-        material: Material::default(),
-    })
-    .expect("object");
+    rig.add_object(utils::slab_object(3)).expect("object");
     std::thread::sleep(Duration::from_millis(500));
     let ran = rig.haptic_telemetry().ticks;
     let recording = rig.stop().expect("the device comes back");

@@ -40,13 +40,7 @@ fn the_rig_runs_both_threads_and_broadcasts_collisions() {
     });
     let tool = ToolSpec::new(utils::ball_tool(), Material::default());
     let rig = HapticRig::start(device, tool, RigConfig::default(), HapticEvents::default(), on_collision).expect("rig");
-    rig.add_object(ObjectSpec {
-        id: 3,
-        tree: utils::slab(),
-        pose: Pose::from_translation(Vec3::new(0.0, -0.01, 0.0)),
-        material: Material::default(),
-    })
-    .expect("object");
+    rig.add_object(utils::slab_object(3)).expect("object");
     assert!(eventually(|| rig.haptic_telemetry().ticks > 50 && rig.telemetry().collision_sequence > 50));
     assert!(eventually(|| hits.load(std::sync::atomic::Ordering::Relaxed) > 0), "OnCollision fired with contacts");
     let mut samples = Vec::new();

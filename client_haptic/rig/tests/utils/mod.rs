@@ -30,3 +30,27 @@ pub fn slab() -> Arc<InnerSphereTree> {
     })
     .clone()
 }
+
+/// The slab with its top face at y = 0, as object `id` with the default material.
+pub fn slab_object(id: u32) -> haptic_rig::ObjectSpec {
+    haptic_rig::ObjectSpec {
+        id,
+        tree: slab(),
+        pose: haptic_common::Pose::from_translation(glam::Vec3::new(0.0, -0.01, 0.0)),
+        material: forcecomp::Material::default(),
+    }
+}
+
+/// The benchmark scene with small trees: the bunny's mesh (metres), its tree of 1,500 spheres and the
+/// gemstone tool's of 150 (built once per test binary).
+pub fn small_bunny_scene() -> (collette::TriMesh, Arc<InnerSphereTree>, Arc<InnerSphereTree>) {
+    static T: OnceLock<(collette::TriMesh, Arc<InnerSphereTree>, Arc<InnerSphereTree>)> = OnceLock::new();
+    T.get_or_init(|| {
+        use collette::scene;
+        let bunny_mesh = scene::load_bunny(scene::default_bunny_path()).expect("bunny");
+        let bunny = build(&bunny_mesh, 1500);
+        let gem = build(&scene::brilliant_cut(scene::TOOL_DIAMETER), 150);
+        (bunny_mesh, bunny, gem)
+    })
+    .clone()
+}
