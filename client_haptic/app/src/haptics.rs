@@ -43,8 +43,11 @@ const WINDOW_US: u64 = 1_000_000;
 /// factor, so hard stays as much harder than soft.
 pub const STIFFEST_COPY_N_PER_M: f32 = 1000.0;
 /// With proxy rendering, a copy whose briefed stiffness is above this (N/m, before the device's scaling)
-/// feels hard: between soft (300) and hard (800).
-pub const HARD_ABOVE_N_PER_M: f32 = 550.0;
+/// feels hard: halfway between the soft and the hard materials (300 and 800: 550).
+pub fn hard_above_n_per_m() -> f32 {
+    let stiffness = |c: artifact::MaterialClass| c.material().stiffness_n_per_m;
+    0.5 * (stiffness(artifact::MaterialClass::SoftSmooth) + stiffness(artifact::MaterialClass::HardSmooth))
+}
 
 /// How forces are rendered.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
@@ -234,7 +237,7 @@ impl Haptics {
     /// With proxy rendering, the resting force over depth (N/m) above which a copy feels hard; `None`
     /// with volumetric rendering (the touch bot then judges by force over depth²).
     pub fn hard_above_n_per_m(&self) -> Option<f32> {
-        (self.rendering == Rendering::Proxy).then_some(HARD_ABOVE_N_PER_M * self.stiffness_scale)
+        (self.rendering == Rendering::Proxy).then(|| hard_above_n_per_m() * self.stiffness_scale)
     }
 
     /// Starts building the tree of `copy` (replacing whatever was on the bench).
@@ -417,6 +420,15 @@ pub fn build_tree(
 mod tests {
     use super::*;
     use heist_shared::artifact::{ArtifactKind, MaterialClass, build_mesh, generate_copies};
+
+    #[test]
+    fn the_proxys_hardness_threshold_lies_between_every_soft_and_every_hard_material() {
+        let t = hard_above_n_per_m();
+        for c in MaterialClass::ALL {
+            let k = c.material().stiffness_n_per_m;
+            assert!(if c.is_hard() { k > t + 100.0 } else { k < t - 100.0 }, "{c:?}: {k} N/m against {t}");
+        }
+    }
 
     #[test]
     fn a_hard_copy_pushes_back_its_briefed_stiffness_at_the_reference_depth() {

@@ -47,4 +47,9 @@ impl ForceTorque {
     pub fn is_finite(&self) -> bool {
         self.force.is_finite() && self.torque.is_finite()
     }
+
+    /// The six components' bits, to compare two commands exactly (−0.0 and 0.0 differ, as in a file).
+    pub fn to_bits(&self) -> [u32; 6] {
+        [self.force.x, self.force.y, self.force.z, self.torque.x, self.torque.y, self.torque.z].map(f32::to_bits)
+    }
 }

@@ -194,12 +194,7 @@ impl ForceStage {
                 for object in frame.touched() {
                     add(&object.contacts, &object.material, &object.motion);
                 }
-                let age = if frame.sequence == 0 {
-                    u64::MAX
-                } else {
-                    device.timestamp_us.saturating_sub(frame.pose_timestamp_us)
-                };
-                (frame.sequence, age)
+                (frame.sequence, frame.age_us(device.timestamp_us))
             }
             Source::Collette(c) => {
                 let mut sequence = 0;
@@ -226,10 +221,10 @@ impl ForceStage {
             Rendering::Coupled => self.coupling.step(&device, contact_device, dt),
             Rendering::Direct | Rendering::Proxy => contact_device,
         };
-        let age_s = if age_us == u64::MAX { f32::INFINITY } else { age_us as f32 * 1e-6 };
+        let used = Used { contacts, sequence, age_us };
         let before = tick.total();
         let requested = ForceTorque { force: before.force + wanted.force, torque: before.torque + wanted.torque };
-        let out = self.safety.apply(requested, dt, age_s);
+        let out = self.safety.apply(requested, dt, used.age_s());
         tick.set(out);
 
         let tool_now = match self.rendering {
@@ -247,7 +242,6 @@ impl ForceStage {
             }),
             Source::Collette(c) => c.tool.set(tool_now, device.timestamp_us),
         }
-        let used = Used { contacts, sequence, age_us };
         self.report(device, out, contact_device.force, tool_now.translation, tool_now, used);
     }
 
@@ -284,16 +278,11 @@ impl ForceStage {
         let velocity = self.map.velocity_to_scene(device.linear_velocity) / scale;
         let force_scene = self.god.update(&config, tip.translation, velocity, balls, scale);
         let contact_device = self.map.wrench_to_device(ForceTorque { force: force_scene, torque: Vec3::ZERO });
-        let (sequence, age_us) = if frame.sequence == 0 {
-            (0, u64::MAX)
-        } else {
-            (frame.sequence, device.timestamp_us.saturating_sub(frame.pose_timestamp_us))
-        };
-        let contacts = balls.len() as u32;
-        let age_s = if age_us == u64::MAX { f32::INFINITY } else { age_us as f32 * 1e-6 };
+        let used =
+            Used { contacts: balls.len() as u32, sequence: frame.sequence, age_us: frame.age_us(device.timestamp_us) };
         let before = tick.total();
         let requested = ForceTorque { force: before.force + contact_device.force, torque: before.torque };
-        let out = self.safety.apply(requested, tick.dt_s, age_s);
+        let out = self.safety.apply(requested, tick.dt_s, used.age_s());
         tick.set(out);
         let proxy_pose = Pose::new(self.god.proxy(), tip.rotation);
         poses.write(ToolPoseMsg {
@@ -304,7 +293,6 @@ impl ForceStage {
             timestamp_us: device.timestamp_us,
             reach: self.god.proxy().distance(tip.translation) + self.proxy.margin + self.proxy.tip_radius,
         });
-        let used = Used { contacts, sequence, age_us };
         self.report(device, out, contact_device.force, tip.translation, proxy_pose, used);
     }
 
@@ -350,4 +338,11 @@ struct Used {
     contacts: u32,
     sequence: u64,
     age_us: u64,
+}
+
+impl Used {
+    /// The data's age for the safety layer's watchdog, seconds (infinite before the first step).
+    fn age_s(&self) -> f32 {
+        if self.age_us == u64::MAX { f32::INFINITY } else { self.age_us as f32 * 1e-6 }
+    }
 }

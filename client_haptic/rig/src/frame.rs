@@ -150,6 +150,12 @@ impl CollisionFrame {
         &self.objects[..self.count]
     }
 
+    /// Age at `now_us` of the tool pose this frame was computed from, µs (`u64::MAX` before the first
+    /// step).
+    pub fn age_us(&self, now_us: u64) -> u64 {
+        if self.sequence == 0 { u64::MAX } else { now_us.saturating_sub(self.pose_timestamp_us) }
+    }
+
     /// Number of contacts over all objects (spheres near the tip, with proxy rendering).
     pub fn contact_count(&self) -> usize {
         self.touched().iter().map(|o| o.contacts.len()).sum::<usize>() + self.balls.len()

@@ -33,10 +33,6 @@ fn run_bunny_scene(device: impl Device, times: &[u64]) -> Vec<ForceTorque> {
     times.iter().map(|&t| rig.tick(t)).collect()
 }
 
-fn bits(f: &ForceTorque) -> [u32; 6] {
-    [f.force.x, f.force.y, f.force.z, f.torque.x, f.torque.y, f.torque.z].map(f32::to_bits)
-}
-
 #[test]
 fn a_lockstep_replay_of_a_recorded_trace_renders_the_recorded_forces_to_the_bit() {
     let (bunny_mesh, ..) = utils::small_bunny_scene();
@@ -53,14 +49,17 @@ fn a_lockstep_replay_of_a_recorded_trace_renders_the_recorded_forces_to_the_bit(
     let recorded = trace::load_trace(&path).expect("the trace reads back");
     let commands = recorded.commands.clone().expect("a v2 trace carries the commands");
     assert_eq!(commands.len(), 20_000);
-    assert!(rendered.iter().zip(&commands).all(|(a, b)| bits(a) == bits(b)), "the file holds what was commanded");
+    assert!(
+        rendered.iter().zip(&commands).all(|(a, b)| a.to_bits() == b.to_bits()),
+        "the file holds what was commanded"
+    );
     let pushing = commands.iter().filter(|c| c.force.length() > 0.05).count();
     assert!(pushing > 1000, "the path presses into the bunny ({pushing} ticks above 0.05 N)");
 
     let replayed = TraceDevice::new(presets::phantom_premium_6dof(), recorded.states.clone(), false).expect("trace");
     let times: Vec<u64> = recorded.states.iter().map(|s| s.timestamp_us).collect();
     let again = run_bunny_scene(replayed, &times);
-    let differing = again.iter().zip(&commands).filter(|(a, b)| bits(a) != bits(b)).count();
+    let differing = again.iter().zip(&commands).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
     assert_eq!(differing, 0, "ticks whose replayed force differs from the recorded one");
     std::fs::remove_file(&path).ok();
 }

@@ -283,7 +283,7 @@ mod tests {
         save(&path, &samples(), &commands()).expect("save");
         let back = load_trace(&path).expect("load");
         assert_eq!(back.states, samples());
-        let bits = |c: &[ForceTorque]| c.iter().map(|c| c.force.x.to_bits() ^ c.torque.z.to_bits()).collect::<Vec<_>>();
+        let bits = |c: &[ForceTorque]| c.iter().map(ForceTorque::to_bits).collect::<Vec<_>>();
         assert_eq!(back.commands.as_deref(), Some(&commands()[..]));
         assert_eq!(bits(back.commands.as_deref().unwrap_or_default()), bits(&commands()), "to the bit, -0.0 too");
         std::fs::remove_dir_all(&dir).ok();

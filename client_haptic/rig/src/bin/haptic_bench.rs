@@ -351,7 +351,7 @@ fn lockstep(
         safety
     );
     let compared = replay.and_then(|t| t.commands.as_deref()).map(|recorded| {
-        let same = forces.iter().zip(recorded).filter(|(a, b)| bits(a) == bits(b)).count();
+        let same = forces.iter().zip(recorded).filter(|(a, b)| a.to_bits() == b.to_bits()).count();
         let worst = forces.iter().zip(recorded).map(|(a, b)| (a.force - b.force).length()).fold(0.0f32, f32::max);
         println!(
             "replay: {same} of {} ticks' forces are the recorded ones to the bit; largest force difference {worst:.3e} N",
@@ -374,11 +374,6 @@ fn lockstep(
         println!("{json}");
     }
     Ok(())
-}
-
-/// The bits of a force and torque (so that -0.0 and 0.0 differ, as they would in a file).
-fn bits(f: &ForceTorque) -> [u32; 6] {
-    [f.force.x, f.force.y, f.force.z, f.torque.x, f.torque.y, f.torque.z].map(f32::to_bits)
 }
 
 /// Closes a recording and says what it wrote.

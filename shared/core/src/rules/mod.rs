@@ -50,6 +50,7 @@ pub fn move_body(
 ) -> glam::Vec2 {
     walls.slide(from, direction * speed * dt, BODY_RADIUS)
 }
+
 /// Where a thrown object lands: aimed at `target`, at most [`THROW_RANGE`] away, it flies (checked
 /// every 25 cm) until the next step would cross a wall or leave the rooms, and lands just before. The
 /// server throws with this and the Vive bot plans its lures with it.
