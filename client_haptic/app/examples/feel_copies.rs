@@ -51,7 +51,7 @@ fn main() -> anyhow::Result<()> {
     std::thread::sleep(std::time::Duration::from_millis(2500));
     println!(
         "kind,seed,count,material,felt_count,felt_material,stiffness_n_per_m,pressure_n_per_m2,friction,\
-         stroke_contact,attempts,presses,right"
+         ridge_mm,ridge_strength,stroke_contact,attempts,presses,right"
     );
     let (mut item, mut felt, mut wrong) = (0, 0, 0);
     for &seed in &args.seeds {
@@ -78,8 +78,10 @@ fn main() -> anyhow::Result<()> {
                         let mm: Vec<String> = f.profile.iter().map(|r| format!("{:.1}", r * 1e3)).collect();
                         eprintln!("{kind:?} seed {seed}: {}; profile (mm) {}", f.describe(), mm.join(" "));
                     }
+                    // The strongest repeat the strokes had, ridges or not (spacing, strength).
+                    let (ridge_mm, ridge_strength) = f.ridges.map_or((0.0, 0.0), |(s, a)| (s * 1e3, a));
                     println!(
-                        "{kind:?},{seed},{},{:?},{},{:?},{:.0},{:.0},{:.2},{:.2},{},{},{right}",
+                        "{kind:?},{seed},{},{:?},{},{:?},{:.0},{:.0},{:.2},{ridge_mm:.1},{ridge_strength:.3},{:.2},{},{},{right}",
                         t.feature_count,
                         t.material,
                         f.feature_count,

@@ -686,13 +686,15 @@ fn contact_sound(mut state: ResMut<PhantomState>, haptics: NonSend<Haptics>, mut
 }
 
 /// The contact sound's parameters from force samples (mean contact force and sliding speed of the
-/// stylus); `last` carries the previous sample between frames; `feel` sets hardness and roughness.
+/// stylus); `last` carries the previous sample between frames; `feel` sets hardness and roughness,
+/// and a ribbed copy's ridges tick at the rate the stylus crosses them (its speed up or down the copy
+/// over their spacing).
 pub fn contact_params(
     samples: &[haptic_rig::ForceSample],
     last: &mut Option<(u64, Vec3)>,
     feel: Option<MaterialClass>,
 ) -> ContactParams {
-    let (mut force, mut speed, mut n) = (0.0, 0.0, 0u32);
+    let (mut force, mut speed, mut climb, mut n) = (0.0, 0.0, 0.0, 0u32);
     for s in samples {
         let f = s.contact_force.length();
         if let Some((t, p)) = *last
@@ -700,7 +702,9 @@ pub fn contact_params(
         {
             let v = (s.tool_position - p) / ((s.t_us - t) as f32 * 1e-6);
             let normal = s.contact_force.normalize_or_zero();
-            speed += (v - normal * v.dot(normal)).length();
+            let slip = v - normal * v.dot(normal);
+            speed += slip.length();
+            climb += slip.y.abs();
         }
         *last = Some((s.t_us, s.tool_position));
         force += f;
@@ -710,11 +714,13 @@ pub fn contact_params(
         return ContactParams::default();
     }
     let feel = feel.unwrap_or(MaterialClass::HardSmooth);
+    let ridges_per_s = feel.material().ridges.map_or(0.0, |r| climb / n as f32 / r.spacing_m);
     ContactParams {
         force_n: force / n as f32,
         slip_m_per_s: speed / n as f32,
         hardness: if feel.is_hard() { 1.0 } else { 0.2 },
         roughness: if feel.is_rough() { 1.0 } else { 0.1 },
+        ridges_per_s,
     }
 }
 
@@ -812,5 +818,23 @@ mod tests {
         assert!((sliding.force_n - 1.2).abs() < 1e-4 && (sliding.slip_m_per_s - 0.05).abs() < 1e-3, "{sliding:?}");
         audio.contact(sliding);
         assert!(energy(capture.render(24_000)) > 1e-2, "the stylus sliding on a copy is heard");
+    }
+
+    #[test]
+    fn stroking_up_a_ribbed_copy_ticks_once_per_ridge_crossed_and_a_smooth_one_never() {
+        // Up the side of the copy (pressed along −x) at 6 cm/s: 20 ridges 3 mm apart a second.
+        let up: Vec<ForceSample> = stroke(1.0, 0.06)
+            .into_iter()
+            .map(|s| ForceSample {
+                contact_force: Vec3::X,
+                tool_position: Vec3::new(0.04, s.tool_position.x, 0.0),
+                ..s
+            })
+            .collect();
+        let ribbed = contact_params(&up, &mut None, Some(MaterialClass::SoftRough));
+        assert!((ribbed.ridges_per_s - 20.0).abs() < 0.1, "{ribbed:?}");
+        assert_eq!(contact_params(&up, &mut None, Some(MaterialClass::SoftSmooth)).ridges_per_s, 0.0);
+        // Round the copy, along the ridges: none crossed.
+        assert!(contact_params(&stroke(1.0, 0.06), &mut None, Some(MaterialClass::SoftRough)).ridges_per_s < 1e-3);
     }
 }

@@ -9,9 +9,11 @@
 //!    Each poke that met the surface also rests there: the force over the depth since first touch,
 //!    median over the pokes, gives the stiffness;
 //! 2. a light press on a plain part and a stroke down and up: the drag against the motion over the
-//!    normal force gives the friction. A stroke that was mostly out of touch (the press met nothing)
-//!    says nothing about the friction: the hand backs off and presses again, a little deeper, up to
-//!    [`ATTEMPTS`] times.
+//!    normal force gives the friction, and a push along the stroke that repeats with the height gives the
+//!    ridges: a copy with ridges ([`RIDGES_ABOVE`]) that grips ([`ROUGH_ABOVE`]) is rough (ribbed).
+//!    A stroke that was mostly out of touch
+//!    (the press met nothing) says nothing: the hand backs off and presses again, a little deeper, up
+//!    to [`ATTEMPTS`] times.
 //!
 //! A hand can only judge what it felt at full force: when the haptic loop stalls (the process was not
 //! scheduled) or the contact data goes stale, the safety layer fades the forces out and back in over two
@@ -44,8 +46,9 @@ pub fn taps(kind: ArtifactKind) -> usize {
 }
 /// Seconds per poke.
 pub const TAP_S: f32 = 0.4;
-/// Friction above which a copy feels rough (briefed: smooth 0.1, rough 0.6; felt through the packed
-/// skin's bumps a little higher).
+/// Friction above which a copy grips like a rough one (briefed: smooth 0.1, rough 0.6; felt through
+/// the packed skin's bumps a little higher). A ribbed copy must grip too: on a narrow soft idol the
+/// packing's bumps alone repeated as strongly as ridges (0.24, volumetric rendering, seed 24).
 pub const ROUGH_ABOVE: f32 = 0.45;
 /// Explorations of one copy at most, when the first ones were disturbed.
 pub const ATTEMPTS: u32 = 3;
@@ -62,7 +65,7 @@ const RECOVER_US: u64 = 2_500_000;
 /// hard, N/m². Learnt per kind, like a player learns how a hard crown feels: the crown's thin points give
 /// way more than the solid amphora or idol, and on the crown's points and the idol's narrow body a smooth
 /// surface lets the stylus slip aside, so those two have one threshold for smooth and one for rough
-/// copies (friction is told apart first). Set from the copies of seeds 3, 5 and 11
+/// copies (the ridges are told apart first). Set from the copies of seeds 3, 5 and 11
 /// (docs/phantom-client.md); the tests use other seeds.
 pub fn hard_above_n_per_m2(kind: ArtifactKind, rough: bool) -> f32 {
     match (kind, rough) {
@@ -118,7 +121,10 @@ pub struct Findings {
     pub pressure_n_per_m2: f32,
     /// Friction coefficient from the stroke.
     pub friction: f32,
-    /// The material class these make.
+    /// The strongest repeat felt along the strokes: (spacing, m; its push along the stroke over the
+    /// normal force). Ridges when that passes [`RIDGES_ABOVE`]; None when the strokes barely touched.
+    pub ridges: Option<(f32, f32)>,
+    /// The material class these make (ribbed when ridges were felt).
     pub material: MaterialClass,
     /// Explorations it took (more than one when the haptic loop was disturbed during one).
     pub attempts: u32,
@@ -147,8 +153,16 @@ impl Findings {
             0 | 1 => String::new(),
             n => format!(" ({n} presses: the earlier strokes met nothing)"),
         };
+        let ridges = match self.ridges {
+            Some((spacing, strength)) => format!(
+                "{} (strongest repeat every {:.1} mm, {strength:.2})",
+                if strength > RIDGES_ABOVE { "ridges" } else { "no ridges" },
+                spacing * 1000.0
+            ),
+            None => "no ridges (the strokes barely touched)".to_string(),
+        };
         format!(
-            "{} features, stiffness {:.0} N/m ({:.0} kN/m²), friction {:.2} ({:.0} % of the stroke in touch): {}{attempts}{presses}",
+            "{} features, stiffness {:.0} N/m ({:.0} kN/m²), friction {:.2}, {ridges} ({:.0} % of the stroke in touch): {}{attempts}{presses}",
             self.feature_count,
             self.stiffness_n_per_m,
             self.pressure_n_per_m2 / 1000.0,
@@ -222,6 +236,8 @@ pub struct Exploration {
     slide: (f32, f32),
     /// Sliding samples of this stroke: all of them, and those in touch.
     stroke: (u32, u32),
+    /// In-touch sliding samples of this press's strokes, for the ridges.
+    strokes: Vec<StrokeSample>,
     presses: u32,
     last: Option<(u64, Vec3)>,
     /// Haptic-clock time from which the forces are whole again after the last stall or stale data.
@@ -258,6 +274,7 @@ impl Exploration {
             surface: 0.0,
             slide: (0.0, 0.0),
             stroke: (0, 0),
+            strokes: Vec::with_capacity(2048),
             presses: 1,
             last: None,
             calm_from_us: 0,
@@ -351,6 +368,7 @@ impl Exploration {
             Stage::Press => {
                 self.slide = (0.0, 0.0);
                 self.stroke = (0, 0);
+                self.strokes.clear();
                 (Stage::SlideDown, line(at, at - Vec3::Y * SLIDE_M, 0.5), 0.55)
             }
             Stage::SlideDown => (Stage::SlideUp, line(at, at + Vec3::Y * SLIDE_M, 0.5), 0.55),
@@ -434,6 +452,12 @@ impl Exploration {
                         self.stroke.1 += 1;
                         self.slide.0 += -s.contact_force.y * velocity.y.signum();
                         self.slide.1 += normal;
+                        self.strokes.push(StrokeSample {
+                            height: p.y,
+                            along: s.contact_force.y,
+                            normal,
+                            up: velocity.y > 0.0,
+                        });
                     }
                 }
             }
@@ -521,7 +545,8 @@ impl Exploration {
         let stiffness_n_per_m = median(rests.iter().map(|(d, f)| f / d).collect()).unwrap_or(0.0);
         let pressure_n_per_m2 = median(rests.iter().map(|(d, f)| f / (d * d)).collect()).unwrap_or(0.0);
         let friction = if self.slide.1 > 0.0 { self.slide.0 / self.slide.1 } else { 0.0 };
-        let rough = friction > ROUGH_ABOVE;
+        let ridges = strongest_repeat(&self.strokes);
+        let rough = ridges.is_some_and(|(_, strength)| strength > RIDGES_ABOVE) && friction > ROUGH_ABOVE;
         let hard = match self.hard_above_n_per_m {
             Some(threshold) => stiffness_n_per_m > threshold,
             None => pressure_n_per_m2 > hard_above_n_per_m2(self.kind, rough),
@@ -538,6 +563,7 @@ impl Exploration {
             stiffness_n_per_m,
             pressure_n_per_m2,
             friction,
+            ridges,
             material,
             attempts: self.attempts,
             presses: self.presses,
@@ -545,6 +571,69 @@ impl Exploration {
             disturbed: self.disturbed,
         }
     }
+}
+
+/// One in-touch sample of a stroke: the stylus's height, the contact force along the stroke and into
+/// the copy, and which way it went.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct StrokeSample {
+    height: f32,
+    along: f32,
+    normal: f32,
+    up: bool,
+}
+
+/// Shortest and longest ridge spacing looked for, m: the stroke must cross at least three.
+const RIDGE_SPACINGS_M: (f32, f32) = (0.0015, SLIDE_M / 3.0);
+/// A push along the stroke that repeats with the stylus's height, this strong against the normal force
+/// (its Fourier amplitude over each way of the stroke), means ridges. Ribbed copies gave 0.25–0.48 and
+/// the packing's bumps on smooth ones at most 0.12 through the proxy, 0.24 once through the volumetric
+/// rendering (seeds 21–24, docs/phantom-client.md).
+pub const RIDGES_ABOVE: f32 = 0.18;
+
+/// The spacing at which the push along the stroke (less its mean on each way: the friction) repeats
+/// most strongly with the stylus's height on each way, and that strength over the mean normal force;
+/// None for fewer than 64 samples in touch.
+fn strongest_repeat(strokes: &[StrokeSample]) -> Option<(f32, f32)> {
+    if strokes.len() < 64 {
+        return None;
+    }
+    let mean = |up: bool| {
+        let (sum, n) = strokes.iter().filter(|s| s.up == up).fold((0.0, 0u32), |(a, n), s| (a + s.along, n + 1));
+        if n > 0 { sum / n as f32 } else { 0.0 }
+    };
+    let (mean_up, mean_down) = (mean(true), mean(false));
+    let normal = strokes.iter().map(|s| s.normal).sum::<f32>() / strokes.len() as f32;
+    // Each way on its own: the stylus lags the hand by up to the friction cone, one way down and the
+    // other way up, so the two ways' repeats can be out of phase (by half a ridge on a soft rough copy).
+    let strength = |spacing: f32| {
+        let (mut amplitude, mut total) = (0.0f32, 0.0f32);
+        for up in [false, true] {
+            let (mut c, mut s, mut travel) = (0.0f32, 0.0f32, 0.0f32);
+            for w in strokes.windows(2).filter(|w| w[0].up == up && w[1].up == up) {
+                let (a, b) = (w[0], w[1]);
+                let dy = (b.height - a.height).abs();
+                if dy > 0.001 {
+                    continue; // a gap in touch
+                }
+                let push = b.along - if up { mean_up } else { mean_down };
+                let phase = TAU * b.height / spacing;
+                c += push * phase.cos() * dy;
+                s += push * phase.sin() * dy;
+                travel += dy;
+            }
+            if travel > 0.0 {
+                amplitude += 2.0 * c.hypot(s);
+                total += travel;
+            }
+        }
+        if total > 0.0 { amplitude / total / normal.max(TOUCH_N) } else { 0.0 }
+    };
+    let (lo, hi) = RIDGE_SPACINGS_M;
+    (0..=64)
+        .map(|i| lo * (hi / lo).powf(i as f32 / 64.0))
+        .map(|spacing| (spacing, strength(spacing)))
+        .max_by(|a, b| a.1.total_cmp(&b.1))
 }
 
 /// Places `copy` on the bench of a running [`crate::haptics::Haptics`] (sim device) and explores it;
@@ -929,5 +1018,50 @@ mod tests {
         wrap[0] = 0.0;
         wrap[1] = 0.0;
         assert_eq!(lowest_run_middle(&wrap), 0);
+    }
+
+    /// A stroke 12 mm down and back up at 1 N against the copy, with friction `mu` and a push along it of
+    /// `ridge` N repeating every `spacing` m, plus `bump` N of push at the packing's 1.1 mm.
+    fn strokes(mu: f32, ridge: f32, spacing: f32, bump: f32) -> Vec<StrokeSample> {
+        let mut out = Vec::new();
+        for (up, from, to) in [(false, 0.0, -SLIDE_M), (true, -SLIDE_M, 0.0)] {
+            for i in 0..500 {
+                let height: f32 = from + (to - from) * i as f32 / 500.0;
+                let friction = if up { -mu } else { mu };
+                let along =
+                    friction + ridge * (TAU * height / spacing).sin() + bump * (TAU * height / 0.0011 + 0.3).sin();
+                out.push(StrokeSample { height, along, normal: 1.0, up });
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn ridges_are_found_at_their_spacing_whatever_the_friction() {
+        for mu in [0.1, 0.6] {
+            let (spacing, strength) = strongest_repeat(&strokes(mu, 0.3, 0.003, 0.05)).expect("stroked");
+            assert!(
+                (spacing - 0.003).abs() < 0.0003 && (strength - 0.3).abs() < 0.05,
+                "mu {mu}: {spacing} m, {strength}"
+            );
+        }
+        let (spacing, _) = strongest_repeat(&strokes(0.3, 0.3, 0.002, 0.0)).expect("finer ribs");
+        assert!((spacing - 0.002).abs() < 0.0002, "{spacing}");
+        // The stylus lagging the hand half a ridge one way and not the other (a soft, rough copy): the
+        // two ways' repeats are out of phase, and each still counts.
+        let lagged: Vec<StrokeSample> = strokes(0.6, 0.3, 0.003, 0.0)
+            .into_iter()
+            .map(|s| if s.up { StrokeSample { along: -0.6 - (s.along + 0.6), ..s } } else { s })
+            .collect();
+        let (spacing, strength) = strongest_repeat(&lagged).expect("stroked");
+        assert!((spacing - 0.003).abs() < 0.0003 && strength > 0.25, "{spacing} m, {strength}");
+    }
+
+    #[test]
+    fn friction_and_the_packings_bumps_alone_are_no_ridges() {
+        let weak = |s: &[StrokeSample]| strongest_repeat(s).is_some_and(|(_, strength)| strength < RIDGES_ABOVE);
+        assert!(weak(&strokes(0.6, 0.0, 0.003, 0.05)) && weak(&strokes(0.1, 0.0, 0.003, 0.0)));
+        // A stroke that barely touched says nothing.
+        assert_eq!(strongest_repeat(&strokes(0.1, 0.3, 0.003, 0.0)[..40]), None);
     }
 }

@@ -178,8 +178,10 @@ impl Haptics {
         let tool_reference_volume_m3 = immersed_volume(tree.spheres(), glam::Vec3::X, REFERENCE_DEPTH_M);
         // The gem is far stiffer than any copy, and its friction is 1 so the copy's own coefficient decides
         // (see `haptic_material`).
-        let tool =
-            ToolSpec::new(Arc::new(tree), Material { stiffness_n_per_m3: 1e12, damping_ns_per_m: 1e6, friction: 1.0 });
+        let tool = ToolSpec::new(
+            Arc::new(tree),
+            Material { stiffness_n_per_m3: 1e12, damping_ns_per_m: 1e6, friction: 1.0, texture: None },
+        );
         let scale = if specs.workspace_radius_m > 0.0 { (0.08 / specs.workspace_radius_m).max(1.0) } else { 1.0 };
         let map = WorkspaceMap { origin: Pose::IDENTITY, scale };
         let rendering = match settings.rendering {
@@ -346,12 +348,14 @@ impl Haptics {
 /// that pushes back `k · d0` when the gemstone is `d0` = [`REFERENCE_DEPTH_M`] deep in a flat, fully
 /// packed face, where its packed volume is `tool_volume_m3` (see [`immersed_volume`]); a copy's own
 /// packing leaves its skin a little softer. Friction is squared because contact friction is the
-/// geometric mean with the gem's (1).
+/// geometric mean with the gem's (1). Ridges become a texture repeating up the copy (+Y), their
+/// depth read with the briefed stiffness.
 pub fn haptic_material(m: &artifact::Material, tool_volume_m3: f32) -> Material {
     Material {
         stiffness_n_per_m3: m.stiffness_n_per_m * REFERENCE_DEPTH_M / tool_volume_m3.max(1e-12),
         damping_ns_per_m: m.damping,
         friction: m.friction * m.friction,
+        texture: m.ridges.map(|r| forcecomp::Texture::ribs(r.spacing_m, r.depth_m, m.stiffness_n_per_m)),
     }
 }
 
@@ -447,11 +451,13 @@ mod tests {
         assert!((force / (800.0 * d) - 1.0).abs() < 1e-4, "{force} N at {d} m");
         let soft = haptic_material(&MaterialClass::SoftRough.material(), cap);
         assert!((m.stiffness_n_per_m3 / soft.stiffness_n_per_m3 - 800.0 / 300.0).abs() < 1e-3);
-        assert!(
-            (m.combine(&Material { stiffness_n_per_m3: 1e12, damping_ns_per_m: 1e6, friction: 1.0 }).friction - 0.6)
-                .abs()
-                < 1e-4
-        );
+        let contact =
+            m.combine(&Material { stiffness_n_per_m3: 1e12, damping_ns_per_m: 1e6, friction: 1.0, texture: None });
+        assert!((contact.friction - 0.6).abs() < 1e-4);
+        // The rough copy's ridges reach the contact, read with its briefed stiffness; a smooth copy has none.
+        let ridges = contact.texture.expect("a rough copy is ribbed");
+        assert_eq!((ridges.spacing, ridges.amplitude, ridges.stiffness, ridges.axis), (0.003, 0.0003, 800.0, Vec3::Y));
+        assert!(haptic_material(&MaterialClass::HardSmooth.material(), cap).texture.is_none());
     }
 
     #[test]

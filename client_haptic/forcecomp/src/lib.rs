@@ -2,6 +2,7 @@
 //!
 //! - [`penalty`]: the volumetric penalty force (Eq. 1) and torque (Eq. 2) from an Inner Sphere Tree
 //!   contact set, with per-object [`Material`]s;
+//! - [`texture`]: ridges on a material's surface, felt on top of either rendering;
 //! - [`proxy`]: the 3-DOF god-object (proxy) force for point tools on an Inner Sphere Tree's spheres;
 //! - [`coupling`]: virtual coupling between the device and a simulated tool, for stable 6-DOF rendering;
 //! - [`safety`]: the layer applied last, always — clamps, force-rate limit, start-up engagement,
@@ -18,6 +19,7 @@ pub mod material;
 pub mod penalty;
 pub mod proxy;
 pub mod safety;
+pub mod texture;
 
 pub use coupling::{CouplingConfig, VirtualCoupling};
 pub use error::{ForceCompError, Result};
@@ -25,3 +27,4 @@ pub use material::{BodyMotion, Material};
 pub use penalty::volumetric_penalty;
 pub use proxy::{Ball, GodObject, ProxyConfig};
 pub use safety::{SafetyConfig, SafetyLayer, SafetyPhase, SafetyStats};
+pub use texture::Texture;

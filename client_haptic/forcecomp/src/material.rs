@@ -1,11 +1,12 @@
 //! Per-object materials and the rigid-body motion the force laws need.
 //!
-//! You need this module to give an object its feel (stiffness, damping, friction) and to describe how
+//! You need this module to give an object its feel (stiffness, damping, friction, texture) and to describe how
 //! the tool and the touched object move.
 
-use glam::Vec3;
+use glam::{Quat, Vec3};
 
 use crate::error::{Result, non_negative};
+use crate::texture::Texture;
 
 /// How an object feels: the paper's ε_c and ε_d, plus friction.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -16,22 +17,25 @@ pub struct Material {
     pub damping_ns_per_m: f32,
     /// Coulomb friction coefficient (default 0.3).
     pub friction: f32,
+    /// Ridges on the surface (default none: smooth).
+    pub texture: Option<Texture>,
 }
 
 impl Default for Material {
     fn default() -> Self {
-        Self { stiffness_n_per_m3: 3e6, damping_ns_per_m: 2.0, friction: 0.3 }
+        Self { stiffness_n_per_m3: 3e6, damping_ns_per_m: 2.0, friction: 0.3, texture: None }
     }
 }
 
 impl Material {
     /// A frictionless material with the given stiffness and damping.
     pub const fn new(stiffness_n_per_m3: f32, damping_ns_per_m: f32) -> Self {
-        Self { stiffness_n_per_m3, damping_ns_per_m, friction: 0.0 }
+        Self { stiffness_n_per_m3, damping_ns_per_m, friction: 0.0, texture: None }
     }
 
     /// The material of a contact between two objects: stiffness and damping in series (two springs
-    /// pressed together), friction the geometric mean.
+    /// pressed together), friction the geometric mean, the texture `other`'s (the touched object's)
+    /// or else this one's.
     pub fn combine(&self, other: &Material) -> Material {
         fn series(a: f32, b: f32) -> f32 {
             if a <= 0.0 || b <= 0.0 { 0.0 } else { a * b / (a + b) }
@@ -40,6 +44,7 @@ impl Material {
             stiffness_n_per_m3: series(self.stiffness_n_per_m3, other.stiffness_n_per_m3),
             damping_ns_per_m: series(self.damping_ns_per_m, other.damping_ns_per_m),
             friction: (self.friction.max(0.0) * other.friction.max(0.0)).sqrt(),
+            texture: other.texture.or(self.texture),
         }
     }
 
@@ -47,15 +52,18 @@ impl Material {
     pub fn validate(&self) -> Result<()> {
         non_negative("stiffness_n_per_m3", self.stiffness_n_per_m3)?;
         non_negative("damping_ns_per_m", self.damping_ns_per_m)?;
-        non_negative("friction", self.friction)
+        non_negative("friction", self.friction)?;
+        self.texture.as_ref().map_or(Ok(()), Texture::validate)
     }
 }
 
-/// How a rigid body moves right now, in world coordinates.
+/// Where a rigid body is and how it moves right now, in world coordinates.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct BodyMotion {
     /// Centre of mass, m.
     pub center_of_mass: Vec3,
+    /// Orientation of the body's frame (its texture turns with it; default identity).
+    pub orientation: Quat,
     /// Linear velocity of the centre of mass, m/s.
     pub linear_velocity: Vec3,
     /// Angular velocity, rad/s.
@@ -63,9 +71,9 @@ pub struct BodyMotion {
 }
 
 impl BodyMotion {
-    /// A body at rest with its centre of mass at `center_of_mass`.
+    /// A body at rest with its centre of mass at `center_of_mass`, unrotated.
     pub const fn at_rest(center_of_mass: Vec3) -> Self {
-        Self { center_of_mass, linear_velocity: Vec3::ZERO, angular_velocity: Vec3::ZERO }
+        Self { center_of_mass, orientation: Quat::IDENTITY, linear_velocity: Vec3::ZERO, angular_velocity: Vec3::ZERO }
     }
 
     /// Velocity of the body's material point at `point`, m/s.
@@ -76,7 +84,10 @@ impl BodyMotion {
 
     /// True when every value is finite.
     pub fn is_finite(&self) -> bool {
-        self.center_of_mass.is_finite() && self.linear_velocity.is_finite() && self.angular_velocity.is_finite()
+        self.center_of_mass.is_finite()
+            && self.orientation.is_finite()
+            && self.linear_velocity.is_finite()
+            && self.angular_velocity.is_finite()
     }
 }
 

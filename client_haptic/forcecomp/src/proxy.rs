@@ -73,6 +73,7 @@ pub struct GodObject {
     /// Where the proxy was last tick (`None` before the first update).
     last: Option<Vec3>,
     in_contact: bool,
+    normal: Vec3,
 }
 
 impl GodObject {
@@ -84,6 +85,11 @@ impl GodObject {
     /// The proxy position (the device point while free).
     pub fn proxy(&self) -> Vec3 {
         self.last.unwrap_or(Vec3::ZERO)
+    }
+
+    /// The surface's outward normal at the proxy while in contact (zero while free).
+    pub fn normal(&self) -> Vec3 {
+        if self.in_contact { self.normal } else { Vec3::ZERO }
     }
 
     /// True while the proxy is held on a surface.
@@ -131,6 +137,7 @@ impl GodObject {
         }
         self.last = Some(proxy);
         self.in_contact = true;
+        self.normal = -surface.volume_and_gradient(proxy).1.normalize_or_zero();
         let spring = (proxy - device) * (config.stiffness_n_per_m / scale.max(f32::MIN_POSITIVE));
         let n = spring.normalize_or_zero();
         let into = velocity.dot(n).min(0.0); // damp only motion into the surface
@@ -303,12 +310,13 @@ mod tests {
         let f = g.update(&K, Vec3::new(0.0, REST - 0.002, 0.0), Vec3::ZERO, &balls, 1.0);
         assert!((f - Vec3::new(0.0, 1.0, 0.0)).length() < 0.02, "{f}");
         assert!((g.proxy().y - REST).abs() < 2e-5 && g.in_contact(), "{}", g.proxy());
+        assert!((g.normal() - Vec3::Y).length() < 1e-3, "the floor's normal: {}", g.normal());
         // Deeper: more force, never a pop-through.
         let f = g.update(&K, Vec3::new(0.0, -0.5, 0.0), Vec3::ZERO, &balls, 1.0);
         assert!((f.y - 500.0 * (0.5 + REST)).abs() < 0.5, "{f}");
         // Back out: no force.
         assert_eq!(g.update(&K, Vec3::new(0.0, REST + 0.001, 0.0), Vec3::ZERO, &balls, 1.0), Vec3::ZERO);
-        assert!(!g.in_contact());
+        assert!(!g.in_contact() && g.normal() == Vec3::ZERO);
     }
 
     #[test]

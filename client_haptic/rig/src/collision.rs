@@ -87,7 +87,10 @@ pub(crate) struct WatchedObject {
 impl WatchedObject {
     /// Boxes `spec` with its motion (allocates and walks the tree: call on the game thread).
     pub(crate) fn boxed(spec: ObjectSpec) -> Box<Self> {
-        let motion = BodyMotion::at_rest(spec.pose.transform_point(crate::frame::center_of_mass(&spec.tree)));
+        let motion = BodyMotion {
+            orientation: spec.pose.rotation,
+            ..BodyMotion::at_rest(spec.pose.transform_point(crate::frame::center_of_mass(&spec.tree)))
+        };
         Box::new(Self { spec, motion })
     }
 }

@@ -176,6 +176,7 @@ impl ForceStage {
         let com = tool_scene.transform_point(tool_com_local);
         let tool_motion = BodyMotion {
             center_of_mass: com,
+            orientation: tool_scene.rotation,
             linear_velocity: self.map.velocity_to_scene(v),
             angular_velocity: self.map.angular_velocity_to_scene(w),
         };
@@ -276,7 +277,21 @@ impl ForceStage {
         };
         let scale = self.map.scale.max(f32::MIN_POSITIVE);
         let velocity = self.map.velocity_to_scene(device.linear_velocity) / scale;
-        let force_scene = self.god.update(&config, tip.translation, velocity, balls, scale);
+        let mut force_scene = self.god.update(&config, tip.translation, velocity, balls, scale);
+        // Ridges: the spring's push along the surface normal becomes that of the ridged surface.
+        let texture = material.and_then(|m| m.texture);
+        if let (Some(t), Some(i)) = (texture, slot.filter(|_| self.god.in_contact())) {
+            let n = self.god.normal();
+            let push = n * force_scene.dot(n).max(0.0);
+            let body = &frame.objects[frame.balls.object_of(i)].motion;
+            let ridged = t.apply(
+                push,
+                self.god.proxy(),
+                (body.orientation, body.center_of_mass),
+                config.stiffness_n_per_m / scale,
+            );
+            force_scene += ridged - push;
+        }
         let contact_device = self.map.wrench_to_device(ForceTorque { force: force_scene, torque: Vec3::ZERO });
         let used =
             Used { contacts: balls.len() as u32, sequence: frame.sequence, age_us: frame.age_us(device.timestamp_us) };

@@ -28,7 +28,7 @@ fn clamps_and_force_rate_hold_along_the_whole_benchmark_trace() {
     let safety = SafetyConfig::for_limits(specs.peak_force_n, specs.max_torque_nm);
     let config = RigConfig { safety: Some(safety), ..RigConfig::default() };
     // Very stiff materials, so that the deep stretch asks for more than the device's peak force.
-    let stiff = Material { stiffness_n_per_m3: 1e10, damping_ns_per_m: 4.0, friction: 0.3 };
+    let stiff = Material { stiffness_n_per_m3: 1e10, damping_ns_per_m: 4.0, friction: 0.3, texture: None };
     let mut rig =
         Lockstep::new(device, ToolSpec::new(gem, stiff), &config, 2, Some(Duration::from_micros(400))).expect("rig");
     rig.add_object(ObjectSpec { id: 1, tree: bunny, pose: Pose::IDENTITY, material: stiff }).expect("bunny");

@@ -1,11 +1,11 @@
 //! The whole per-tick work of both threads (collision step with collette's query, penalty force,
 //! coupling, safety, buffers; or, for the 3-DOF proxy, the spheres near the tip and the god-object)
-//! neither allocates nor frees once warmed up.
+//! neither allocates nor frees once warmed up, on a ribbed slab (the texture force included).
 
 mod utils;
 
 use assert_no_alloc::{AllocDisabler, assert_no_alloc};
-use forcecomp::Material;
+use forcecomp::{Material, Texture};
 use glam::Vec3;
 use haptic_common::Pose;
 use haptic_rig::lockstep::Lockstep;
@@ -38,7 +38,10 @@ fn steady_state_ticks_do_not_allocate(specs: haptico::DeviceSpecs, rendering: Re
         id: 1,
         tree: utils::slab(),
         pose: Pose::from_translation(Vec3::new(0.0, -0.01, 0.0)),
-        material: Material::default(),
+        material: Material {
+            texture: Some(Texture { axis: Vec3::X, ..Texture::ribs(0.003, 0.0003, 1000.0) }),
+            ..Material::default()
+        },
     };
     rig.add_object(slab).expect("object");
     let mut t = 0;

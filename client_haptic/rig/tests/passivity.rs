@@ -17,7 +17,7 @@ fn push_into_wall(rendering: Rendering, seconds: f64) -> Vec<(f32, f32, f32)> {
         SimConfig::new(presets::touch()),
         TargetPath::line(Vec3::new(0.0, 0.02, 0.0), Vec3::new(0.0, -0.004, 0.0), 1.0),
     );
-    let stiff = Material { stiffness_n_per_m3: 1e9, damping_ns_per_m: 1.0, friction: 0.0 };
+    let stiff = Material { stiffness_n_per_m3: 1e9, damping_ns_per_m: 1.0, friction: 0.0, texture: None };
     let config = RigConfig {
         rendering,
         safety: Some(SafetyConfig { ramp_in_s: 0.05, ..SafetyConfig::for_limits(3.3, 0.0) }),

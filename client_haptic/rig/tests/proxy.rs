@@ -36,7 +36,7 @@ fn surface_y(pose_y: f32) -> f32 {
 /// Lockstep proxy rendering of a Touch whose hand follows `keys` over the slab (top face at y = 0).
 fn rig(keys: Vec<Keyframe>) -> Lockstep<SimDevice> {
     let device = SimDevice::new(SimConfig::new(presets::touch()), TargetPath::Keyframes(keys));
-    let material = Material { stiffness_n_per_m3: 3e7, damping_ns_per_m: 2.0, friction: MU };
+    let material = Material { stiffness_n_per_m3: 3e7, damping_ns_per_m: 2.0, friction: MU, texture: None };
     // The tool's material is far stiffer, so the slab's decides (series combination).
     let tool = ToolSpec::new(utils::ball_tool(), Material { stiffness_n_per_m3: 3e12, ..material });
     let config = RigConfig {

@@ -27,7 +27,7 @@ fn temp(name: &str) -> PathBuf {
 /// The bunny scene with small trees, in lockstep with exact queries, ticked at `times`.
 fn run_bunny_scene(device: impl Device, times: &[u64]) -> Vec<ForceTorque> {
     let (_, bunny, gem) = utils::small_bunny_scene();
-    let material = Material { stiffness_n_per_m3: 5e8, damping_ns_per_m: 4.0, friction: 0.3 };
+    let material = Material { stiffness_n_per_m3: 5e8, damping_ns_per_m: 4.0, friction: 0.3, texture: None };
     let mut rig = Lockstep::new(device, ToolSpec::new(gem, material), &RigConfig::default(), 1, None).expect("rig");
     rig.add_object(ObjectSpec { id: 1, tree: bunny, pose: Pose::IDENTITY, material }).expect("bunny");
     times.iter().map(|&t| rig.tick(t)).collect()

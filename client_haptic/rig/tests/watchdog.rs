@@ -20,7 +20,7 @@ fn pausing_the_collision_thread_ramps_the_force_to_zero() {
     let config = RigConfig { safety: Some(safety), ..RigConfig::default() };
     let tool = ToolSpec::new(utils::ball_tool(), Material::default());
     let mut rig = Lockstep::new(device, tool, &config, 1, None).expect("rig");
-    let slab = Material { stiffness_n_per_m3: 1e9, damping_ns_per_m: 1.0, friction: 0.0 };
+    let slab = Material { stiffness_n_per_m3: 1e9, damping_ns_per_m: 1.0, friction: 0.0, texture: None };
     rig.add_object(ObjectSpec {
         id: 7,
         tree: utils::slab(),

@@ -209,6 +209,8 @@ pub struct ContactParams {
     pub hardness: f32,
     /// 0 (smooth) … 1 (rough): louder, grainier scrapes.
     pub roughness: f32,
+    /// Ridges the stylus rides over per second (0 on a smooth surface): the scrape ticks with each.
+    pub ridges_per_s: f32,
 }
 
 /// Controls a playing [`ContactSoundData`].
@@ -229,8 +231,8 @@ impl ContactHandle {
     }
 }
 
-/// The contact sound: a scrape (noise through a resonant band-pass, level from force × sliding speed)
-/// and taps (a decaying resonance, pitch and decay from hardness).
+/// The contact sound: a scrape (noise through a resonant band-pass, level from force × sliding speed,
+/// swelling once per ridge ridden over) and taps (a decaying resonance, pitch and decay from hardness).
 pub struct ContactSoundData;
 
 impl SoundData for ContactSoundData {
@@ -248,6 +250,7 @@ impl SoundData for ContactSoundData {
             level: 0.0,
             tap_amp: 0.0,
             tap_phase: 0.0,
+            ridge_phase: 0.0,
             current: ContactParams::default(),
         };
         Ok((Box::new(sound), ContactHandle { params: input, taps }))
@@ -262,6 +265,7 @@ struct ContactSound {
     level: f32,
     tap_amp: f32,
     tap_phase: f32,
+    ridge_phase: f32,
     current: ContactParams,
 }
 
@@ -289,6 +293,9 @@ impl Sound for ContactSound {
         let q = 0.5;
         let tap_f = 600.0 + 1600.0 * p.hardness;
         let tap_decay = (-dt / (0.015 + 0.025 * p.hardness)).exp();
+        // Ridges faster than 200 a second blur into the scrape; a negative or NaN rate is none.
+        let ridge_step = TAU * p.ridges_per_s.clamp(0.0, 200.0) * dt;
+        let ridged = ridge_step > 0.0;
         for frame in out {
             self.level += (target - self.level) * 0.002;
             let x = self.noise.next_sample() * (1.0 + p.roughness * self.noise.next_sample().abs());
@@ -296,7 +303,15 @@ impl Sound for ContactSound {
             *low += f * *band;
             let high = x - *low - q * *band;
             *band += f * high;
-            let scrape = *band * self.level;
+            // Over ridges the scrape swells as the tip drops off each one: a sharp peak per ridge.
+            let swell = if ridged {
+                self.ridge_phase = (self.ridge_phase + ridge_step) % TAU;
+                let crest = 0.5 + 0.5 * self.ridge_phase.cos();
+                0.25 + 1.5 * crest * crest * crest * crest
+            } else {
+                1.0
+            };
+            let scrape = *band * self.level * swell;
             self.tap_phase += TAU * tap_f * dt;
             let tap = self.tap_amp * self.tap_phase.sin();
             self.tap_amp *= tap_decay;

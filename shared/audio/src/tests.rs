@@ -80,7 +80,7 @@ fn a_contact_makes_a_contact_sound_and_free_space_is_silent() {
     e.contact(ContactParams::default());
     let (l, r) = energy(&capture.render(24_000));
     assert!(l + r < 1e-9, "free space: energy {}", l + r);
-    e.contact(ContactParams { force_n: 1.5, slip_m_per_s: 0.05, hardness: 1.0, roughness: 1.0 });
+    e.contact(ContactParams { force_n: 1.5, slip_m_per_s: 0.05, hardness: 1.0, roughness: 1.0, ridges_per_s: 0.0 });
     let (l, r) = energy(&capture.render(24_000));
     assert!(l + r > 1e-2, "sliding contact: energy {}", l + r);
     e.contact(ContactParams::default());
@@ -97,12 +97,44 @@ fn a_rough_scrape_is_louder_than_a_smooth_one() {
     let scrape = |roughness: f32| {
         let mut e = engine(SpatialMode::TimeLevel);
         let capture = e.capture().expect("memory output").clone();
-        e.contact(ContactParams { force_n: 1.0, slip_m_per_s: 0.05, hardness: 0.5, roughness });
+        e.contact(ContactParams { force_n: 1.0, slip_m_per_s: 0.05, hardness: 0.5, roughness, ..Default::default() });
         capture.render(4_800);
         let (l, r) = energy(&capture.render(24_000));
         l + r
     };
     assert!(scrape(1.0) > 1.5 * scrape(0.0));
+}
+
+/// Strength of the loudness swing that repeats `per_s` times a second in `frames` (48 kHz), relative
+/// to the mean loudness (a Fourier coefficient of the 2 ms energy envelope).
+fn swing_at(frames: &[(f32, f32)], per_s: f32) -> f32 {
+    let envelope: Vec<f32> = frames.chunks(96).map(|c| c.iter().map(|f| f.0 * f.0 + f.1 * f.1).sum()).collect();
+    let mean = envelope.iter().sum::<f32>() / envelope.len() as f32;
+    let (mut c, mut s) = (0.0f32, 0.0f32);
+    for (i, e) in envelope.iter().enumerate() {
+        let phase = std::f32::consts::TAU * per_s * i as f32 * 0.002;
+        c += (e - mean) * phase.cos();
+        s += (e - mean) * phase.sin();
+    }
+    2.0 * c.hypot(s) / envelope.len() as f32 / mean.max(f32::MIN_POSITIVE)
+}
+
+#[test]
+fn a_scrape_over_ridges_swells_once_per_ridge_and_a_smooth_one_does_not() {
+    let scrape = |ridges_per_s: f32| {
+        let mut e = engine(SpatialMode::TimeLevel);
+        let capture = e.capture().expect("memory output").clone();
+        e.contact(ContactParams { force_n: 1.0, slip_m_per_s: 0.05, hardness: 0.5, roughness: 1.0, ridges_per_s });
+        capture.render(9_600);
+        capture.render(48_000)
+    };
+    let ribbed = scrape(17.0);
+    let smooth = scrape(0.0);
+    let (at, off) = (swing_at(&ribbed, 17.0), swing_at(&ribbed, 11.0));
+    let plain = swing_at(&smooth, 17.0);
+    assert!(at > 0.5, "the scrape swells 17 times a second over 17 ridges a second: {at}");
+    assert!(at > 4.0 * off, "at the ridges' rate, not another: {at} vs {off} at 11/s");
+    assert!(plain < 0.2 * at, "a smooth scrape has no such swing: {plain}");
 }
 
 #[test]

@@ -169,8 +169,11 @@ fn run() -> anyhow::Result<()> {
         ..RigConfig::default()
     };
     // Stiff enough for newtons at a few millimetres, soft enough that the deep stretch really goes deep.
-    let tool = ToolSpec::new(Arc::new(gem), Material { stiffness_n_per_m3: 5e8, damping_ns_per_m: 4.0, friction: 0.3 });
-    let bunny_material = Material { stiffness_n_per_m3: 5e7, damping_ns_per_m: 4.0, friction: 0.3 };
+    let tool = ToolSpec::new(
+        Arc::new(gem),
+        Material { stiffness_n_per_m3: 5e8, damping_ns_per_m: 4.0, friction: 0.3, texture: None },
+    );
+    let bunny_material = Material { stiffness_n_per_m3: 5e7, damping_ns_per_m: 4.0, friction: 0.3, texture: None };
     let bunny = ObjectSpec { id: 1, tree: Arc::new(bunny), pose: Pose::IDENTITY, material: bunny_material };
     if args.lockstep {
         return lockstep(&args, device, tool, bunny, &config, replay.as_ref(), recording);

@@ -85,7 +85,7 @@ mod tests {
     fn a_single_feature_is_singular() {
         let b =
             briefing(&CopyTraits { kind: ArtifactKind::Idol, feature_count: 1, material: MaterialClass::SoftRough });
-        assert_eq!(b.text, "The real idol has one notch. It feels soft and rough, like unfired clay.");
+        assert_eq!(b.text, "The real idol has one notch. It feels soft and ribbed, like combed clay.");
     }
 
     #[test]

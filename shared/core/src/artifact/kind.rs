@@ -63,6 +63,23 @@ pub struct Material {
     pub damping: f32,
     /// Coulomb friction coefficient, dimensionless (0 = ice, ~0.6 = rough stone).
     pub friction: f32,
+    /// Ridges running round the copy (None: a smooth surface).
+    pub ridges: Option<Ridges>,
+}
+
+/// Ridges running round an upright copy, repeating up its height: what makes a copy feel ribbed.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Ridges {
+    /// Distance from one ridge to the next, m.
+    pub spacing_m: f32,
+    /// Depth of the grooves between them, m.
+    pub depth_m: f32,
+}
+
+impl Ridges {
+    /// The ridges of every rough copy: 3 mm apart, grooves 0.3 mm deep (fluted stone, combed clay;
+    /// a stylus tip feels them one by one at a stroke of a few centimetres a second).
+    pub const ROUGH: Ridges = Ridges { spacing_m: 0.003, depth_m: 0.0003 };
 }
 
 /// A material as a player can name it by touch: hard or soft, smooth or rough.
@@ -70,11 +87,11 @@ pub struct Material {
 pub enum MaterialClass {
     /// Hard and smooth, like polished gold.
     HardSmooth,
-    /// Hard and rough, like carved stone.
+    /// Hard and ribbed, like fluted stone (ridges 3 mm apart, more friction).
     HardRough,
     /// Soft and smooth, like waxed leather.
     SoftSmooth,
-    /// Soft and rough, like unfired clay.
+    /// Soft and ribbed, like combed clay (ridges 3 mm apart, more friction).
     SoftRough,
 }
 
@@ -87,8 +104,8 @@ impl MaterialClass {
     pub fn material(self) -> Material {
         // Hard reads as hard from about 0.8 N/mm on a desktop device; 0.3 N/mm is clearly soft.
         let (stiffness_n_per_m, damping) = if self.is_hard() { (800.0, 1.0) } else { (300.0, 1.5) };
-        let friction = if self.is_rough() { 0.6 } else { 0.1 };
-        Material { stiffness_n_per_m, damping, friction }
+        let (friction, ridges) = if self.is_rough() { (0.6, Some(Ridges::ROUGH)) } else { (0.1, None) };
+        Material { stiffness_n_per_m, damping, friction, ridges }
     }
 
     /// True for the hard classes.
@@ -96,18 +113,18 @@ impl MaterialClass {
         matches!(self, MaterialClass::HardSmooth | MaterialClass::HardRough)
     }
 
-    /// True for the rough classes.
+    /// True for the rough classes (ribbed, with more friction).
     pub fn is_rough(self) -> bool {
         matches!(self, MaterialClass::HardRough | MaterialClass::SoftRough)
     }
 
-    /// Spoken adjectives ("hard and smooth").
+    /// Spoken adjectives ("hard and smooth", "soft and ribbed").
     pub fn adjective(self) -> &'static str {
         match self {
             MaterialClass::HardSmooth => "hard and smooth",
-            MaterialClass::HardRough => "hard and rough",
+            MaterialClass::HardRough => "hard and ribbed",
             MaterialClass::SoftSmooth => "soft and smooth",
-            MaterialClass::SoftRough => "soft and rough",
+            MaterialClass::SoftRough => "soft and ribbed",
         }
     }
 
@@ -115,22 +132,24 @@ impl MaterialClass {
     pub fn simile(self) -> &'static str {
         match self {
             MaterialClass::HardSmooth => "like polished gold",
-            MaterialClass::HardRough => "like carved stone",
+            MaterialClass::HardRough => "like fluted stone",
             MaterialClass::SoftSmooth => "like waxed leather",
-            MaterialClass::SoftRough => "like unfired clay",
+            MaterialClass::SoftRough => "like combed clay",
         }
     }
 
     /// The class whose [`material`](Self::material) is nearest to `m`.
     ///
-    /// Distances scale stiffness by 1000 N/m, friction by 0.5 and damping by 5 N·s/m.
+    /// Distances scale stiffness by 1000 N/m, friction by 0.5 and damping by 5 N·s/m; ridges where
+    /// the class has none (or none where it has them) count as far as the friction's whole range.
     pub fn nearest(m: &Material) -> MaterialClass {
         let distance = |c: MaterialClass| {
             let r = c.material();
             let ds = (m.stiffness_n_per_m - r.stiffness_n_per_m) / 1000.0;
             let df = (m.friction - r.friction) / 0.5;
             let dd = (m.damping - r.damping) / 5.0;
-            let d = ds * ds + df * df + dd * dd;
+            let dr = if m.ridges.is_some() == r.ridges.is_some() { 0.0 } else { 1.0 };
+            let d = ds * ds + df * df + dd * dd + dr;
             if d.is_nan() { f32::INFINITY } else { d }
         };
         let mut best = MaterialClass::ALL[0];
@@ -196,7 +215,7 @@ mod tests {
 
     #[test]
     fn nearest_class_tolerates_perturbed_values() {
-        let m = Material { stiffness_n_per_m: 700.0, damping: 1.2, friction: 0.5 };
+        let m = Material { stiffness_n_per_m: 700.0, damping: 1.2, friction: 0.5, ridges: Some(Ridges::ROUGH) };
         assert_eq!(MaterialClass::nearest(&m), MaterialClass::HardRough);
     }
 

@@ -18,7 +18,7 @@ mod shapes;
 pub use analyze::{MIN_FEATURE_SIZE_M, Observed, PROBE_RAYS, analyze, count_high_runs, judge, matches};
 pub use briefing::{Briefing, briefing, number_in_words};
 pub use generate::{MIN_COPIES, copy_mesh_seed, generate_copies, target_seed};
-pub use kind::{ArtifactKind, ArtifactLook, CopyTraits, Material, MaterialClass, look};
+pub use kind::{ArtifactKind, ArtifactLook, CopyTraits, Material, MaterialClass, Ridges, look};
 pub use mesh::{HapticMesh, MIN_TRIANGLE_AREA_M2, MeshError};
 pub use shapes::{AMPHORA_RIDGE_HEIGHT_M, CROWN_POINT_HEIGHT_M, IDOL_NOTCH_DEPTH_M, IDOL_NOTCH_WIDTH_M, build_mesh};
 
