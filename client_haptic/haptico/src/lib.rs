@@ -34,6 +34,7 @@ static ALLOCATOR: assert_no_alloc::AllocDisabler = assert_no_alloc::AllocDisable
 pub mod core;
 pub mod device;
 pub mod error;
+pub mod falcon;
 #[cfg(feature = "hid")]
 pub mod hid;
 pub mod mock;
