@@ -512,6 +512,11 @@ pub fn devices() -> anyhow::Result<()> {
         }
         Err(e) => println!("HID devices could not be listed: {e}"),
     }
+    match haptico::falcon::usb::count_plugged_in() {
+        Ok(0) => println!("No Novint Falcon on USB."),
+        Ok(n) => println!("Novint Falcon on USB ({n}): renders forces (--device falcon[:FIRMWARE])."),
+        Err(e) => println!("USB devices could not be listed (for a Falcon): {e}"),
+    }
     Ok(())
 }
 

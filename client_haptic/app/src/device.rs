@@ -1,7 +1,7 @@
 //! Which haptic device the client drives, and how the game thread steers a simulated hand.
 //!
 //! You need this module to open the device named on the command line (`sim`, `trace:FILE`,
-//! `hid[:PATH]`) and, with the sim device, to move its hand from the keyboard or from the bot through
+//! `hid[:PATH]`, `falcon[:FIRMWARE]`) and, with the sim device, to move its hand from the keyboard or from the bot through
 //! a [`HandControl`] (latest [`HandGoal`] through a triple buffer: the haptic thread never waits).
 
 use std::f32::consts::TAU;
@@ -24,6 +24,8 @@ pub enum DeviceChoice {
     Trace(PathBuf),
     /// A HID device: the first HID PID force-feedback device or SpaceMouse, or the one at hidraw `PATH`.
     Hid(Option<String>),
+    /// The first Novint Falcon on USB, loading Novint's firmware from `FIRMWARE` when it is not running.
+    Falcon(Option<PathBuf>),
 }
 
 impl FromStr for DeviceChoice {
@@ -33,9 +35,11 @@ impl FromStr for DeviceChoice {
         match s.split_once(':') {
             None if s == "sim" => Ok(Self::Sim),
             None if s == "hid" => Ok(Self::Hid(None)),
+            None if s == "falcon" => Ok(Self::Falcon(None)),
+            Some(("falcon", file)) if !file.is_empty() => Ok(Self::Falcon(Some(PathBuf::from(file)))),
             Some(("trace", file)) if !file.is_empty() => Ok(Self::Trace(PathBuf::from(file))),
             Some(("hid", path)) if !path.is_empty() => Ok(Self::Hid(Some(path.to_owned()))),
-            _ => Err(format!("{s:?} is not a device: use sim, trace:FILE or hid[:PATH]")),
+            _ => Err(format!("{s:?} is not a device: use sim, trace:FILE, hid[:PATH] or falcon[:FIRMWARE]")),
         }
     }
 }
@@ -222,6 +226,11 @@ pub fn open(choice: &DeviceChoice, specs: DeviceSpecs) -> Result<(Box<dyn Device
             Ok((Box::new(device), None))
         }
         DeviceChoice::Hid(path) => open_hid(path.as_deref(), &specs),
+        DeviceChoice::Falcon(firmware) => {
+            let (device, _status) = haptico::falcon::open(firmware.as_deref())
+                .map_err(|e| ClientError::Device(format!("the Falcon: {e}")))?;
+            Ok((Box::new(device), None))
+        }
     }
 }
 
@@ -246,9 +255,25 @@ mod tests {
         assert_eq!("trace:/tmp/a.csv".parse(), Ok(DeviceChoice::Trace("/tmp/a.csv".into())));
         assert_eq!("hid".parse(), Ok(DeviceChoice::Hid(None)));
         assert_eq!("hid:/dev/hidraw2".parse(), Ok(DeviceChoice::Hid(Some("/dev/hidraw2".into()))));
+        assert_eq!("falcon".parse(), Ok(DeviceChoice::Falcon(None)));
+        assert_eq!(
+            "falcon:/opt/novint/nvent_firmware.bin".parse(),
+            Ok(DeviceChoice::Falcon(Some("/opt/novint/nvent_firmware.bin".into())))
+        );
         let err = "trace:".parse::<DeviceChoice>().unwrap_err();
-        assert!(err.contains("sim, trace:FILE or hid[:PATH]"), "{err}");
-        assert!("falcon".parse::<DeviceChoice>().is_err());
+        assert!(err.contains("sim, trace:FILE, hid[:PATH] or falcon[:FIRMWARE]"), "{err}");
+        assert!("inverse3".parse::<DeviceChoice>().is_err());
+    }
+
+    #[test]
+    fn a_falcon_that_is_not_plugged_in_is_refused_at_once_with_what_to_check() {
+        let start = std::time::Instant::now();
+        let Err(e) = open(&DeviceChoice::Falcon(None), haptico::presets::falcon()) else {
+            panic!("no Falcon is plugged into a test machine");
+        };
+        let e = e.to_string();
+        assert!(e.contains("Novint Falcon (USB 0403:cb48)") && !e.contains('\n'), "{e}");
+        assert!(start.elapsed() < std::time::Duration::from_secs(5), "answered in {:?}", start.elapsed());
     }
 
     #[test]

@@ -16,6 +16,9 @@ pub enum HapticoError {
     /// The HID layer refused (permissions, device gone, bad report).
     #[error("HID: {0}")]
     Hid(String),
+    /// A USB device refused or failed (permissions, device gone, no answer).
+    #[error("USB: {0}")]
+    Usb(String),
     /// Reading or writing a trace file failed.
     #[error("trace file {path}: {source}")]
     Io {

@@ -1,7 +1,7 @@
 //! haptico: the haptic device layer (paper §3.3).
 //!
-//! A [`Device`] trait with simulated ([`sim`]), recorded ([`trace`]), mock ([`mock`]) and HID (`hid`)
-//! backends, and the 1 kHz haptic thread ([`thread`]) that reads the device, broadcasts `OnTransform`,
+//! A [`Device`] trait with simulated ([`sim`]), recorded ([`trace`]), mock ([`mock`]), HID (`hid`) and
+//! Novint Falcon ([`falcon`]) backends, an I/O thread for devices whose I/O blocks ([`io`]), and the 1 kHz haptic thread ([`thread`]) that reads the device, broadcasts `OnTransform`,
 //! gathers forces through `ForceOnHapticTick` and commands the device. It depends only on
 //! `haptic_common`; force computation and collision detection plug in through the events.
 //!
@@ -37,6 +37,7 @@ pub mod error;
 pub mod falcon;
 #[cfg(feature = "hid")]
 pub mod hid;
+pub mod io;
 pub mod mock;
 pub mod presets;
 pub mod sim;

@@ -37,6 +37,7 @@ pub trait Transport: Send {
 /// What the game thread can read about a running Falcon.
 #[derive(Debug, Default)]
 pub struct FalconStatus {
+    replies: AtomicU64,
     homed: AtomicU8,
     disconnected: AtomicBool,
     bad_packets: AtomicU64,
@@ -44,6 +45,11 @@ pub struct FalconStatus {
 }
 
 impl FalconStatus {
+    /// Replies taken so far (the firmware is running once there is one).
+    pub fn replies(&self) -> u64 {
+        self.replies.load(Ordering::Relaxed)
+    }
+
     /// Which arms are home (top, right, left).
     pub fn homed(&self) -> [bool; 3] {
         let bits = self.homed.load(Ordering::Relaxed);
@@ -99,7 +105,13 @@ impl<T: Transport> FalconDevice<T> {
         self.status.clone()
     }
 
+    /// The transport (e.g. to load the firmware before the first exchange).
+    pub fn transport_mut(&mut self) -> &mut T {
+        &mut self.transport
+    }
+
     fn take(&mut self, reply: &Reply, t_us: u64) {
+        self.status.replies.fetch_add(1, Ordering::Relaxed);
         self.homing.update(reply, t_us);
         let bits = reply.homed.iter().enumerate().fold(0u8, |b, (i, h)| b | (u8::from(*h) << i));
         self.status.homed.store(bits, Ordering::Relaxed);
@@ -264,7 +276,7 @@ mod tests {
         let later = f.read_state(2000);
         assert_eq!(later.pose, first.pose);
         let status = f.status();
-        assert!(status.disconnected() && status.failed_exchanges() == 1);
+        assert!(status.disconnected() && status.failed_exchanges() == 1 && status.replies() == 2);
         f.release();
     }
 }
