@@ -1,6 +1,8 @@
 //! Generates the server side of Agones' SDK from the `.proto` files the `agones` crate ships (it builds
 //! only the client side from them). The crate's sources are found through `cargo metadata`, so the
-//! protocol is always the one of the `agones` version in Cargo.lock.
+//! protocol is always the one of the `agones` version in Cargo.lock. The metadata is filtered to the
+//! platform being built for: offline, cargo has only that platform's crates (a dependency's macOS-only
+//! crates, say, were never downloaded on Linux).
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -8,8 +10,10 @@ use std::process::Command;
 fn agones_dir() -> Result<PathBuf, String> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let manifest = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").map_err(|e| e.to_string())?).join("Cargo.toml");
+    let target = std::env::var("TARGET").map_err(|e| format!("cargo set no TARGET: {e}"))?;
     let out = Command::new(cargo)
-        .args(["metadata", "--format-version", "1", "--locked", "--offline", "--manifest-path"])
+        .args(["metadata", "--format-version", "1", "--locked", "--offline", "--filter-platform", &target])
+        .arg("--manifest-path")
         .arg(&manifest)
         .output()
         .map_err(|e| format!("cannot run cargo metadata: {e}"))?;
