@@ -30,6 +30,35 @@ impl IoStats {
     }
 }
 
+/// The I/O thread's side: where it writes states and finds the newest force (see [`IoDevice::with_loop`]).
+pub struct IoThread {
+    /// Each state read, stamped on [`Self::clock`].
+    pub states: triple_buffer::Input<DeviceState>,
+    forces: triple_buffer::Output<ForceTorque>,
+    /// Counters; the loop counts each exchange in `exchanges`.
+    pub stats: Arc<IoStats>,
+    stop: Arc<AtomicBool>,
+    /// The haptic side's clock.
+    pub clock: HapticClock,
+}
+
+impl IoThread {
+    /// The newest force the haptic thread commanded.
+    pub fn newest_force(&mut self) -> ForceTorque {
+        *self.forces.read()
+    }
+
+    /// True once the haptic side let go: the loop leaves the device without force and returns.
+    pub fn stopping(&self) -> bool {
+        self.stop.load(Ordering::Acquire)
+    }
+
+    /// Counts one exchange.
+    pub fn count_exchange(&self) {
+        self.stats.exchanges.fetch_add(1, Ordering::Relaxed);
+    }
+}
+
 /// The haptic thread's side of a device run on an I/O thread.
 pub struct IoDevice {
     specs: DeviceSpecs,
@@ -51,26 +80,37 @@ impl IoDevice {
         let specs = device.specs().clone();
         let clock = HapticClock::new();
         let first = device.read_state(clock.now_us());
-        let (mut states_in, states) = triple_buffer::triple_buffer(&first);
-        let (forces, mut forces_out) = triple_buffer::triple_buffer(&ForceTorque::ZERO);
+        let period_ns = (1e9 / f64::from(rate_hz)) as u64;
+        Self::with_loop(specs, first, clock, name, move |mut io: IoThread| {
+            let mut deadline = io.clock.now_ns();
+            while !io.stopping() {
+                io.states.write(device.read_state(io.clock.now_us()));
+                device.command(io.newest_force());
+                io.stats.exchanges.fetch_add(1, Ordering::Relaxed);
+                (deadline, _) = next_deadline(deadline, io.clock.now_ns(), period_ns, 5);
+                wait_until(&io.clock, deadline, 200_000);
+            }
+            device.release();
+        })
+    }
+
+    /// Starts an I/O thread named `name` running `body`, which owns the device's I/O: it writes each state
+    /// it reads (stamped on `clock`) and sends the newest force, counting its exchanges, until
+    /// [`IoThread::stopping`]. `first` is the state read before the thread starts.
+    pub fn with_loop(
+        specs: DeviceSpecs,
+        first: DeviceState,
+        clock: HapticClock,
+        name: &str,
+        body: impl FnOnce(IoThread) + Send + 'static,
+    ) -> Result<Self> {
+        let (states_in, states) = triple_buffer::triple_buffer(&first);
+        let (forces, forces_out) = triple_buffer::triple_buffer(&ForceTorque::ZERO);
         let stats = Arc::new(IoStats::default());
         let stop = Arc::new(AtomicBool::new(false));
-        let (thread_stats, thread_stop) = (stats.clone(), stop.clone());
-        let period_ns = (1e9 / f64::from(rate_hz)) as u64;
-        let thread = std::thread::Builder::new()
-            .name(name.to_owned())
-            .spawn(move || {
-                let mut deadline = clock.now_ns();
-                while !thread_stop.load(Ordering::Acquire) {
-                    states_in.write(device.read_state(clock.now_us()));
-                    device.command(*forces_out.read());
-                    thread_stats.exchanges.fetch_add(1, Ordering::Relaxed);
-                    (deadline, _) = next_deadline(deadline, clock.now_ns(), period_ns, 5);
-                    wait_until(&clock, deadline, 200_000);
-                }
-                device.release();
-            })
-            .map_err(HapticoError::Spawn)?;
+        let io = IoThread { states: states_in, forces: forces_out, stats: stats.clone(), stop: stop.clone(), clock };
+        let thread =
+            std::thread::Builder::new().name(name.to_owned()).spawn(move || body(io)).map_err(HapticoError::Spawn)?;
         Ok(Self { specs, states, forces, stats, clock, stop, thread: Some(thread) })
     }
 

@@ -1,7 +1,7 @@
 //! haptico: the haptic device layer (paper §3.3).
 //!
-//! A [`Device`] trait with simulated ([`sim`]), recorded ([`trace`]), mock ([`mock`]), HID (`hid`) and
-//! Novint Falcon ([`falcon`]) backends, an I/O thread for devices whose I/O blocks ([`io`]), and the 1 kHz haptic thread ([`thread`]) that reads the device, broadcasts `OnTransform`,
+//! A [`Device`] trait with simulated ([`sim`]), recorded ([`trace`]), mock ([`mock`]), HID (`hid`), Novint
+//! Falcon ([`falcon`]) and Haply Inverse3 (`haply`) backends, an I/O thread for devices whose I/O blocks ([`io`]), and the 1 kHz haptic thread ([`thread`]) that reads the device, broadcasts `OnTransform`,
 //! gathers forces through `ForceOnHapticTick` and commands the device. It depends only on
 //! `haptic_common`; force computation and collision detection plug in through the events.
 //!
@@ -35,6 +35,8 @@ pub mod core;
 pub mod device;
 pub mod error;
 pub mod falcon;
+#[cfg(feature = "haply")]
+pub mod haply;
 #[cfg(feature = "hid")]
 pub mod hid;
 pub mod io;

@@ -75,6 +75,23 @@ pub fn falcon() -> DeviceSpecs {
     }
 }
 
+/// Haply Inverse3: 3-DOF (the VerseGrip's orientation is not read). Haply's data sheet could not be read
+/// from where this was written: every figure is assumed and conservative (the Touch's force, a workspace
+/// well inside the arm's reach) until checked against the device.
+pub fn inverse3() -> DeviceSpecs {
+    DeviceSpecs {
+        name: "Haply Inverse3",
+        sensed_dof: 3,
+        actuated_dof: 3,
+        peak_force_n: 3.3,       // assumed
+        continuous_force_n: 1.5, // assumed
+        max_torque_nm: 0.0,
+        max_stiffness_n_per_m: 800.0, // assumed
+        max_damping_ns_per_m: 4.0,    // assumed
+        workspace_radius_m: 0.1,      // assumed
+    }
+}
+
 /// Force Dimension omega.x: 12 N, 5000 N/m, 75 mm workspace radius.
 pub fn omega() -> DeviceSpecs {
     DeviceSpecs {
@@ -121,8 +138,18 @@ pub fn delta3() -> DeviceSpecs {
 }
 
 /// Every preset, for menus and tests.
-pub fn all() -> [DeviceSpecs; 8] {
-    [touch(), phantom_omni(), phantom_desktop(), phantom_premium_6dof(), falcon(), omega(), sigma7(), delta3()]
+pub fn all() -> [DeviceSpecs; 9] {
+    [
+        touch(),
+        phantom_omni(),
+        phantom_desktop(),
+        phantom_premium_6dof(),
+        falcon(),
+        inverse3(),
+        omega(),
+        sigma7(),
+        delta3(),
+    ]
 }
 
 /// The preset whose name contains `name` (case-insensitive), if any.
