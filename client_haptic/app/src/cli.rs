@@ -103,7 +103,9 @@ pub struct JoinArgs {
 /// Settings shared by `join` and `practice`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct ClientArgs {
-    /// The haptic device: sim (keyboard moves its hand), trace:FILE (replay), hid or hid:/dev/hidrawN.
+    /// The haptic device: sim (keyboard moves its hand), trace:FILE (replay), hid or hid:/dev/hidrawN,
+    /// falcon or falcon:FIRMWARE (a Novint Falcon on USB), haply or haply:ws://HOST:PORT/ (a Haply
+    /// Inverse3 through the Haply Inverse Service; default ws://localhost:10001/).
     #[arg(long, default_value = "sim")]
     pub device: DeviceChoice,
     /// Device preset the sim device copies (e.g. touch, falcon, premium); default Phantom Desktop.
@@ -390,6 +392,7 @@ fn tell_the_link(
 pub fn join(args: &JoinArgs) -> anyhow::Result<()> {
     let mut settings = args.client.settings().map_err(anyhow::Error::msg)?;
     let mut prompter = crate::prompt::Prompter::new(&mut settings)?;
+    check_device(&mut prompter, &settings)?;
     let cache = heist_client::SeatCache::in_default_dir();
     let joined = get_a_seat(&mut prompter, args, cache.as_ref());
     let (addr, joining) = match joined {
@@ -407,6 +410,25 @@ pub fn join(args: &JoinArgs) -> anyhow::Result<()> {
     heist_client::connect(&mut app, joining.token)?;
     heist_client::hold_seat(&mut app, cache, addr, Role::Phantom);
     app.run();
+    Ok(())
+}
+
+/// Looks for a real device before anything else, and says what was found and what to do with it, or what
+/// is wrong (then the program ends: a seat is no use without the device).
+pub fn check_device(prompter: &mut crate::prompt::Prompter, settings: &PhantomSettings) -> anyhow::Result<()> {
+    match crate::device::check(&settings.haptics.device) {
+        Ok(Some(setup)) => prompter.say(setup),
+        Ok(None) => {}
+        Err(e) => {
+            let said = match &e {
+                crate::ClientError::Device(why) => format!("The haptic device is not ready: {why}."),
+                other => other.to_string(),
+            };
+            prompter.say(said);
+            prompter.finish_speaking(Duration::from_secs(30));
+            return Err(e.into());
+        }
+    }
     Ok(())
 }
 
@@ -517,6 +539,20 @@ pub fn devices() -> anyhow::Result<()> {
         Ok(n) => println!("Novint Falcon on USB ({n}): renders forces (--device falcon[:FIRMWARE])."),
         Err(e) => println!("USB devices could not be listed (for a Falcon): {e}"),
     }
+    let url = haptico::haply::DEFAULT_URL;
+    match haptico::haply::probe(url, Duration::from_secs(1)) {
+        Ok(list) if list.is_empty() => println!("The Haply Inverse Service at {url} lists no Inverse3."),
+        Ok(list) => {
+            for d in list {
+                println!(
+                    "Haply Inverse3 {} at {url}: renders forces (--device haply){}",
+                    d.device_id,
+                    if d.calibrated { "" } else { "; not calibrated yet" }
+                );
+            }
+        }
+        Err(_) => println!("No Haply Inverse Service at {url} (for an Inverse3)."),
+    }
     Ok(())
 }
 
@@ -543,9 +579,10 @@ mod tests {
 
     #[test]
     fn a_bad_device_is_a_clear_usage_error() {
-        let err = Cli::try_parse_from(["client_haptic", "join", "127.0.0.1:5757", "--code", "A", "--device", "falcon"])
-            .unwrap_err()
-            .to_string();
-        assert!(err.contains("sim, trace:FILE or hid[:PATH]"), "{err}");
+        let err =
+            Cli::try_parse_from(["client_haptic", "join", "127.0.0.1:5757", "--code", "A", "--device", "phantom"])
+                .unwrap_err()
+                .to_string();
+        assert!(err.contains("sim, trace:FILE, hid[:PATH], falcon[:FIRMWARE] or haply[:URL]"), "{err}");
     }
 }

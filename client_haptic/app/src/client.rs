@@ -167,7 +167,7 @@ impl Plugin for PhantomClientPlugin {
             .init_resource::<BenchView>()
             .add_message::<HeistEvent>()
             .configure_sets(Update, (PhantomSystems::Receive, PhantomSystems::Play, PhantomSystems::Sound).chain())
-            .add_systems(Update, (receive, poll_haptics).chain().in_set(PhantomSystems::Receive))
+            .add_systems(Update, (receive, poll_haptics, watch_device).chain().in_set(PhantomSystems::Receive))
             .add_systems(
                 Update,
                 (lobby, keys, device_buttons, after_verdict, touch_bot).chain().in_set(PhantomSystems::Play),
@@ -223,6 +223,18 @@ fn receive(
 }
 
 /// Polls the tree build and the rig's rings; announces when the copy can be felt.
+/// Tells the player, once, when the real device stopped answering (its link went: no force reaches it).
+fn watch_device(haptics: NonSend<Haptics>, mut speaker: NonSendMut<Speaker>, mut told: Local<bool>) {
+    if *told {
+        return;
+    }
+    if let Some(notice) = haptics.device_lost() {
+        log::warn!("{notice}");
+        speaker.say(notice);
+        *told = true;
+    }
+}
+
 fn poll_haptics(
     mut haptics: NonSendMut<Haptics>,
     mut speaker: NonSendMut<Speaker>,

@@ -1,12 +1,14 @@
 //! Which haptic device the client drives, and how the game thread steers a simulated hand.
 //!
 //! You need this module to open the device named on the command line (`sim`, `trace:FILE`,
-//! `hid[:PATH]`, `falcon[:FIRMWARE]`) and, with the sim device, to move its hand from the keyboard or from the bot through
+//! `hid[:PATH]`, `falcon[:FIRMWARE]`, `haply[:URL]`), to check a real one before a session and watch it
+//! during one ([`check`], [`DeviceHealth`]), and, with the sim device, to move its hand from the keyboard or from the bot through
 //! a [`HandControl`] (latest [`HandGoal`] through a triple buffer: the haptic thread never waits).
 
 use std::f32::consts::TAU;
 use std::path::PathBuf;
 use std::str::FromStr;
+use std::sync::Arc;
 
 use glam::{Quat, Vec3};
 use haptic_common::{DeviceState, ForceTorque, Pose};
@@ -26,7 +28,13 @@ pub enum DeviceChoice {
     Hid(Option<String>),
     /// The first Novint Falcon on USB, loading Novint's firmware from `FIRMWARE` when it is not running.
     Falcon(Option<PathBuf>),
+    /// The first Haply Inverse3 of the Haply Inverse Service at `URL` (a WebSocket address).
+    Haply(String),
 }
+
+/// Where a real device's grip is put in the device frame when the game starts: where the simulated hand
+/// starts, in front of the workbench.
+pub const START: Vec3 = Vec3::new(0.0, 0.06, 0.07);
 
 impl FromStr for DeviceChoice {
     type Err = String;
@@ -36,10 +44,14 @@ impl FromStr for DeviceChoice {
             None if s == "sim" => Ok(Self::Sim),
             None if s == "hid" => Ok(Self::Hid(None)),
             None if s == "falcon" => Ok(Self::Falcon(None)),
+            None if s == "haply" => Ok(Self::Haply(haptico::haply::DEFAULT_URL.to_owned())),
+            Some(("haply", url)) if !url.is_empty() => Ok(Self::Haply(url.to_owned())),
             Some(("falcon", file)) if !file.is_empty() => Ok(Self::Falcon(Some(PathBuf::from(file)))),
             Some(("trace", file)) if !file.is_empty() => Ok(Self::Trace(PathBuf::from(file))),
             Some(("hid", path)) if !path.is_empty() => Ok(Self::Hid(Some(path.to_owned()))),
-            _ => Err(format!("{s:?} is not a device: use sim, trace:FILE, hid[:PATH] or falcon[:FIRMWARE]")),
+            _ => {
+                Err(format!("{s:?} is not a device: use sim, trace:FILE, hid[:PATH], falcon[:FIRMWARE] or haply[:URL]"))
+            }
         }
     }
 }
@@ -211,38 +223,118 @@ pub fn preset(name: Option<&str>) -> Result<DeviceSpecs, ClientError> {
     }
 }
 
+/// What a real device's I/O thread tells of its link, watched during a session.
+#[derive(Clone, Debug, Default)]
+pub enum DeviceHealth {
+    /// A device with no link to lose (simulated, a trace, HID).
+    #[default]
+    Local,
+    /// A Novint Falcon on USB.
+    Falcon(Arc<haptico::falcon::device::FalconStatus>),
+    /// A Haply Inverse3 through its service.
+    Haply(Arc<haptico::haply::HaplyStatus>),
+}
+
+impl DeviceHealth {
+    /// What to tell the player once the device stopped answering (forces no longer reach it), else `None`.
+    pub fn lost(&self) -> Option<&'static str> {
+        match self {
+            Self::Falcon(s) if s.disconnected() => {
+                Some("The Falcon stopped answering: no force reaches it. Check its cable and power, then start again.")
+            }
+            Self::Haply(s) if s.disconnected() => Some(
+                "The Haply service went away: no force reaches the Inverse3. Check that the Haply Inverse Service \
+                 runs and the Inverse3 is on, then start again.",
+            ),
+            _ => None,
+        }
+    }
+}
+
+/// A device opened for the haptic thread.
+pub struct Opened {
+    /// The device.
+    pub device: Box<dyn Device>,
+    /// With `sim`: what moves its hand.
+    pub hand: Option<HandControl>,
+    /// Its link, to watch.
+    pub health: DeviceHealth,
+}
+
+/// Looks for a real device before a session, quickly (a few seconds at most): what to tell the player to
+/// do when it is there (`None` for simulated, recorded and HID devices, opened as they are), or what is
+/// wrong, to be said before anything else happens.
+pub fn check(choice: &DeviceChoice) -> Result<Option<String>, ClientError> {
+    match choice {
+        DeviceChoice::Falcon(_) => match haptico::falcon::usb::count_plugged_in() {
+            Ok(0) => Err(ClientError::Device(
+                "no Novint Falcon is plugged in: plug its USB cable and its power in, then start again".into(),
+            )),
+            Ok(_) => Ok(Some(format!(
+                "Found the Novint Falcon. When the game starts its light is red until it is homed: {}",
+                haptico::falcon::homing::INSTRUCTION
+            ))),
+            Err(e) => Err(ClientError::Device(format!(
+                "no Novint Falcon found, as USB devices could not be listed ({e}): plug it in, check that this \
+                 program may read USB devices (docs/haptics.md has the udev rule), then start again"
+            ))),
+        },
+        DeviceChoice::Haply(url) => {
+            let listed = haptico::haply::probe(url, haptico::haply::CONNECT_TIMEOUT)
+                .map_err(|e| ClientError::Device(format!("the Haply Inverse3: {e}")))?;
+            let Some(first) = listed.first() else {
+                return Err(ClientError::Device(format!(
+                    "the Haply Inverse Service at {url} lists no Inverse3: plug it in and switch it on, then start again"
+                )));
+            };
+            let calibrated = if first.calibrated { "" } else { " The service says it is not calibrated yet." };
+            Ok(Some(format!(
+                "Found the Haply Inverse3.{calibrated} Hold its grip still where you want to play: the game centres \
+                 on it when it starts."
+            )))
+        }
+        DeviceChoice::Sim | DeviceChoice::Trace(_) | DeviceChoice::Hid(_) => Ok(None),
+    }
+}
+
 /// Opens the chosen device. With `sim`, also returns the control that moves its hand.
-pub fn open(choice: &DeviceChoice, specs: DeviceSpecs) -> Result<(Box<dyn Device>, Option<HandControl>), ClientError> {
+pub fn open(choice: &DeviceChoice, specs: DeviceSpecs) -> Result<Opened, ClientError> {
+    let local = |device: Box<dyn Device>, hand| Opened { device, hand, health: DeviceHealth::Local };
     match choice {
         DeviceChoice::Sim => {
-            let (device, control) = SteeredSim::new(specs, Pose::new(Vec3::new(0.0, 0.06, 0.07), Quat::IDENTITY));
-            Ok((Box::new(device), Some(control)))
+            let (device, control) = SteeredSim::new(specs, Pose::new(START, Quat::IDENTITY));
+            Ok(local(Box::new(device), Some(control)))
         }
         DeviceChoice::Trace(path) => {
             let samples = haptico::trace::load(path)
                 .map_err(|e| ClientError::Device(format!("reading the trace {}: {e}", path.display())))?;
             let device = haptico::trace::TraceDevice::new(specs, samples, true)
                 .map_err(|e| ClientError::Device(format!("the trace {}: {e}", path.display())))?;
-            Ok((Box::new(device), None))
+            Ok(local(Box::new(device), None))
         }
-        DeviceChoice::Hid(path) => open_hid(path.as_deref(), &specs),
+        DeviceChoice::Hid(path) => open_hid(path.as_deref(), &specs).map(|d| local(d, None)),
         DeviceChoice::Falcon(firmware) => {
-            let (device, _status) = haptico::falcon::open(firmware.as_deref())
+            let (device, status) = haptico::falcon::open(firmware.as_deref())
                 .map_err(|e| ClientError::Device(format!("the Falcon: {e}")))?;
-            Ok((Box::new(device), None))
+            Ok(Opened { device: Box::new(device), hand: None, health: DeviceHealth::Falcon(status) })
+        }
+        DeviceChoice::Haply(url) => {
+            let (device, status) = haptico::haply::open(url, haptico::presets::inverse3(), START)
+                .map_err(|e| ClientError::Device(format!("the Haply Inverse3: {e}")))?;
+            Ok(Opened { device: Box::new(device), hand: None, health: DeviceHealth::Haply(status) })
         }
     }
 }
 
-fn open_hid(path: Option<&str>, specs: &DeviceSpecs) -> Result<(Box<dyn Device>, Option<HandControl>), ClientError> {
+fn open_hid(path: Option<&str>, specs: &DeviceSpecs) -> Result<Box<dyn Device>, ClientError> {
     use haptico::hid::{PidForceDevice, PidReportIds, SpaceMouse, SpaceMouseMode};
     match PidForceDevice::open(PidReportIds::default(), specs.peak_force_n, path) {
-        Ok(d) => return Ok((Box::new(d), None)),
+        Ok(d) => return Ok(Box::new(d)),
         Err(e) => log::info!("no HID force-feedback device: {e}"),
     }
     let mode = SpaceMouseMode::Rate { metres_per_s_per_count: 2e-4, radians_per_s_per_count: 2e-3 };
     let device = SpaceMouse::open(mode, path).map_err(|e| ClientError::Device(format!("no HID device: {e}")))?;
-    Ok((Box::new(device), None))
+    Ok(Box::new(device))
 }
 
 #[cfg(test)]
@@ -260,8 +352,10 @@ mod tests {
             "falcon:/opt/novint/nvent_firmware.bin".parse(),
             Ok(DeviceChoice::Falcon(Some("/opt/novint/nvent_firmware.bin".into())))
         );
+        assert_eq!("haply".parse(), Ok(DeviceChoice::Haply("ws://localhost:10001/".into())));
+        assert_eq!("haply:ws://10.0.0.2:10001/".parse(), Ok(DeviceChoice::Haply("ws://10.0.0.2:10001/".into())));
         let err = "trace:".parse::<DeviceChoice>().unwrap_err();
-        assert!(err.contains("sim, trace:FILE, hid[:PATH] or falcon[:FIRMWARE]"), "{err}");
+        assert!(err.contains("sim, trace:FILE, hid[:PATH], falcon[:FIRMWARE] or haply[:URL]"), "{err}");
         assert!("inverse3".parse::<DeviceChoice>().is_err());
     }
 
@@ -274,6 +368,19 @@ mod tests {
         let e = e.to_string();
         assert!(e.contains("Novint Falcon (USB 0403:cb48)") && !e.contains('\n'), "{e}");
         assert!(start.elapsed() < std::time::Duration::from_secs(5), "answered in {:?}", start.elapsed());
+    }
+
+    #[test]
+    fn an_inverse3_service_that_is_not_running_is_refused_within_seconds_with_what_to_start() {
+        let port = std::net::TcpListener::bind("127.0.0.1:0").expect("binds").local_addr().expect("port").port();
+        let choice = DeviceChoice::Haply(format!("ws://127.0.0.1:{port}/"));
+        let start = std::time::Instant::now();
+        let e = check(&choice).expect_err("nothing listens there").to_string();
+        assert!(e.contains("no Haply Inverse Service at ws://127.0.0.1:") && e.contains("start the service"), "{e}");
+        let Err(opened) = open(&choice, haptico::presets::inverse3()) else { panic!("opened a closed port") };
+        assert_eq!(opened.to_string(), e, "the check and the open say the same");
+        assert!(!e.contains('\n') && start.elapsed() < std::time::Duration::from_secs(5), "{:?}", start.elapsed());
+        assert!(DeviceHealth::Local.lost().is_none());
     }
 
     #[test]

@@ -134,6 +134,8 @@ pub struct Haptics {
     recording_lost: u64,
     /// Moves the simulated hand (sim device only).
     pub hand: Option<HandControl>,
+    /// The real device's link (see [`Haptics::device_lost`]).
+    pub health: device::DeviceHealth,
     /// The device's limits.
     pub specs: DeviceSpecs,
     /// How forces are rendered (the choice resolved for the device).
@@ -162,7 +164,7 @@ impl Haptics {
     /// Opens the device and starts the haptic and collision threads with the gemstone tool.
     pub fn start(settings: HapticsSettings) -> Result<Self, ClientError> {
         let specs = device::preset(settings.preset.as_deref())?;
-        let (device, hand) = device::open(&settings.device, specs.clone())?;
+        let device::Opened { device, hand, health } = device::open(&settings.device, specs.clone())?;
         let (device, recording): (Box<dyn Device>, _) = match &settings.record {
             Some(path) => {
                 let (device, writer) = haptico::trace::record(device, path)
@@ -205,6 +207,7 @@ impl Haptics {
             recording,
             recording_lost: 0,
             hand,
+            health,
             specs,
             rendering,
             stiffness_scale,
@@ -219,6 +222,11 @@ impl Haptics {
             rates: Vec::new(),
             settings,
         })
+    }
+
+    /// What to tell the player once a real device stopped answering (no force reaches it any more).
+    pub fn device_lost(&self) -> Option<&'static str> {
+        self.health.lost()
     }
 
     /// Microseconds on the haptic clock.

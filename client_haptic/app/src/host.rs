@@ -47,6 +47,7 @@ pub fn spell(code: &str) -> String {
 pub fn host(args: &HostArgs) -> anyhow::Result<()> {
     let mut settings = args.client.settings().map_err(anyhow::Error::msg)?;
     let mut prompter = crate::prompt::Prompter::new(&mut settings)?;
+    crate::cli::check_device(&mut prompter, &settings)?;
     let started = match args.host.server {
         Some(server) => match heist_client::create_session(server, Role::Phantom, Duration::from_secs(5)) {
             Ok((code, token)) => Ok((server, server, code, token)),

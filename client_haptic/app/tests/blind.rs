@@ -197,6 +197,29 @@ fn every_failure_before_the_session_is_spoken_with_what_to_do_next() {
     let loud = heard.iter().filter(|s| s.abs() > 0.02).count();
     assert!(loud > 48_000, "{loud} loud samples");
 
+    // A device that is not there: said before anything else (the address is never tried), within seconds.
+    let closed = free_port();
+    let haply = format!("haply:ws://127.0.0.1:{closed}/");
+    let args = ["join", "127.0.0.1:1", "--code", "ABCD-EFGH-JKLM", "--device", &haply];
+    let (mut child, _stdin, rx) = headless_with_cache(&args, &dir);
+    let mut said = Vec::new();
+    let not_ready = "The haptic device is not ready: the Haply Inverse3: no Haply Inverse Service at ws://127.0.0.1:";
+    assert!(hear(&rx, &mut said, not_ready, Duration::from_secs(5)), "said within 5 s: {said:#?}");
+    assert!(said.last().is_some_and(|l| l.contains("start the service")), "{said:#?}");
+    let status = wait(&mut child, Duration::from_secs(60)).expect("ends once it is said");
+    said.extend(rx.try_iter());
+    assert!(!status.success());
+    assert!(!said.iter().any(|l| l.starts_with("Nobody answers")), "the device comes first: {said:#?}");
+    let mut err = String::new();
+    if let Some(mut e) = child.stderr.take() {
+        let _ = std::io::Read::read_to_string(&mut e, &mut err);
+    }
+    assert_eq!(err.lines().count(), 1, "one line on stderr: {err}");
+    let (status, said, err) = run(&["join", "127.0.0.1:1", "--code", "ABCD-EFGH-JKLM", "--device", "falcon"]);
+    assert!(!status.success());
+    assert!(said.iter().any(|l| l.starts_with("The haptic device is not ready: no Novint Falcon")), "{said:#?}");
+    assert_eq!(err.lines().count(), 1, "one line on stderr: {err}");
+
     // A wrong code, given on the command line: said, and the program ends (nothing to ask again).
     let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
     let (addr, code, host) = host_with_a_vive_bot(stop.clone(), Default::default(), 300.0);
