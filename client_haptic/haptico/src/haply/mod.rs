@@ -380,7 +380,13 @@ async fn exchange(
             Some(Some(Ok(_))) => continue,
             None if io.stopping() => {
                 let _ = send_json(&mut ws, &force_msg(&device_id, Vec3::ZERO)).await;
-                let _ = tokio::time::timeout(SEND_TIMEOUT, ws.close(None)).await;
+                // Close and wait for the service's answer: a socket dropped at once may be reset before
+                // the service read the last force.
+                let _ = tokio::time::timeout(SEND_TIMEOUT, async {
+                    let _ = ws.close(None).await;
+                    while let Some(Ok(_)) = ws.next().await {}
+                })
+                .await;
                 return;
             }
             None if last_send.elapsed() < KEEPALIVE => continue,
