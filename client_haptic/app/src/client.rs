@@ -223,15 +223,19 @@ fn receive(
 }
 
 /// Polls the tree build and the rig's rings; announces when the copy can be felt.
-/// Tells the player, once, when the real device stopped answering (its link went: no force reaches it).
-fn watch_device(haptics: NonSend<Haptics>, mut speaker: NonSendMut<Speaker>, mut told: Local<bool>) {
-    if *told {
-        return;
-    }
-    if let Some(notice) = haptics.device_lost() {
-        log::warn!("{notice}");
+/// Guides the player through the real device's set-up as the session goes (the Falcon's homing) and
+/// tells them, once, when it stopped answering (its link went: no force reaches it).
+fn watch_device(
+    haptics: NonSend<Haptics>,
+    mut speaker: NonSendMut<Speaker>,
+    mut guide: Local<crate::device::Guide>,
+    mut started: Local<Option<std::time::Instant>>,
+) {
+    let started = *started.get_or_insert_with(std::time::Instant::now);
+    let health = &haptics.health;
+    if let Some(notice) = guide.next(health.reading(), health.lost(), started.elapsed().as_secs_f64()) {
+        log::info!("device: {notice}");
         speaker.say(notice);
-        *told = true;
     }
 }
 

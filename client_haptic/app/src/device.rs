@@ -251,6 +251,68 @@ impl DeviceHealth {
     }
 }
 
+/// What the link says now, for a [`Guide`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Reading {
+    /// The device stopped answering.
+    pub lost: bool,
+    /// For a device that must be homed (the Falcon): whether every arm is home.
+    pub homed: Option<bool>,
+}
+
+impl DeviceHealth {
+    /// The link's state now.
+    pub fn reading(&self) -> Reading {
+        match self {
+            Self::Local => Reading { lost: false, homed: None },
+            Self::Falcon(s) => Reading {
+                lost: s.disconnected(),
+                // Homing starts once the firmware answers.
+                homed: (s.replies() > 0).then(|| s.homed().iter().all(|&h| h)),
+            },
+            Self::Haply(s) => Reading { lost: s.disconnected(), homed: None },
+        }
+    }
+}
+
+/// What to tell the player of a real device as a session goes on: the homing instruction when homing
+/// starts and every [`haptico::falcon::homing::Homing::REMIND`] while it lasts, once that forces are on
+/// when it is done, and once that the device was lost (nothing after that).
+#[derive(Debug, Default)]
+pub struct Guide {
+    instructed_at_s: Option<f64>,
+    lost_told: bool,
+}
+
+impl Guide {
+    /// What to say at `now_s` (seconds, any monotonic clock), given the link's `reading` and what
+    /// [`DeviceHealth::lost`] says of it.
+    pub fn next(&mut self, reading: Reading, lost_notice: Option<&'static str>, now_s: f64) -> Option<&'static str> {
+        if self.lost_told {
+            return None;
+        }
+        if reading.lost {
+            self.lost_told = true;
+            return lost_notice;
+        }
+        match (reading.homed, self.instructed_at_s) {
+            (Some(false), None) => {
+                self.instructed_at_s = Some(now_s);
+                Some(haptico::falcon::homing::INSTRUCTION)
+            }
+            (Some(false), Some(t)) if now_s - t >= haptico::falcon::homing::Homing::REMIND.as_secs_f64() => {
+                self.instructed_at_s = Some(now_s);
+                Some(haptico::falcon::homing::INSTRUCTION)
+            }
+            (Some(true), Some(_)) => {
+                self.instructed_at_s = None;
+                Some("The Falcon is homed: you will feel the copies now.")
+            }
+            _ => None,
+        }
+    }
+}
+
 /// A device opened for the haptic thread.
 pub struct Opened {
     /// The device.
@@ -381,6 +443,31 @@ mod tests {
         assert_eq!(opened.to_string(), e, "the check and the open say the same");
         assert!(!e.contains('\n') && start.elapsed() < std::time::Duration::from_secs(5), "{:?}", start.elapsed());
         assert!(DeviceHealth::Local.lost().is_none());
+    }
+
+    #[test]
+    fn the_guide_repeats_the_homing_instruction_until_homed_then_tells_forces_are_on_and_a_loss_once() {
+        let homing = Reading { lost: false, homed: Some(false) };
+        let homed = Reading { lost: false, homed: Some(true) };
+        let lost = Reading { lost: true, homed: Some(true) };
+        let instruction = Some(haptico::falcon::homing::INSTRUCTION);
+        let mut g = Guide::default();
+        // Before the firmware answers, nothing; then the instruction at once and every 8 s.
+        assert_eq!(g.next(Reading { lost: false, homed: None }, None, 0.0), None);
+        assert_eq!(g.next(homing, None, 1.0), instruction);
+        assert_eq!(g.next(homing, None, 8.9), None);
+        assert_eq!(g.next(homing, None, 9.0), instruction);
+        assert_eq!(g.next(homed, None, 10.0), Some("The Falcon is homed: you will feel the copies now."));
+        assert_eq!(g.next(homed, None, 30.0), None, "said once");
+        // An arm loses home: homing again.
+        assert_eq!(g.next(homing, None, 31.0), instruction);
+        assert_eq!(g.next(lost, Some("gone"), 32.0), Some("gone"));
+        assert_eq!(g.next(lost, Some("gone"), 33.0), None, "the loss is said once, and nothing after it");
+        assert_eq!(g.next(homing, None, 60.0), None);
+        // A device without homing only ever hears of a loss.
+        let mut g = Guide::default();
+        assert_eq!(g.next(Reading { lost: false, homed: None }, None, 0.0), None);
+        assert_eq!(DeviceHealth::Local.reading(), Reading { lost: false, homed: None });
     }
 
     #[test]

@@ -134,7 +134,7 @@ pub struct Haptics {
     recording_lost: u64,
     /// Moves the simulated hand (sim device only).
     pub hand: Option<HandControl>,
-    /// The real device's link (see [`Haptics::device_lost`]).
+    /// The real device's link (watched by the client: [`device::Guide`]).
     pub health: device::DeviceHealth,
     /// The device's limits.
     pub specs: DeviceSpecs,
@@ -222,11 +222,6 @@ impl Haptics {
             rates: Vec::new(),
             settings,
         })
-    }
-
-    /// What to tell the player once a real device stopped answering (no force reaches it any more).
-    pub fn device_lost(&self) -> Option<&'static str> {
-        self.health.lost()
     }
 
     /// Microseconds on the haptic clock.
