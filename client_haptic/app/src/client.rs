@@ -222,7 +222,6 @@ fn receive(
     }
 }
 
-/// Polls the tree build and the rig's rings; announces when the copy can be felt.
 /// Guides the player through the real device's set-up as the session goes (the Falcon's homing) and
 /// tells them, once, when it stopped answering (its link went: no force reaches it).
 fn watch_device(
@@ -232,13 +231,13 @@ fn watch_device(
     mut started: Local<Option<std::time::Instant>>,
 ) {
     let started = *started.get_or_insert_with(std::time::Instant::now);
-    let health = &haptics.health;
-    if let Some(notice) = guide.next(health.reading(), health.lost(), started.elapsed().as_secs_f64()) {
+    if let Some(notice) = guide.next(haptics.health.reading(), started.elapsed().as_secs_f64()) {
         log::info!("device: {notice}");
         speaker.say(notice);
     }
 }
 
+/// Polls the tree build and the rig's rings; announces when the copy can be felt.
 fn poll_haptics(
     mut haptics: NonSendMut<Haptics>,
     mut speaker: NonSendMut<Speaker>,

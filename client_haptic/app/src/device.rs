@@ -235,27 +235,12 @@ pub enum DeviceHealth {
     Haply(Arc<haptico::haply::HaplyStatus>),
 }
 
-impl DeviceHealth {
-    /// What to tell the player once the device stopped answering (forces no longer reach it), else `None`.
-    pub fn lost(&self) -> Option<&'static str> {
-        match self {
-            Self::Falcon(s) if s.disconnected() => {
-                Some("The Falcon stopped answering: no force reaches it. Check its cable and power, then start again.")
-            }
-            Self::Haply(s) if s.disconnected() => Some(
-                "The Haply service went away: no force reaches the Inverse3. Check that the Haply Inverse Service \
-                 runs and the Inverse3 is on, then start again.",
-            ),
-            _ => None,
-        }
-    }
-}
-
 /// What the link says now, for a [`Guide`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Reading {
-    /// The device stopped answering.
-    pub lost: bool,
+    /// What to tell the player once the device stopped answering (no force reaches it any more), else
+    /// `None`.
+    pub lost: Option<&'static str>,
     /// For a device that must be homed (the Falcon): whether every arm is home.
     pub homed: Option<bool>,
 }
@@ -264,13 +249,21 @@ impl DeviceHealth {
     /// The link's state now.
     pub fn reading(&self) -> Reading {
         match self {
-            Self::Local => Reading { lost: false, homed: None },
+            Self::Local => Reading { lost: None, homed: None },
             Self::Falcon(s) => Reading {
-                lost: s.disconnected(),
+                lost: s.disconnected().then_some(
+                    "The Falcon stopped answering: no force reaches it. Check its cable and power, then start again.",
+                ),
                 // Homing starts once the firmware answers.
                 homed: (s.replies() > 0).then(|| s.homed().iter().all(|&h| h)),
             },
-            Self::Haply(s) => Reading { lost: s.disconnected(), homed: None },
+            Self::Haply(s) => Reading {
+                lost: s.disconnected().then_some(
+                    "The Haply service went away: no force reaches the Inverse3. Check that the Haply Inverse \
+                     Service runs and the Inverse3 is on, then start again.",
+                ),
+                homed: None,
+            },
         }
     }
 }
@@ -285,15 +278,14 @@ pub struct Guide {
 }
 
 impl Guide {
-    /// What to say at `now_s` (seconds, any monotonic clock), given the link's `reading` and what
-    /// [`DeviceHealth::lost`] says of it.
-    pub fn next(&mut self, reading: Reading, lost_notice: Option<&'static str>, now_s: f64) -> Option<&'static str> {
+    /// What to say at `now_s` (seconds, any monotonic clock), given the link's `reading`.
+    pub fn next(&mut self, reading: Reading, now_s: f64) -> Option<&'static str> {
         if self.lost_told {
             return None;
         }
-        if reading.lost {
+        if let Some(notice) = reading.lost {
             self.lost_told = true;
-            return lost_notice;
+            return Some(notice);
         }
         match (reading.homed, self.instructed_at_s) {
             (Some(false), None) => {
@@ -442,32 +434,32 @@ mod tests {
         let Err(opened) = open(&choice, haptico::presets::inverse3()) else { panic!("opened a closed port") };
         assert_eq!(opened.to_string(), e, "the check and the open say the same");
         assert!(!e.contains('\n') && start.elapsed() < std::time::Duration::from_secs(5), "{:?}", start.elapsed());
-        assert!(DeviceHealth::Local.lost().is_none());
+        assert!(DeviceHealth::Local.reading().lost.is_none());
     }
 
     #[test]
     fn the_guide_repeats_the_homing_instruction_until_homed_then_tells_forces_are_on_and_a_loss_once() {
-        let homing = Reading { lost: false, homed: Some(false) };
-        let homed = Reading { lost: false, homed: Some(true) };
-        let lost = Reading { lost: true, homed: Some(true) };
+        let homing = Reading { lost: None, homed: Some(false) };
+        let homed = Reading { lost: None, homed: Some(true) };
+        let lost = Reading { lost: Some("gone"), homed: Some(true) };
         let instruction = Some(haptico::falcon::homing::INSTRUCTION);
         let mut g = Guide::default();
         // Before the firmware answers, nothing; then the instruction at once and every 8 s.
-        assert_eq!(g.next(Reading { lost: false, homed: None }, None, 0.0), None);
-        assert_eq!(g.next(homing, None, 1.0), instruction);
-        assert_eq!(g.next(homing, None, 8.9), None);
-        assert_eq!(g.next(homing, None, 9.0), instruction);
-        assert_eq!(g.next(homed, None, 10.0), Some("The Falcon is homed: you will feel the copies now."));
-        assert_eq!(g.next(homed, None, 30.0), None, "said once");
+        assert_eq!(g.next(Reading { lost: None, homed: None }, 0.0), None);
+        assert_eq!(g.next(homing, 1.0), instruction);
+        assert_eq!(g.next(homing, 8.9), None);
+        assert_eq!(g.next(homing, 9.0), instruction);
+        assert_eq!(g.next(homed, 10.0), Some("The Falcon is homed: you will feel the copies now."));
+        assert_eq!(g.next(homed, 30.0), None, "said once");
         // An arm loses home: homing again.
-        assert_eq!(g.next(homing, None, 31.0), instruction);
-        assert_eq!(g.next(lost, Some("gone"), 32.0), Some("gone"));
-        assert_eq!(g.next(lost, Some("gone"), 33.0), None, "the loss is said once, and nothing after it");
-        assert_eq!(g.next(homing, None, 60.0), None);
+        assert_eq!(g.next(homing, 31.0), instruction);
+        assert_eq!(g.next(lost, 32.0), Some("gone"));
+        assert_eq!(g.next(lost, 33.0), None, "the loss is said once, and nothing after it");
+        assert_eq!(g.next(homing, 60.0), None);
         // A device without homing only ever hears of a loss.
         let mut g = Guide::default();
-        assert_eq!(g.next(Reading { lost: false, homed: None }, None, 0.0), None);
-        assert_eq!(DeviceHealth::Local.reading(), Reading { lost: false, homed: None });
+        assert_eq!(g.next(Reading { lost: None, homed: None }, 0.0), None);
+        assert_eq!(DeviceHealth::Local.reading(), Reading { lost: None, homed: None });
     }
 
     #[test]

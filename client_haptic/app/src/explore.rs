@@ -11,9 +11,8 @@
 //! 2. a light press on a plain part and a stroke down and up: the drag against the motion over the
 //!    normal force gives the friction, and a push along the stroke that repeats with the height gives the
 //!    ridges: a copy with ridges ([`RIDGES_ABOVE`]) that grips ([`ROUGH_ABOVE`]) is rough (ribbed).
-//!    A stroke that was mostly out of touch
-//!    (the press met nothing) says nothing: the hand backs off and presses again, a little deeper, up
-//!    to [`ATTEMPTS`] times.
+//!    A stroke that was mostly out of touch (the press met nothing) says nothing: the hand backs off
+//!    and presses again, a little deeper, up to [`ATTEMPTS`] times.
 //!
 //! A hand can only judge what it felt at full force: when the haptic loop stalls (the process was not
 //! scheduled) or the contact data goes stale, the safety layer fades the forces out and back in over two

@@ -86,7 +86,7 @@ impl IoDevice {
             while !io.stopping() {
                 io.states.write(device.read_state(io.clock.now_us()));
                 device.command(io.newest_force());
-                io.stats.exchanges.fetch_add(1, Ordering::Relaxed);
+                io.count_exchange();
                 (deadline, _) = next_deadline(deadline, io.clock.now_ns(), period_ns, 5);
                 wait_until(&io.clock, deadline, 200_000);
             }

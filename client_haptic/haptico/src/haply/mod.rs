@@ -227,36 +227,40 @@ async fn merge(state: &SharedState, text: String, first: &mut bool) {
     haply::state::update_state_on_message(state.clone(), text, first, VerseGripDuplicateMode::default()).await;
 }
 
+/// The next text frame before `deadline` (`None` once it passed, other frames skipped), or what went
+/// wrong with the connection (`during`: while doing what).
+async fn next_text(ws: &mut Socket, deadline: tokio::time::Instant, during: &str) -> Result<Option<String>> {
+    loop {
+        match tokio::time::timeout_at(deadline, ws.next()).await {
+            Err(_) => return Ok(None),
+            Ok(Some(Ok(Message::Text(text)))) => return Ok(Some(text.to_string())),
+            Ok(Some(Ok(_))) => {}
+            Ok(Some(Err(e))) => return Err(HapticoError::Usb(format!("the Haply service connection failed: {e}"))),
+            Ok(None) => return Err(HapticoError::Usb(format!("the Haply service closed the connection{during}"))),
+        }
+    }
+}
+
 /// Reads frames until the service lists an Inverse3; its id.
 async fn first_frame(ws: &mut Socket, state: &SharedState, wait: Duration) -> Result<String> {
     let deadline = tokio::time::Instant::now() + wait;
     let mut first = true;
     let mut frames = 0u32;
-    loop {
-        let next = tokio::time::timeout_at(deadline, ws.next()).await;
-        match next {
-            Ok(Some(Ok(Message::Text(text)))) => {
-                frames += 1;
-                merge(state, text.to_string(), &mut first).await;
-                if let Some(d) = state.lock().await.data.inverse3.first() {
-                    return Ok(d.device_id.clone());
-                }
-            }
-            Ok(Some(Ok(_))) => {}
-            Ok(Some(Err(e))) => return Err(HapticoError::Usb(format!("the Haply service connection failed: {e}"))),
-            Ok(None) => return Err(HapticoError::Usb("the Haply service closed the connection".into())),
-            Err(_) => {
-                return Err(HapticoError::NoDevice {
-                    wanted: "Inverse3 on the Haply Inverse Service".into(),
-                    hint: format!(
-                        "the service answered ({frames} state messages in {} s) but lists no Inverse3: plug it in, \
-                         switch it on and check the service's dashboard",
-                        wait.as_secs_f32()
-                    ),
-                });
-            }
+    while let Some(text) = next_text(ws, deadline, "").await? {
+        frames += 1;
+        merge(state, text, &mut first).await;
+        if let Some(d) = state.lock().await.data.inverse3.first() {
+            return Ok(d.device_id.clone());
         }
     }
+    Err(HapticoError::NoDevice {
+        wanted: "Inverse3 on the Haply Inverse Service".into(),
+        hint: format!(
+            "the service answered ({frames} state messages in {} s) but lists no Inverse3: plug it in, switch it \
+             on and check the service's dashboard",
+            wait.as_secs_f32()
+        ),
+    })
 }
 
 /// Reads the grip for [`CENTRING`] (answering each frame with no force) and returns the mean position
@@ -267,21 +271,13 @@ async fn centre_on_the_grip(ws: &mut Socket, state: &SharedState, device_id: &st
     let mut first = false;
     let (mut lo, mut hi, mut sum, mut n) = (Vec3::INFINITY, Vec3::NEG_INFINITY, Vec3::ZERO, 0u32);
     send_json(ws, &zero).await?;
-    loop {
-        match tokio::time::timeout_at(deadline, ws.next()).await {
-            Err(_) => break,
-            Ok(Some(Ok(Message::Text(text)))) => {
-                merge(state, text.to_string(), &mut first).await;
-                let p = state.lock().await.data.inverse3.iter().find(|d| d.device_id == device_id).and_then(position);
-                if let Some(p) = p {
-                    (lo, hi, sum, n) = (lo.min(p), hi.max(p), sum + p, n + 1);
-                }
-                send_json(ws, &zero).await?;
-            }
-            Ok(Some(Ok(_))) => {}
-            Ok(Some(Err(e))) => return Err(HapticoError::Usb(format!("the Haply service connection failed: {e}"))),
-            Ok(None) => return Err(HapticoError::Usb("the Haply service closed the connection while centring".into())),
+    while let Some(text) = next_text(ws, deadline, " while centring").await? {
+        merge(state, text, &mut first).await;
+        let p = state.lock().await.data.inverse3.iter().find(|d| d.device_id == device_id).and_then(position);
+        if let Some(p) = p {
+            (lo, hi, sum, n) = (lo.min(p), hi.max(p), sum + p, n + 1);
         }
+        send_json(ws, &zero).await?;
     }
     if n == 0 {
         return Err(HapticoError::Usb(format!(
