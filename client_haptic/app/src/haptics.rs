@@ -177,7 +177,8 @@ impl Haptics {
         let gem = collette::scene::brilliant_cut(TOOL_DIAMETER_M);
         let (tree, _) = collette::build(&gem, &BuildOptions::spheres(TOOL_SPHERES), &mut |_| {})
             .map_err(|e| ClientError::Device(format!("building the gemstone's tree: {e}")))?;
-        let tool_reference_volume_m3 = immersed_volume(tree.spheres(), glam::Vec3::X, REFERENCE_DEPTH_M);
+        let tool_reference_volume_m3 =
+            immersed_volume(tree.spheres(), tree.weights(), glam::Vec3::X, REFERENCE_DEPTH_M);
         // The gem is far stiffer than any copy, and its friction is 1 so the copy's own coefficient decides
         // (see `haptic_material`).
         let tool = ToolSpec::new(
@@ -349,10 +350,9 @@ impl Haptics {
 
 /// The contact material of a copy: the briefed stiffness `k` (N/m) becomes the volumetric stiffness
 /// that pushes back `k · d0` when the gemstone is `d0` = [`REFERENCE_DEPTH_M`] deep in a flat, fully
-/// packed face, where its packed volume is `tool_volume_m3` (see [`immersed_volume`]); a copy's own
-/// packing leaves its skin a little softer. Friction is squared because contact friction is the
-/// geometric mean with the gem's (1). Ridges become a texture repeating up the copy (+Y), their
-/// depth read with the briefed stiffness.
+/// packed face, where its weighted volume is `tool_volume_m3` (see [`immersed_volume`]). Friction is
+/// squared because contact friction is the geometric mean with the gem's (1). Ridges become a texture
+/// repeating up the copy (+Y), their depth read with the briefed stiffness.
 pub fn haptic_material(m: &artifact::Material, tool_volume_m3: f32) -> Material {
     Material {
         stiffness_n_per_m3: m.stiffness_n_per_m * REFERENCE_DEPTH_M / tool_volume_m3.max(1e-12),
@@ -363,16 +363,18 @@ pub fn haptic_material(m: &artifact::Material, tool_volume_m3: f32) -> Material 
 }
 
 /// Volume of `spheres` past a plane `depth` behind their outermost point along `normal` (what of a
-/// tool is inside a flat face it was pushed `depth` into, along −`normal`), m³.
-pub fn immersed_volume(spheres: &[collette::Sphere], normal: Vec3, depth: f32) -> f32 {
+/// tool is inside a flat face it was pushed `depth` into, along −`normal`), each sphere's part times
+/// its weight (the share of the mesh it stands for, as the overlap queries count it), m³.
+pub fn immersed_volume(spheres: &[collette::Sphere], weights: &[f32], normal: Vec3, depth: f32) -> f32 {
     let n = normal.normalize_or(Vec3::X);
     let front = spheres.iter().map(|s| s.center.dot(n) + s.radius).fold(f32::NEG_INFINITY, f32::max);
     let plane = front - depth;
     spheres
         .iter()
-        .map(|s| {
+        .zip(weights.iter().chain(std::iter::repeat(&1.0)))
+        .map(|(s, w)| {
             let h = (s.center.dot(n) + s.radius - plane).clamp(0.0, 2.0 * s.radius);
-            std::f32::consts::PI * h * h * (3.0 * s.radius - h) / 3.0
+            w * std::f32::consts::PI * h * h * (3.0 * s.radius - h) / 3.0
         })
         .sum()
 }
@@ -380,7 +382,7 @@ pub fn immersed_volume(spheres: &[collette::Sphere], normal: Vec3, depth: f32) -
 /// Content hash of a mesh and the build settings, as the cache file's name.
 pub fn cache_key(mesh: &HapticMesh, spheres: usize) -> String {
     let mut h = blake3::Hasher::new();
-    h.update(b"phantom-heist ist v1");
+    h.update(b"phantom-heist ist v2"); // v2: weighted spheres
     h.update(&(spheres as u64).to_le_bytes());
     for v in &mesh.vertices {
         for c in v {
@@ -444,9 +446,11 @@ mod tests {
         let d = REFERENCE_DEPTH_M;
         let one = [collette::Sphere { center: Vec3::ZERO, radius: r }];
         let cap = std::f32::consts::PI * d * d * (3.0 * r - d) / 3.0;
-        assert!((immersed_volume(&one, Vec3::X, d) / cap - 1.0).abs() < 1e-4);
+        assert!((immersed_volume(&one, &[1.0], Vec3::X, d) / cap - 1.0).abs() < 1e-4);
+        assert!((immersed_volume(&one, &[1.5], Vec3::X, d) / (1.5 * cap) - 1.0).abs() < 1e-4, "weighted");
         assert!(
-            (immersed_volume(&one, Vec3::X, 3.0 * r) / (4.0 / 3.0 * std::f32::consts::PI * r * r * r) - 1.0).abs()
+            (immersed_volume(&one, &[1.0], Vec3::X, 3.0 * r) / (4.0 / 3.0 * std::f32::consts::PI * r * r * r) - 1.0)
+                .abs()
                 < 1e-4
         );
         let m = haptic_material(&MaterialClass::HardRough.material(), cap);

@@ -131,10 +131,14 @@ pub fn run() -> anyhow::Result<()> {
             let radii = tree.spheres().iter().map(|s| s.radius);
             let (rmin, rmax) = radii.fold((f32::INFINITY, 0.0f32), |(a, b), r| (a.min(r), b.max(r)));
             let root = tree.root().bound;
+            let weights = tree.weights().iter();
+            let (wmin, wmax) = weights.clone().fold((f32::INFINITY, 0.0f32), |(a, b), &w| (a.min(w), b.max(w)));
+            let wmean = weights.sum::<f32>() / tree.weights().len().max(1) as f32;
             if json {
                 let v = serde_json::json!({
                     "file": file, "spheres": tree.spheres().len(), "nodes": tree.nodes().len(), "depth": tree.depth(),
                     "mesh_volume": tree.mesh_volume(), "packed_volume": tree.packed_volume(), "coverage": tree.coverage(),
+                    "mesh_share": tree.mesh_share(), "min_weight": wmin, "mean_weight": wmean, "max_weight": wmax,
                     "min_radius": rmin, "max_radius": rmax, "bound_center": root.center.to_array(),
                     "bound_radius": root.radius, "load_ms": load_ms,
                 });
@@ -144,6 +148,10 @@ pub fn run() -> anyhow::Result<()> {
                 println!("  spheres        {} (radius {rmin:.4e} .. {rmax:.4e})", tree.spheres().len());
                 println!("  hierarchy      {} nodes, depth {}", tree.nodes().len(), tree.depth());
                 println!("  coverage       {:.2} % of mesh volume {:.6e}", tree.coverage() * 100.0, tree.mesh_volume());
+                println!(
+                    "  weights        {wmin:.2} .. {wmax:.2} (mean {wmean:.2}): the spheres stand for {:.2} % of it",
+                    100.0 * tree.mesh_share() / tree.mesh_volume().max(f32::MIN_POSITIVE)
+                );
                 println!("  bound          centre {:?}, radius {:.4e}", root.center.to_array(), root.radius);
                 println!("  loaded in      {load_ms:.2} ms");
             }

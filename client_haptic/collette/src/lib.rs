@@ -1,9 +1,11 @@
 //! collette: Inner Sphere Trees (ISTs) for volumetric collision detection in haptics.
 //!
-//! An IST fills an object with non-overlapping spheres (greedy packing on a voxel distance field) and
-//! wraps them in a hierarchy of bounding spheres. Two ISTs report the overlap volume of the objects
-//! (a lower bound of the true intersection), every overlapping sphere pair with its exact lens volume,
-//! normal and contact point: the input of volumetric penalty forces.
+//! An IST fills an object with non-overlapping spheres (greedy packing on a voxel distance field),
+//! weighs each by the share of the mesh it stands for (itself and the nearest gaps) and wraps them in a
+//! hierarchy of bounding spheres. Two ISTs report the overlap volume of the objects (the lens volumes of
+//! their overlapping sphere pairs, each times both weights: an estimate of the true intersection), every
+//! overlapping sphere pair with its volume, normal and contact point: the input of volumetric penalty
+//! forces.
 //!
 //! - Build: [`TriMesh::from_obj`] / [`TriMesh::from_buffers`], then [`build`] with [`BuildOptions`].
 //! - Store: [`InnerSphereTree::save`] / [`InnerSphereTree::load`] (the `.ist` format, see [`io`]).

@@ -43,6 +43,9 @@ fn build_info_and_render_work_end_to_end() {
     assert!(out.status.success());
     let info: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json info");
     assert_eq!(info["spheres"], 200);
+    let share = info["mesh_share"].as_f64().expect("number");
+    assert!((share - 1.0).abs() < 1e-3, "the weighted spheres stand for the whole cube: {share}");
+    assert!(info["min_weight"].as_f64().expect("number") >= 1.0);
 
     let out = bin().arg("render").arg(&ist).arg("-o").arg(&png).args(["--size", "64"]).output().expect("runs");
     assert!(out.status.success());

@@ -194,11 +194,12 @@ pub struct ObjectSpec {
     pub material: Material,
 }
 
-/// Volume-weighted centre of a tree's inner spheres (its centre of mass at uniform density).
+/// Centre of a tree's inner spheres weighted by the mesh volume each stands for (the object's centre
+/// of mass at uniform density).
 pub fn center_of_mass(tree: &collette::InnerSphereTree) -> Vec3 {
     let (mut sum, mut weight) = (Vec3::ZERO, 0.0f32);
-    for s in tree.spheres() {
-        let w = s.radius * s.radius * s.radius;
+    for (s, share) in tree.spheres().iter().zip(tree.weights()) {
+        let w = s.radius * s.radius * s.radius * share;
         sum += s.center * w;
         weight += w;
     }

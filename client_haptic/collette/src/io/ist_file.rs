@@ -5,15 +5,17 @@
 //! | offset | size | field |
 //! |---|---|---|
 //! | 0 | 8 | magic `COLLIST\0` |
-//! | 8 | 4 | format version (u32, currently 1) |
+//! | 8 | 4 | format version (u32, currently 2; version 1 is still read) |
 //! | 12 | 4 | header size in bytes (u32, 64) |
 //! | 16 | 4 | sphere count S (u32) |
 //! | 20 | 4 | node count N (u32) |
 //! | 24 | 4 | exact mesh volume (f32) |
 //! | 28 | 36 | reserved, zero |
-//! | 64 | 16·S | spheres: centre x, y, z, radius (f32) |
-//! | 64+16·S | 28·N | nodes: bound centre x, y, z, radius, summed leaf volume (f32), first (u32), count with bit 31 set for leaves (u32) |
+//! | 64 | 20·S | spheres: centre x, y, z, radius, weight (f32) |
+//! | 64+20·S | 32·N | nodes: bound centre x, y, z, radius, summed leaf volume, mesh share (f32), first (u32), count with bit 31 set for leaves (u32) |
 //! | end−4 | 4 | CRC-32 (IEEE) of every preceding byte |
+//!
+//! Version 1 had no weight (16-byte spheres) and no mesh share (28-byte nodes): its spheres weigh 1.
 
 use crate::error::IstFileError;
 use crate::partitioning::{InnerSphereTree, Node};
@@ -23,12 +25,20 @@ use std::path::Path;
 
 /// First bytes of every `.ist` file.
 pub const MAGIC: [u8; 8] = *b"COLLIST\0";
-/// Version written by this library (and the only one it reads).
-pub const FORMAT_VERSION: u32 = 1;
+/// Version written by this library (it also reads version 1).
+pub const FORMAT_VERSION: u32 = 2;
 /// Size of the fixed header.
 pub const HEADER_SIZE: usize = 64;
-const SPHERE_SIZE: usize = 16;
-const NODE_SIZE: usize = 28;
+const SPHERE_SIZE: usize = 20;
+const NODE_SIZE: usize = 32;
+/// Record sizes (sphere, node) of each version read.
+fn record_sizes(version: u32) -> Option<(usize, usize)> {
+    match version {
+        1 => Some((16, 28)),
+        2 => Some((SPHERE_SIZE, NODE_SIZE)),
+        _ => None,
+    }
+}
 const LEAF_BIT: u32 = 1 << 31;
 
 impl InnerSphereTree {
@@ -43,13 +53,13 @@ impl InnerSphereTree {
         b.extend_from_slice(&self.mesh_volume.to_le_bytes());
         b.resize(HEADER_SIZE, 0);
         let f = |b: &mut Vec<u8>, x: f32| b.extend_from_slice(&x.to_le_bytes());
-        for s in &self.spheres {
-            for x in [s.center.x, s.center.y, s.center.z, s.radius] {
+        for (s, w) in self.spheres.iter().zip(&self.weights) {
+            for x in [s.center.x, s.center.y, s.center.z, s.radius, *w] {
                 f(&mut b, x);
             }
         }
         for n in &self.nodes {
-            for x in [n.bound.center.x, n.bound.center.y, n.bound.center.z, n.bound.radius, n.volume] {
+            for x in [n.bound.center.x, n.bound.center.y, n.bound.center.z, n.bound.radius, n.volume, n.mesh_share] {
                 f(&mut b, x);
             }
             b.extend_from_slice(&n.first.to_le_bytes());
@@ -71,14 +81,18 @@ impl InnerSphereTree {
         }
         let u = |at: usize| u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]);
         let version = u(8);
-        if version != FORMAT_VERSION {
+        let Some((sphere_size, node_size)) = record_sizes(version) else {
             return Err(IstFileError::UnsupportedVersion { found: version, supported: FORMAT_VERSION });
-        }
+        };
         if u(12) as usize != HEADER_SIZE {
             return Err(IstFileError::Invalid(format!("header size {} (expected {HEADER_SIZE})", u(12))));
         }
         let (spheres, nodes) = (u(16) as usize, u(20) as usize);
-        let expected = HEADER_SIZE + SPHERE_SIZE * spheres + NODE_SIZE * nodes + 4;
+        let expected = (spheres as u64)
+            .checked_mul(sphere_size as u64)
+            .zip((nodes as u64).checked_mul(node_size as u64))
+            .map_or(u64::MAX, |(s, n)| HEADER_SIZE as u64 + s + n + 4);
+        let expected = usize::try_from(expected).unwrap_or(usize::MAX);
         if bytes.len() < expected {
             return Err(IstFileError::Truncated { expected, found: bytes.len() });
         }
@@ -93,16 +107,20 @@ impl InnerSphereTree {
         let f = |at: usize| f32::from_bits(u(at));
         let v3 = |at: usize| Vec3::new(f(at), f(at + 4), f(at + 8));
         let sphere_at = |at: usize| Sphere::new(v3(at), f(at + 12));
+        let weighted = version >= 2;
         let tree = InnerSphereTree {
-            spheres: (0..spheres).map(|i| sphere_at(HEADER_SIZE + SPHERE_SIZE * i)).collect(),
+            spheres: (0..spheres).map(|i| sphere_at(HEADER_SIZE + sphere_size * i)).collect(),
+            weights: (0..spheres).map(|i| if weighted { f(HEADER_SIZE + sphere_size * i + 16) } else { 1.0 }).collect(),
             nodes: (0..nodes)
                 .map(|i| {
-                    let at = HEADER_SIZE + SPHERE_SIZE * spheres + NODE_SIZE * i;
-                    let count = u(at + 24);
+                    let at = HEADER_SIZE + sphere_size * spheres + node_size * i;
+                    let (volume, tail) = (f(at + 16), if weighted { at + 24 } else { at + 20 });
+                    let count = u(tail + 4);
                     Node {
                         bound: sphere_at(at),
-                        volume: f(at + 16),
-                        first: u(at + 20),
+                        volume,
+                        mesh_share: if weighted { f(at + 20) } else { volume },
+                        first: u(tail),
                         count: count & !LEAF_BIT,
                         leaf: count & LEAF_BIT != 0,
                     }
@@ -174,10 +192,33 @@ mod tests {
     }
 
     #[test]
+    fn a_version_1_file_loads_with_every_sphere_weighing_1() {
+        let tree = sample().unweighted();
+        let mut v1 = Vec::new();
+        v1.extend_from_slice(&tree.to_bytes()[..HEADER_SIZE]);
+        v1[8..12].copy_from_slice(&1u32.to_le_bytes());
+        for s in tree.spheres() {
+            for x in [s.center.x, s.center.y, s.center.z, s.radius] {
+                v1.extend_from_slice(&x.to_le_bytes());
+            }
+        }
+        for n in tree.nodes() {
+            for x in [n.bound.center.x, n.bound.center.y, n.bound.center.z, n.bound.radius, n.volume] {
+                v1.extend_from_slice(&x.to_le_bytes());
+            }
+            v1.extend_from_slice(&n.first.to_le_bytes());
+            v1.extend_from_slice(&(n.count | if n.leaf { LEAF_BIT } else { 0 }).to_le_bytes());
+        }
+        let crc = crc32fast::hash(&v1);
+        v1.extend_from_slice(&crc.to_le_bytes());
+        assert_eq!(InnerSphereTree::from_bytes(&v1).expect("version 1 reads"), tree);
+    }
+
+    #[test]
     fn a_well_checksummed_but_inconsistent_tree_is_refused() {
         let mut bytes = sample().to_bytes();
         // Point the root past the node array, then fix the checksum so only validation can catch it.
-        let root_first = HEADER_SIZE + SPHERE_SIZE * sample().spheres.len() + 20;
+        let root_first = HEADER_SIZE + SPHERE_SIZE * sample().spheres.len() + 24;
         bytes[root_first..root_first + 4].copy_from_slice(&9_999_999u32.to_le_bytes());
         let n = bytes.len() - 4;
         let crc = crc32fast::hash(&bytes[..n]);

@@ -1,4 +1,5 @@
-//! Building an Inner Sphere Tree from a mesh: voxel distance field, greedy sphere packing, hierarchy.
+//! Building an Inner Sphere Tree from a mesh: voxel distance field, greedy sphere packing, hierarchy,
+//! sphere weights (the share of the mesh each sphere stands for).
 //!
 //! You need this module to turn a closed mesh into an [`InnerSphereTree`] (or use the `collette build`
 //! command, which calls [`build`] and saves the result).
@@ -6,6 +7,7 @@
 mod distance_field;
 mod greedy;
 mod refine;
+mod weights;
 
 pub use distance_field::{DistanceField, to_parry};
 
@@ -163,7 +165,8 @@ pub fn build(
     progress(BuildProgress::Hierarchy);
     let packed_volume: f64 = spheres.iter().map(|s| s.volume() as f64).sum();
     let count = spheres.len();
-    let tree = InnerSphereTree::from_spheres(spheres, mesh_volume as f32);
+    let mut tree = InnerSphereTree::from_spheres(spheres, mesh_volume as f32);
+    weights::weigh(&mut tree, &field);
     let report = BuildReport {
         spheres: count,
         coverage: packed_volume / mesh_volume,

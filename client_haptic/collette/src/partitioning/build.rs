@@ -13,7 +13,7 @@ impl InnerSphereTree {
     /// Each node is split in two at the volume-weighted median along its axis of largest volume-weighted
     /// spread (the split index kept within the middle half so the tree stays balanced), twice per level,
     /// giving up to four children. Inner nodes store the sphere wrapping their leaves and their leaves'
-    /// summed volume.
+    /// summed volume. Every sphere weighs 1 ([`InnerSphereTree::weights`]): `build` weighs them.
     pub fn from_spheres(mut spheres: Vec<Sphere>, mesh_volume: f32) -> Self {
         let mut nodes = vec![Node::default()];
         let mut work = vec![(0usize, 0usize, spheres.len())];
@@ -22,7 +22,8 @@ impl InnerSphereTree {
             let volume = slice.iter().map(|s| s.volume() as f64).sum::<f64>() as f32;
             let bound = enclosing_sphere(slice);
             if hi - lo <= LEAF_SIZE {
-                nodes[node] = Node { bound, volume, first: lo as u32, count: (hi - lo) as u32, leaf: true };
+                nodes[node] =
+                    Node { bound, volume, mesh_share: volume, first: lo as u32, count: (hi - lo) as u32, leaf: true };
                 continue;
             }
             let mid = split(&mut spheres[lo..hi]) + lo;
@@ -38,12 +39,14 @@ impl InnerSphereTree {
             }
             let first = nodes.len();
             nodes.extend(parts.iter().map(|_| Node::default()));
-            nodes[node] = Node { bound, volume, first: first as u32, count: parts.len() as u32, leaf: false };
+            nodes[node] =
+                Node { bound, volume, mesh_share: volume, first: first as u32, count: parts.len() as u32, leaf: false };
             for (i, &(a, b)) in parts.iter().enumerate().rev() {
                 work.push((first + i, a, b));
             }
         }
-        Self { spheres, nodes, mesh_volume }
+        let weights = vec![1.0; spheres.len()];
+        Self { spheres, weights, nodes, mesh_volume }
     }
 }
 

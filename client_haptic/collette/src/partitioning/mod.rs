@@ -21,6 +21,9 @@ pub struct Node {
     pub bound: Sphere,
     /// Summed volume of the leaf spheres below this node.
     pub volume: f32,
+    /// Volume of the mesh the leaf spheres below this node stand for: their volumes times their
+    /// weights (see [`InnerSphereTree::weights`]).
+    pub mesh_share: f32,
     /// Index of the first child node (inner) or first sphere (leaf).
     pub first: u32,
     /// Number of children (inner) or spheres (leaf).
@@ -41,6 +44,7 @@ impl Node {
 #[derive(Clone, Debug, PartialEq)]
 pub struct InnerSphereTree {
     pub(crate) spheres: Vec<Sphere>,
+    pub(crate) weights: Vec<f32>,
     pub(crate) nodes: Vec<Node>,
     pub(crate) mesh_volume: f32,
 }
@@ -49,6 +53,16 @@ impl InnerSphereTree {
     /// The packed spheres (leaves), in hierarchy order.
     pub fn spheres(&self) -> &[Sphere] {
         &self.spheres
+    }
+
+    /// Per sphere (same order as [`InnerSphereTree::spheres`]): the volume of the mesh it stands for
+    /// divided by its own volume (>= 1). The sphere itself plus its share of the gaps between the
+    /// spheres and the surface: every gap point belongs to the sphere whose surface is nearest, so the
+    /// shares add up to the mesh volume. Queries multiply each lens volume by both spheres' weights,
+    /// which turns the packing's overlap volume (always short) into an estimate of the objects' own.
+    /// All 1 for a tree built without a mesh ([`InnerSphereTree::from_spheres`], version-1 files).
+    pub fn weights(&self) -> &[f32] {
+        &self.weights
     }
 
     /// The nodes; the root is `nodes()[0]`.
@@ -71,6 +85,11 @@ impl InnerSphereTree {
         self.root().volume
     }
 
+    /// Mesh volume the spheres stand for (the mesh volume once weighted, else the packed volume).
+    pub fn mesh_share(&self) -> f32 {
+        self.root().mesh_share
+    }
+
     /// Packed volume / mesh volume.
     pub fn coverage(&self) -> f32 {
         if self.mesh_volume > 0.0 { self.packed_volume() / self.mesh_volume } else { 0.0 }
@@ -91,8 +110,39 @@ impl InnerSphereTree {
         let v = factor * factor * factor;
         Self {
             spheres: self.spheres.iter().map(|&x| s(x)).collect(),
-            nodes: self.nodes.iter().map(|n| Node { bound: s(n.bound), volume: n.volume * v, ..*n }).collect(),
+            weights: self.weights.clone(),
+            nodes: self
+                .nodes
+                .iter()
+                .map(|n| Node { bound: s(n.bound), volume: n.volume * v, mesh_share: n.mesh_share * v, ..*n })
+                .collect(),
             mesh_volume: self.mesh_volume * v,
+        }
+    }
+
+    /// A copy whose spheres all weigh 1: its queries give the packing's own overlap volume.
+    pub fn unweighted(&self) -> Self {
+        let mut t = self.clone();
+        t.weights.fill(1.0);
+        for n in &mut t.nodes {
+            n.mesh_share = n.volume;
+        }
+        t
+    }
+
+    /// Sets the spheres' weights (one per sphere, in sphere order) and every node's mesh share.
+    pub(crate) fn set_weights(&mut self, weights: Vec<f32>) {
+        debug_assert_eq!(weights.len(), self.spheres.len());
+        self.weights = weights;
+        // Children come after their parent: in reverse order every child is done before its parent.
+        for i in (0..self.nodes.len()).rev() {
+            let n = self.nodes[i];
+            let share: f64 = if n.leaf {
+                n.range().map(|s| self.spheres[s].volume() as f64 * self.weights[s] as f64).sum()
+            } else {
+                n.range().map(|c| self.nodes[c].mesh_share as f64).sum()
+            };
+            self.nodes[i].mesh_share = share as f32;
         }
     }
 }

@@ -3,7 +3,8 @@
 use super::InnerSphereTree;
 
 impl InnerSphereTree {
-    /// Checks indices, ranges, finiteness, that bounds wrap their leaves and that volumes add up.
+    /// Checks indices, ranges, finiteness, weights, that bounds wrap their leaves and that volumes and
+    /// mesh shares add up.
     pub fn validate(&self) -> Result<(), String> {
         if self.nodes.is_empty() {
             return Err("the tree has no root node".into());
@@ -18,6 +19,12 @@ impl InnerSphereTree {
         {
             return Err(format!("sphere {i} has a non-finite centre or a bad radius"));
         }
+        if self.weights.len() != self.spheres.len() {
+            return Err(format!("{} weights for {} spheres", self.weights.len(), self.spheres.len()));
+        }
+        if let Some(i) = self.weights.iter().position(|w| !(w.is_finite() && *w >= 1.0 && *w <= 1e6)) {
+            return Err(format!("sphere {i} has weight {} (expected 1 to 1e6)", self.weights[i]));
+        }
         let mut seen = vec![false; self.spheres.len()];
         let mut visited = vec![false; self.nodes.len()];
         let mut stack = vec![(0usize, 0usize)];
@@ -29,7 +36,11 @@ impl InnerSphereTree {
                 return Err(format!("node {n} is reachable twice"));
             }
             let node = &self.nodes[n];
-            if !node.bound.center.is_finite() || !node.bound.radius.is_finite() || !node.volume.is_finite() {
+            if !node.bound.center.is_finite()
+                || !node.bound.radius.is_finite()
+                || !node.volume.is_finite()
+                || !node.mesh_share.is_finite()
+            {
                 return Err(format!("node {n} has non-finite values"));
             }
             let end = node.first as u64 + node.count as u64;
@@ -37,7 +48,7 @@ impl InnerSphereTree {
                 if end > self.spheres.len() as u64 {
                     return Err(format!("leaf {n} points past the sphere array"));
                 }
-                let mut sum = 0.0f64;
+                let (mut sum, mut share) = (0.0f64, 0.0f64);
                 for s in node.range() {
                     if std::mem::replace(&mut seen[s], true) {
                         return Err(format!("sphere {s} belongs to two leaves"));
@@ -48,9 +59,13 @@ impl InnerSphereTree {
                         return Err(format!("leaf {n} does not enclose sphere {s}"));
                     }
                     sum += sp.volume() as f64;
+                    share += sp.volume() as f64 * self.weights[s] as f64;
                 }
                 if (sum as f32 - node.volume).abs() > 1e-3 * node.volume.max(1e-30) + 1e-30 {
                     return Err(format!("leaf {n} volume {} differs from its spheres' {sum}", node.volume));
+                }
+                if (share as f32 - node.mesh_share).abs() > 1e-3 * node.mesh_share.max(1e-30) + 1e-30 {
+                    return Err(format!("leaf {n} mesh share {} differs from its spheres' {share}", node.mesh_share));
                 }
             } else {
                 if node.count == 0 || node.count > 4 || end > self.nodes.len() as u64 || (node.first as usize) <= n {
@@ -59,6 +74,10 @@ impl InnerSphereTree {
                 let sum: f64 = node.range().map(|c| self.nodes[c].volume as f64).sum();
                 if (sum as f32 - node.volume).abs() > 1e-3 * node.volume.max(1e-30) + 1e-30 {
                     return Err(format!("node {n} volume {} differs from its children's {sum}", node.volume));
+                }
+                let share: f64 = node.range().map(|c| self.nodes[c].mesh_share as f64).sum();
+                if (share as f32 - node.mesh_share).abs() > 1e-3 * node.mesh_share.max(1e-30) + 1e-30 {
+                    return Err(format!("node {n} mesh share {} differs from its children's {share}", node.mesh_share));
                 }
                 for c in node.range() {
                     stack.push((c, depth + 1));

@@ -7,5 +7,5 @@ mod primitives;
 mod sphere;
 
 pub use mesh::TriMesh;
-pub use primitives::{box_buffers, uv_sphere_buffers};
+pub use primitives::{box_buffers, torus_buffers, uv_sphere_buffers};
 pub use sphere::{Lens, Sphere, lens, lens_volume, sphere_volume};

@@ -1,4 +1,4 @@
-//! Procedural closed meshes for tests, examples and benchmarks: boxes and UV spheres.
+//! Procedural closed meshes for tests, examples and benchmarks: boxes, UV spheres and tori.
 
 use glam::Vec3;
 
@@ -59,6 +59,31 @@ pub fn uv_sphere_buffers(radius: f32, rings: u32, segments: u32) -> (Vec<Vec3>, 
     (v, t)
 }
 
+/// A closed torus around the z axis: tube centre `major` from the axis, tube radius `minor` (< `major`),
+/// `rings` segments around the axis (>= 3) and `sides` around the tube (>= 3), outward-facing. Its
+/// vertices lie on the ideal surface.
+pub fn torus_buffers(major: f32, minor: f32, rings: u32, sides: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let (rings, sides) = (rings.max(3), sides.max(3));
+    let mut v = Vec::with_capacity((rings * sides) as usize);
+    for i in 0..rings {
+        let u = std::f32::consts::TAU * i as f32 / rings as f32;
+        for j in 0..sides {
+            let w = std::f32::consts::TAU * j as f32 / sides as f32;
+            let r = major + minor * w.cos();
+            v.push(Vec3::new(r * u.cos(), r * u.sin(), minor * w.sin()));
+        }
+    }
+    let at = |i: u32, j: u32| (i % rings) * sides + (j % sides);
+    let mut t = Vec::with_capacity((2 * rings * sides) as usize);
+    for i in 0..rings {
+        for j in 0..sides {
+            t.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            t.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    (v, t)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -70,5 +95,14 @@ mod tests {
         let m = TriMesh::new(v, t).expect("closed");
         let ball = 4.0 / 3.0 * std::f32::consts::PI;
         assert!(m.volume() < ball && m.volume() > 0.98 * ball, "{}", m.volume());
+    }
+
+    #[test]
+    fn a_fine_torus_is_closed_outward_and_close_to_its_volume() {
+        let (v, t) = torus_buffers(3.0, 1.0, 96, 48);
+        let m = TriMesh::new(v, t.clone()).expect("closed");
+        assert_eq!(m.triangles(), &t[..], "already outward: nothing flipped");
+        let ideal = 2.0 * std::f32::consts::PI.powi(2) * 3.0;
+        assert!(m.volume() < ideal && m.volume() > 0.99 * ideal, "{} of {ideal}", m.volume());
     }
 }

@@ -31,6 +31,16 @@ pub fn slab() -> Arc<InnerSphereTree> {
     .clone()
 }
 
+/// The same slab packed finer (6,000 spheres): its top face is flatter (smaller surface spheres).
+pub fn fine_slab() -> Arc<InnerSphereTree> {
+    static T: OnceLock<Arc<InnerSphereTree>> = OnceLock::new();
+    T.get_or_init(|| {
+        let (v, t) = box_buffers(glam::Vec3::new(0.05, 0.01, 0.05));
+        build(&TriMesh::new(v, t).expect("box mesh"), 6000)
+    })
+    .clone()
+}
+
 /// The slab with its top face at y = 0, as object `id` with the default material.
 pub fn slab_object(id: u32) -> haptic_rig::ObjectSpec {
     haptic_rig::ObjectSpec {

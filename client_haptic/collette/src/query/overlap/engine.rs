@@ -26,6 +26,7 @@ pub(super) struct Engine<'a, S> {
 impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
     /// `aggregate`: a node lying wholly inside one leaf sphere of the other tree contributes its summed
     /// volume as one contact (exact volume, far fewer pairs) instead of one contact per leaf pair.
+    /// Every volume is weighted by both spheres' weights ([`InnerSphereTree::weights`]).
     pub(super) fn new(
         a: &'a InnerSphereTree,
         b: &'a InnerSphereTree,
@@ -186,12 +187,15 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
 
     #[inline]
     fn leaf_pairs(&mut self, na: &Node, nb: &Node) {
-        for sb in &self.b.spheres[nb.range()] {
+        for ib in nb.range() {
+            let (sb, wb) = (&self.b.spheres[ib], self.b.weights[ib]);
             let cb = self.tp(sb.center);
-            for sa in &self.a.spheres[na.range()] {
-                if let Some(l) = lens(sa.center, sa.radius, cb, sb.radius)
+            for ia in na.range() {
+                let (sa, wa) = (&self.a.spheres[ia], self.a.weights[ia]);
+                if let Some(mut l) = lens(sa.center, sa.radius, cb, sb.radius)
                     && l.volume > 0.0
                 {
+                    l.volume *= wa * wb;
                     self.result.total_volume += l.volume;
                     self.result.leaf_pairs += 1;
                     (self.sink)(&l, sa.center, cb);
@@ -200,27 +204,31 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
         }
     }
 
-    /// If one node lies wholly inside a single leaf sphere of the other tree, adds the node's volume.
+    /// If one node lies wholly inside a single leaf sphere of the other tree, adds the node's volume
+    /// (its mesh share times the sphere's weight).
     ///
     /// Exact: spheres of one tree are disjoint, so spheres inside one of them overlap no other.
     #[inline]
     fn contained(&mut self, na: &Node, nb: &Node, cb: Vec3) -> bool {
         if nb.leaf {
-            for sb in &self.b.spheres[nb.range()] {
+            for ib in nb.range() {
+                let sb = &self.b.spheres[ib];
                 let c = self.tp(sb.center);
                 let d = na.bound.center.distance(c);
                 if d + na.bound.radius <= sb.radius {
-                    let l =
-                        Lens { volume: na.volume, centroid: na.bound.center, depth: sb.radius + na.bound.radius - d };
+                    let volume = na.mesh_share * self.b.weights[ib];
+                    let l = Lens { volume, centroid: na.bound.center, depth: sb.radius + na.bound.radius - d };
                     self.emit_aggregate(&l, na.bound.center, c);
                     return true;
                 }
             }
         } else if na.leaf {
-            for sa in &self.a.spheres[na.range()] {
+            for ia in na.range() {
+                let sa = &self.a.spheres[ia];
                 let d = sa.center.distance(cb);
                 if d + nb.bound.radius <= sa.radius {
-                    let l = Lens { volume: nb.volume, centroid: cb, depth: sa.radius + nb.bound.radius - d };
+                    let volume = nb.mesh_share * self.a.weights[ia];
+                    let l = Lens { volume, centroid: cb, depth: sa.radius + nb.bound.radius - d };
                     self.emit_aggregate(&l, sa.center, cb);
                     return true;
                 }
@@ -237,14 +245,15 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
         }
     }
 
-    /// Estimates a node pair from its bounds' lens scaled by both fill ratios.
+    /// Estimates a node pair from its bounds' lens scaled by both fill ratios and mean weights.
     fn estimate(&mut self, ia: u32, ib: u32) {
         let na = &self.a.nodes[ia as usize];
         let nb = &self.b.nodes[ib as usize];
         let cb = self.tp(nb.bound.center);
         let Some(mut l) = lens(na.bound.center, na.bound.radius, cb, nb.bound.radius) else { return };
         let fill = |n: &Node| (n.volume / sphere_volume(n.bound.radius).max(f32::MIN_POSITIVE)).min(1.0);
-        l.volume = (l.volume * fill(na) * fill(nb)).min(na.volume).min(nb.volume);
+        let weight = |n: &Node| if n.volume > 0.0 { n.mesh_share / n.volume } else { 1.0 };
+        l.volume = (l.volume * fill(na) * fill(nb) * weight(na) * weight(nb)).min(na.mesh_share).min(nb.mesh_share);
         if l.volume <= 0.0 {
             return;
         }

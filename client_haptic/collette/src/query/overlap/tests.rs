@@ -24,14 +24,14 @@ fn unit_box(spheres: usize) -> InnerSphereTree {
     tree_of(v, t, spheres)
 }
 
-/// Brute force over all sphere pairs: the reference for the tree traversal.
+/// Brute force over all sphere pairs (weighted lens volumes): the reference for the tree traversal.
 fn brute_force(a: &InnerSphereTree, pa: &Pose, b: &InnerSphereTree, pb: &Pose) -> f64 {
     let mut sum = 0.0;
-    for sa in a.spheres() {
+    for (sa, wa) in a.spheres().iter().zip(a.weights()) {
         let ca = pa.transform_point(sa.center);
-        for sb in b.spheres() {
+        for (sb, wb) in b.spheres().iter().zip(b.weights()) {
             let cb = pb.transform_point(sb.center);
-            sum += lens_volume(sa.radius, sb.radius, ca.distance(cb)) as f64;
+            sum += lens_volume(sa.radius, sb.radius, ca.distance(cb)) as f64 * (wa * wb) as f64;
         }
     }
     sum
@@ -51,34 +51,40 @@ fn the_tree_traversal_finds_every_overlapping_pair() {
 }
 
 #[test]
-fn two_ball_trees_match_the_analytic_lens_from_below() {
+fn two_ball_trees_match_the_analytic_lens() {
     // Greedy packing of a ball is (nearly) its inscribed ball, so the overlap is the lens of the balls.
-    for (n, tolerance) in [(100, 0.2), (2000, 0.06)] {
+    for (n, tolerance) in [(100, 0.02), (2000, 0.02)] {
         let t = ball(n);
         for d in [0.3f32, 0.7, 1.0] {
             let analytic = lens_volume(1.0, 1.0, d) as f64;
-            let got = volume(&t, &Pose::IDENTITY, &t, &Pose::from_translation(Vec3::X * d)) as f64;
+            let pose = Pose::from_translation(Vec3::X * d);
+            let packed = volume(&t.unweighted(), &Pose::IDENTITY, &t.unweighted(), &pose) as f64;
+            let got = volume(&t, &Pose::IDENTITY, &t, &pose) as f64;
+            assert!(packed <= analytic * 1.0001, "a packing overlap never exceeds the true overlap");
             let error = (analytic - got) / analytic;
-            assert!(got <= analytic * 1.0001, "a packing overlap never exceeds the true overlap");
-            assert!(error < tolerance, "n={n} d={d}: relative error {error}");
+            assert!(error.abs() < tolerance, "n={n} d={d}: relative error {error}");
         }
     }
 }
 
 #[test]
-fn the_overlap_of_two_boxes_converges_to_the_exact_value() {
+fn the_overlap_of_two_boxes_converges_to_the_exact_value_and_the_weights_close_the_gap() {
     // Unit cubes offset by half a side along x and a quarter along y: exact overlap 0.5 * 0.75 = 0.375.
     let exact = 0.375f64;
     let pb = Pose::from_translation(Vec3::new(0.5, 0.25, 0.0));
-    let mut errors = Vec::new();
+    let (mut packed_errors, mut weighted_errors) = (Vec::new(), Vec::new());
     for n in [200, 2000, 8000] {
         let t = unit_box(n);
+        let packed = volume(&t.unweighted(), &Pose::IDENTITY, &t.unweighted(), &pb) as f64;
         let got = volume(&t, &Pose::IDENTITY, &t, &pb) as f64;
-        assert!(got <= exact * 1.0001);
-        errors.push((exact - got) / exact);
+        assert!(packed <= exact * 1.0001, "the packing's own overlap never exceeds the true one");
+        packed_errors.push((exact - packed) / exact);
+        weighted_errors.push(((exact - got) / exact).abs());
     }
-    assert!(errors.windows(2).all(|w| w[1] < w[0]), "errors {errors:?} shrink");
-    assert!(errors[2] < 0.35, "errors {errors:?}");
+    assert!(packed_errors.windows(2).all(|w| w[1] < w[0]), "errors {packed_errors:?} shrink");
+    assert!(packed_errors[2] > 0.15, "the packing alone is well short: {packed_errors:?}");
+    // Measured: 4.3 %, 1.4 %, 0.8 % (the packing alone: 39 %, 26 %, 20 % short).
+    assert!(weighted_errors.iter().all(|&e| e < 0.06) && weighted_errors[2] < 0.02, "{weighted_errors:?}");
 }
 
 #[test]
@@ -179,7 +185,7 @@ mod properties {
             let ba = volume(t, &pb, t, &pa) as f64;
             prop_assert!((ab - reference).abs() <= 1e-3 * reference + 1e-6);
             prop_assert!((ab - ba).abs() <= 1e-3 * ab + 1e-6);
-            prop_assert!(ab <= t.packed_volume() as f64 * 1.001);
+            prop_assert!(ab <= t.mesh_share() as f64 * 1.001);
         }
     }
 }
