@@ -49,6 +49,8 @@ impl ContactReader {
 pub struct CollisionHandle {
     commands: rtrb::Producer<Command>,
     retired: rtrb::Consumer<Retired>,
+    collected: u64,
+    leaked: Arc<AtomicU64>,
     free_objects: Vec<u32>,
     free_watchers: Vec<u32>,
     stop: Arc<AtomicBool>,
@@ -63,18 +65,27 @@ impl CollisionThread {
     /// Spawns the thread, which steps every `config.period` with `config.step_budget` per step.
     pub fn spawn(config: CollisionConfig) -> std::io::Result<CollisionHandle> {
         let (commands, mut incoming) = rtrb::RingBuffer::new(config.command_capacity);
+        // The return ring cannot fill: a command retires at most one item, and every handle method that
+        // sends one that can retire anything first empties the ring; so at most the commands still queued
+        // at that moment (<= command_capacity) plus the one sent after it retire before the next emptying.
         let (mut retire_tx, retired) =
             rtrb::RingBuffer::new(config.command_capacity + config.max_objects + config.max_watchers);
         let stop = Arc::new(AtomicBool::new(false));
         let steps = Arc::new(AtomicU64::new(0));
+        let leaked = Arc::new(AtomicU64::new(0));
         let mut world = CollisionWorld::new(&config);
-        let (stop2, steps2) = (stop.clone(), steps.clone());
+        let (stop2, steps2, leaked2) = (stop.clone(), steps.clone(), leaked.clone());
         let thread = std::thread::Builder::new().name("collette".into()).spawn(move || {
             let mut next = Instant::now();
             while !stop2.load(Ordering::Acquire) {
                 while let Ok(cmd) = incoming.pop() {
-                    // A full return ring means the handle is not draining it: then (only then) free here.
-                    world.apply(cmd, &mut |r| drop(retire_tx.push(r)));
+                    world.apply(cmd, &mut |r| {
+                        // Unreachable (see the ring's size); were it full, leak rather than free here.
+                        if let Err(rtrb::PushError::Full(r)) = retire_tx.push(r) {
+                            leaked2.fetch_add(1, Ordering::Relaxed);
+                            std::mem::forget(r);
+                        }
+                    });
                 }
                 world.step(Some(Instant::now() + config.step_budget));
                 steps2.fetch_add(1, Ordering::Release);
@@ -90,6 +101,8 @@ impl CollisionThread {
         Ok(CollisionHandle {
             commands,
             retired,
+            collected: 0,
+            leaked,
             free_objects: (0..config.max_objects as u32).rev().collect(),
             free_watchers: (0..config.max_watchers as u32).rev().collect(),
             stop,
@@ -160,7 +173,19 @@ impl CollisionHandle {
     pub fn collect_retired(&mut self) {
         while let Ok(r) = self.retired.pop() {
             drop(r);
+            self.collected += 1;
         }
+    }
+
+    /// Removed or replaced objects and watchers handed back by the thread and freed here so far.
+    pub fn collected(&self) -> u64 {
+        self.collected
+    }
+
+    /// Items the thread could not hand back because the return ring was full (leaked, not freed on the
+    /// thread). Always 0: the ring is sized so that it cannot fill.
+    pub fn leaked(&self) -> u64 {
+        self.leaked.load(Ordering::Relaxed)
     }
 }
 
@@ -190,6 +215,49 @@ mod tests {
             std::thread::sleep(Duration::from_millis(1));
         }
         false
+    }
+
+    #[test]
+    fn everything_removed_comes_back_to_the_handle_even_with_the_command_ring_kept_full() {
+        let (v, t) = box_buffers(Vec3::splat(0.5));
+        let tree = Arc::new(
+            build(&TriMesh::new(v, t).expect("valid"), &BuildOptions::spheres(20), &mut |_| {}).expect("builds").0,
+        );
+        let config = CollisionConfig { command_capacity: 8, max_objects: 4, max_watchers: 2, ..Default::default() };
+        let mut handle = CollisionThread::spawn(config).expect("spawns");
+        let anchor = handle.add_object(tree.clone(), Pose::IDENTITY).expect("slot");
+        let (mut sent, mut removals) = (0u64, 0u64);
+        let start = Instant::now();
+        // Add and remove objects and watchers as fast as the command ring takes them, with the region
+        // commands (which never wait for the return ring to be emptied) in between.
+        while sent < 3000 && start.elapsed() < Duration::from_secs(20) {
+            let Some(object) = handle.add_object(tree.clone(), Pose::from_translation(Vec3::X * 0.5)) else {
+                std::thread::yield_now();
+                continue;
+            };
+            let watcher = handle.add_watcher(anchor.id(), object.id());
+            let _ = handle.set_region(None);
+            if let Some(w) = watcher {
+                while !handle.remove_watcher(w.id()) {
+                    std::thread::yield_now();
+                }
+                removals += 1;
+            }
+            while !handle.remove_object(object.id()) {
+                std::thread::yield_now();
+            }
+            removals += 1;
+            sent += 1;
+        }
+        assert_eq!(sent, 3000, "the thread kept up");
+        let until = Instant::now() + Duration::from_secs(10);
+        while handle.collected() < removals && Instant::now() < until {
+            std::thread::sleep(Duration::from_millis(1));
+            handle.collect_retired();
+        }
+        assert_eq!(handle.leaked(), 0, "the return ring never filled");
+        assert_eq!(handle.collected(), removals, "every removed object and watcher was freed by the handle");
+        assert_eq!(Arc::strong_count(&tree), 2, "only the test's and the anchor's copies are left");
     }
 
     #[test]
