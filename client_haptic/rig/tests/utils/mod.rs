@@ -21,24 +21,22 @@ pub fn ball_tool() -> Arc<InnerSphereTree> {
     .clone()
 }
 
+/// A 10 x 2 x 10 cm box packed with `spheres`, its top face at y = 0.01.
+fn slab_of(spheres: usize) -> Arc<InnerSphereTree> {
+    let (v, t) = box_buffers(glam::Vec3::new(0.05, 0.01, 0.05));
+    build(&TriMesh::new(v, t).expect("box mesh"), spheres)
+}
+
 /// A 10 x 2 x 10 cm slab whose top face is at y = 0 (place it with a pose of y = -0.01).
 pub fn slab() -> Arc<InnerSphereTree> {
     static T: OnceLock<Arc<InnerSphereTree>> = OnceLock::new();
-    T.get_or_init(|| {
-        let (v, t) = box_buffers(glam::Vec3::new(0.05, 0.01, 0.05));
-        build(&TriMesh::new(v, t).expect("box mesh"), 1500)
-    })
-    .clone()
+    T.get_or_init(|| slab_of(1500)).clone()
 }
 
 /// The same slab packed finer (6,000 spheres): its top face is flatter (smaller surface spheres).
 pub fn fine_slab() -> Arc<InnerSphereTree> {
     static T: OnceLock<Arc<InnerSphereTree>> = OnceLock::new();
-    T.get_or_init(|| {
-        let (v, t) = box_buffers(glam::Vec3::new(0.05, 0.01, 0.05));
-        build(&TriMesh::new(v, t).expect("box mesh"), 6000)
-    })
-    .clone()
+    T.get_or_init(|| slab_of(6000)).clone()
 }
 
 /// The slab with its top face at y = 0, as object `id` with the default material.
