@@ -55,8 +55,11 @@ fn agones_hears_ready_health_the_sessions_counter_players_list_a_stall_and_shutd
     let services = FleetServices::start(&server, &FleetOptions { metrics: None, agones: Some(agones) }).unwrap();
     let long = Duration::from_secs(30);
 
-    // Ready once the sockets are bound, the address and version told, capacities set from --max-sessions.
-    assert!(run_until(&mut server, &mut [], &fake, long, |r| r.ready == 1 && r.lists[PLAYERS_LIST].0 == 8));
+    // Ready once the sockets are bound, the address and version told, capacities set from --max-sessions;
+    // the watch stream is opened by its own task, so it is waited for too (it may come after the rest).
+    assert!(run_until(&mut server, &mut [], &fake, long, |r| {
+        r.ready == 1 && r.lists[PLAYERS_LIST].0 == 8 && r.calls.iter().any(|c| c == "WatchGameServer")
+    }));
     let r = fake.recorded();
     assert_eq!(r.state, "Ready");
     assert_eq!(r.annotations.get("phantom-heist.address"), Some(&server.advertised.to_string()));
