@@ -16,6 +16,7 @@
 //! the share of the mesh it stands for).
 
 use clap::Parser;
+use collette::packing::to_parry_oriented;
 use collette::scene::{brilliant_cut, default_bunny_path, load_bunny};
 use collette::shape::{box_buffers, torus_buffers, uv_sphere_buffers};
 use collette::{BuildOptions, InnerSphereTree, Pose, QueryWorkspace, TriMesh, build, overlap_volume};
@@ -75,13 +76,7 @@ struct Solid {
 
 impl Solid {
     fn new(mesh: &TriMesh) -> Self {
-        let v = mesh.vertices().iter().map(|p| parry3d::math::Vector::new(p.x, p.y, p.z)).collect();
-        let parry = parry3d::shape::TriMesh::with_flags(
-            v,
-            mesh.triangles().to_vec(),
-            parry3d::shape::TriMeshFlags::ORIENTED | parry3d::shape::TriMeshFlags::MERGE_DUPLICATE_VERTICES,
-        )
-        .expect("a validated mesh");
+        let parry = to_parry_oriented(mesh);
         let aabb = mesh.aabb();
         let h = aabb.extents().max_element() / 96.0;
         let origin = aabb.min - Vec3::splat(h);

@@ -88,11 +88,7 @@ impl InnerSphereTree {
             return Err(IstFileError::Invalid(format!("header size {} (expected {HEADER_SIZE})", u(12))));
         }
         let (spheres, nodes) = (u(16) as usize, u(20) as usize);
-        let expected = (spheres as u64)
-            .checked_mul(sphere_size as u64)
-            .zip((nodes as u64).checked_mul(node_size as u64))
-            .map_or(u64::MAX, |(s, n)| HEADER_SIZE as u64 + s + n + 4);
-        let expected = usize::try_from(expected).unwrap_or(usize::MAX);
+        let expected = HEADER_SIZE + sphere_size * spheres + node_size * nodes + 4;
         if bytes.len() < expected {
             return Err(IstFileError::Truncated { expected, found: bytes.len() });
         }

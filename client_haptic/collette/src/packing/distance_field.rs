@@ -150,6 +150,14 @@ pub fn to_parry(mesh: &TriMesh) -> parry3d::shape::TriMesh {
         .unwrap_or_else(|_| unreachable!("validated mesh is non-empty"))
 }
 
+/// The mesh as a parry triangle mesh with pseudo-normals (`TriMeshFlags::ORIENTED`), so that parry's
+/// point containment and projection tell inside from outside exactly.
+pub fn to_parry_oriented(mesh: &TriMesh) -> parry3d::shape::TriMesh {
+    let v = mesh.vertices().iter().map(|p| parry3d::math::Vector::new(p.x, p.y, p.z)).collect();
+    parry3d::shape::TriMesh::with_flags(v, mesh.triangles().to_vec(), parry3d::shape::TriMeshFlags::ORIENTED)
+        .unwrap_or_else(|_| unreachable!("validated mesh is non-empty"))
+}
+
 #[inline]
 fn surface_distance(mesh: &parry3d::shape::TriMesh, p: Vec3) -> f32 {
     use parry3d::query::PointQuery;

@@ -9,7 +9,7 @@ mod greedy;
 mod refine;
 mod weights;
 
-pub use distance_field::{DistanceField, to_parry};
+pub use distance_field::{DistanceField, to_parry, to_parry_oriented};
 
 use crate::error::BuildError;
 use crate::partitioning::InnerSphereTree;

@@ -22,10 +22,7 @@ pub(crate) struct Refiner {
 impl Refiner {
     /// A refiner for `mesh` whose first search step is `step` (half a voxel).
     pub(crate) fn new(mesh: &TriMesh, step: f32) -> Self {
-        let v = mesh.vertices().iter().map(|p| parry3d::math::Vector::new(p.x, p.y, p.z)).collect();
-        let mesh =
-            parry3d::shape::TriMesh::with_flags(v, mesh.triangles().to_vec(), parry3d::shape::TriMeshFlags::ORIENTED)
-                .unwrap_or_else(|_| unreachable!("validated mesh is non-empty"));
+        let mesh = super::to_parry_oriented(mesh);
         Self { mesh, cell: step * 8.0, cells: HashMap::new(), spheres: Vec::new(), step }
     }
 

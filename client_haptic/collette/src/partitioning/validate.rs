@@ -61,10 +61,10 @@ impl InnerSphereTree {
                     sum += sp.volume() as f64;
                     share += sp.volume() as f64 * self.weights[s] as f64;
                 }
-                if (sum as f32 - node.volume).abs() > 1e-3 * node.volume.max(1e-30) + 1e-30 {
+                if !adds_up(node.volume, sum) {
                     return Err(format!("leaf {n} volume {} differs from its spheres' {sum}", node.volume));
                 }
-                if (share as f32 - node.mesh_share).abs() > 1e-3 * node.mesh_share.max(1e-30) + 1e-30 {
+                if !adds_up(node.mesh_share, share) {
                     return Err(format!("leaf {n} mesh share {} differs from its spheres' {share}", node.mesh_share));
                 }
             } else {
@@ -72,11 +72,11 @@ impl InnerSphereTree {
                     return Err(format!("inner node {n} has a bad child range (1 to 4 children after it)"));
                 }
                 let sum: f64 = node.range().map(|c| self.nodes[c].volume as f64).sum();
-                if (sum as f32 - node.volume).abs() > 1e-3 * node.volume.max(1e-30) + 1e-30 {
+                if !adds_up(node.volume, sum) {
                     return Err(format!("node {n} volume {} differs from its children's {sum}", node.volume));
                 }
                 let share: f64 = node.range().map(|c| self.nodes[c].mesh_share as f64).sum();
-                if (share as f32 - node.mesh_share).abs() > 1e-3 * node.mesh_share.max(1e-30) + 1e-30 {
+                if !adds_up(node.mesh_share, share) {
                     return Err(format!("node {n} mesh share {} differs from its children's {share}", node.mesh_share));
                 }
                 for c in node.range() {
@@ -89,4 +89,9 @@ impl InnerSphereTree {
         }
         Ok(())
     }
+}
+
+/// True when a stored sum matches the recomputed one within 0.1 % (f32 rounding of many terms).
+fn adds_up(stored: f32, sum: f64) -> bool {
+    (sum as f32 - stored).abs() <= 1e-3 * stored.max(1e-30) + 1e-30
 }
