@@ -11,6 +11,8 @@ use heist_shared::protocol::Role;
 mod common;
 mod listen;
 use common::{headless_with_cache, hear, host_with_a_vive_bot, wait};
+#[path = "../../haptico/tests/support/haply_service.rs"]
+mod haply_service;
 
 /// A fresh directory for one test's seat cache and settings.
 fn home(name: &str) -> std::path::PathBuf {
@@ -233,6 +235,47 @@ fn every_failure_before_the_session_is_spoken_with_what_to_do_next() {
     assert!(said.iter().any(|l| l.starts_with("Could not host the heist:") && l.contains("--bind")), "{said:#?}");
     stop.store(true, std::sync::atomic::Ordering::Relaxed);
     let _ = host.join();
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// The Inverse3 through a local stand-in for the Haply Inverse Service (no hardware): the practice
+/// drives it, and when the service goes away mid-practice the player hears it once, no force goes out
+/// after, and the client goes on until the player quits.
+#[test]
+fn a_haply_service_that_goes_away_mid_practice_is_said_once_and_the_client_quits_cleanly() {
+    use haply_service::{FakeService, Script};
+    let dir = home("haply");
+    let service = FakeService::start(Script { inverse3: true, close_after: None, wander: false });
+    let device = format!("haply:{}", service.url());
+    let args = ["practice", "--kind", "crown", "--seed", "3", "--device", &device];
+    let (mut child, mut stdin, rx) = headless_with_cache(&args, &dir);
+    let mut said = Vec::new();
+    assert!(hear(&rx, &mut said, "You can feel it now.", Duration::from_secs(120)), "{said:#?}");
+    // The haptic loop commands the device through the service: hundreds of forces a second.
+    let start = Instant::now();
+    while service.seen.lock().expect("seen").commands < 500 {
+        assert!(start.elapsed() < Duration::from_secs(10), "forces reach the service: {said:#?}");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let seen = service.seen.clone();
+    drop(service); // the service stops: every connection closes
+    let sent = seen.lock().expect("seen").commands;
+    let lost = "The Haply service went away: no force reaches the Inverse3.";
+    assert!(hear(&rx, &mut said, lost, Duration::from_secs(10)), "said within 10 s: {said:#?}");
+    // Still running, and listening: the player quits.
+    std::thread::sleep(Duration::from_millis(500));
+    assert!(child.try_wait().expect("polls").is_none(), "the client goes on without its device: {said:#?}");
+    writeln!(stdin, "q").expect("types");
+    let status = wait(&mut child, Duration::from_secs(60)).expect("ends when told");
+    said.extend(rx.try_iter());
+    let mut err = String::new();
+    if let Some(mut e) = child.stderr.take() {
+        let _ = std::io::Read::read_to_string(&mut e, &mut err);
+    }
+    assert!(status.success(), "exited with {status}: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(said.iter().filter(|l| l.starts_with(lost)).count(), 1, "said once: {said:#?}");
+    assert_eq!(seen.lock().expect("seen").commands, sent, "no force is read after the service went away");
     let _ = std::fs::remove_dir_all(dir);
 }
 
