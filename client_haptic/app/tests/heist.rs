@@ -103,6 +103,16 @@ fn the_server_a_vive_bot_and_the_touch_bot_win_a_heist_over_loopback_udp() {
     );
     assert!(state.verdicts.iter().any(|v| v.findings.is_some()), "verdicts come from touch");
     assert!(!felt.is_empty(), "the haptic loop ran while copies were felt");
+    // Both loops kept their 1 kHz while copies were felt: the median one-second window within 10 % (a
+    // window or two may be short on this shared machine; a loop that slowed down or stopped is not).
+    let median = |f: fn(&&client_haptic::haptics::RateWindow) -> u32| {
+        let mut hz: Vec<u32> = felt.iter().map(f).collect();
+        hz.sort_unstable();
+        hz[hz.len() / 2]
+    };
+    let (haptic, collision) = (median(|w| w.haptic_hz), median(|w| w.collision_hz));
+    assert!((900..=1100).contains(&haptic), "haptic loop median {haptic} Hz over {} windows", felt.len());
+    assert!((900..=1100).contains(&collision), "collision loop median {collision} Hz over {} windows", felt.len());
     drop(phantom);
     let bytes = std::fs::read(&wav).expect("the session's audio was written");
     let loud = bytes[44..].chunks_exact(2).filter(|s| i16::from_le_bytes([s[0], s[1]]).unsigned_abs() > 1000).count();
