@@ -487,11 +487,14 @@ fn get_a_seat(
     }
 }
 
-/// Runs `practice`.
+/// Runs `practice`: looks for a real device first, as `join` and `host` do, then feels copies on the bench.
 pub fn practice(args: &PracticeArgs) -> anyhow::Result<()> {
-    let settings = args.client.settings().map_err(anyhow::Error::msg)?;
+    let mut settings = args.client.settings().map_err(anyhow::Error::msg)?;
+    let mut prompter = crate::prompt::Prompter::new(&mut settings)?;
+    check_device(&mut prompter, &settings)?;
     let kind = args.kind.into();
-    let mut app = app(settings, args.client.headless, Some(crate::practice::Practice::new(kind, args.seed)), None)?;
+    let practice = Some(crate::practice::Practice::new(kind, args.seed));
+    let mut app = app(settings, args.client.headless, practice, Some(prompter.into_parts()))?;
     args.client.request_shot(&mut app);
     app.run();
     Ok(())

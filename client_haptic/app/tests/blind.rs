@@ -221,6 +221,11 @@ fn every_failure_before_the_session_is_spoken_with_what_to_do_next() {
     assert!(!status.success());
     assert!(said.iter().any(|l| l.starts_with("The haptic device is not ready: no Novint Falcon")), "{said:#?}");
     assert_eq!(err.lines().count(), 1, "one line on stderr: {err}");
+    // Practising with it is looked for the same way.
+    let (status, said, err) = run(&["practice", "--kind", "crown", "--device", "falcon"]);
+    assert!(!status.success());
+    assert!(said.iter().any(|l| l.starts_with("The haptic device is not ready: no Novint Falcon")), "{said:#?}");
+    assert_eq!(err.lines().count(), 1, "one line on stderr: {err}");
 
     // A wrong code, given on the command line: said, and the program ends (nothing to ask again).
     let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
@@ -250,6 +255,9 @@ fn a_haply_service_that_goes_away_mid_practice_is_said_once_and_the_client_quits
     let args = ["practice", "--kind", "crown", "--seed", "3", "--device", &device];
     let (mut child, mut stdin, rx) = headless_with_cache(&args, &dir);
     let mut said = Vec::new();
+    // The device is looked for and the player told what to do before the practice starts.
+    let found = "Found the Haply Inverse3. Hold its grip still where you want to play";
+    assert!(hear(&rx, &mut said, found, Duration::from_secs(10)), "{said:#?}");
     assert!(hear(&rx, &mut said, "You can feel it now.", Duration::from_secs(120)), "{said:#?}");
     // The haptic loop commands the device through the service: hundreds of forces a second.
     let start = Instant::now();
