@@ -145,16 +145,19 @@ fn row_crossing(a: Vec3, b: Vec3, c: Vec3, y: f32, z: f32) -> Option<(f32, i32)>
 
 /// The mesh as a parry triangle mesh (for exact point distances and the parry comparison benchmark).
 pub fn to_parry(mesh: &TriMesh) -> parry3d::shape::TriMesh {
-    let v = mesh.vertices().iter().map(|p| parry3d::math::Vector::new(p.x, p.y, p.z)).collect();
-    parry3d::shape::TriMesh::new(v, mesh.triangles().to_vec())
-        .unwrap_or_else(|_| unreachable!("validated mesh is non-empty"))
+    parry_with(mesh, parry3d::shape::TriMeshFlags::empty())
 }
 
 /// The mesh as a parry triangle mesh with pseudo-normals (`TriMeshFlags::ORIENTED`), so that parry's
 /// point containment and projection tell inside from outside exactly.
 pub fn to_parry_oriented(mesh: &TriMesh) -> parry3d::shape::TriMesh {
+    parry_with(mesh, parry3d::shape::TriMeshFlags::ORIENTED)
+}
+
+/// The mesh as a parry triangle mesh built with `flags` (parry's `TriMesh::new` is `flags` empty).
+fn parry_with(mesh: &TriMesh, flags: parry3d::shape::TriMeshFlags) -> parry3d::shape::TriMesh {
     let v = mesh.vertices().iter().map(|p| parry3d::math::Vector::new(p.x, p.y, p.z)).collect();
-    parry3d::shape::TriMesh::with_flags(v, mesh.triangles().to_vec(), parry3d::shape::TriMeshFlags::ORIENTED)
+    parry3d::shape::TriMesh::with_flags(v, mesh.triangles().to_vec(), flags)
         .unwrap_or_else(|_| unreachable!("validated mesh is non-empty"))
 }
 
