@@ -14,6 +14,15 @@ use common::{headless_with_cache, hear, host_with_a_vive_bot, wait};
 #[path = "../../haptico/tests/support/haply_service.rs"]
 mod haply_service;
 
+/// Everything a finished client wrote on stderr.
+fn stderr_of(child: &mut std::process::Child) -> String {
+    let mut err = String::new();
+    if let Some(mut e) = child.stderr.take() {
+        let _ = std::io::Read::read_to_string(&mut e, &mut err);
+    }
+    err
+}
+
 /// A fresh directory for one test's seat cache and settings.
 fn home(name: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("phantom-blind-{}-{name}", std::process::id()));
@@ -182,10 +191,7 @@ fn every_failure_before_the_session_is_spoken_with_what_to_do_next() {
     let run = |args: &[&str]| {
         let (mut child, _stdin, rx) = headless_with_cache(args, &dir);
         let status = wait(&mut child, Duration::from_secs(60)).expect("ends by itself");
-        let mut err = String::new();
-        if let Some(mut e) = child.stderr.take() {
-            let _ = std::io::Read::read_to_string(&mut e, &mut err);
-        }
+        let err = stderr_of(&mut child);
         (status, rx.try_iter().collect::<Vec<String>>(), err)
     };
     // Nobody at the address.
@@ -212,10 +218,7 @@ fn every_failure_before_the_session_is_spoken_with_what_to_do_next() {
     said.extend(rx.try_iter());
     assert!(!status.success());
     assert!(!said.iter().any(|l| l.starts_with("Nobody answers")), "the device comes first: {said:#?}");
-    let mut err = String::new();
-    if let Some(mut e) = child.stderr.take() {
-        let _ = std::io::Read::read_to_string(&mut e, &mut err);
-    }
+    let err = stderr_of(&mut child);
     assert_eq!(err.lines().count(), 1, "one line on stderr: {err}");
     let (status, said, err) = run(&["join", "127.0.0.1:1", "--code", "ABCD-EFGH-JKLM", "--device", "falcon"]);
     assert!(!status.success());
@@ -276,10 +279,7 @@ fn a_haply_service_that_goes_away_mid_practice_is_said_once_and_the_client_quits
     writeln!(stdin, "q").expect("types");
     let status = wait(&mut child, Duration::from_secs(60)).expect("ends when told");
     said.extend(rx.try_iter());
-    let mut err = String::new();
-    if let Some(mut e) = child.stderr.take() {
-        let _ = std::io::Read::read_to_string(&mut e, &mut err);
-    }
+    let err = stderr_of(&mut child);
     assert!(status.success(), "exited with {status}: {err}");
     assert!(!err.contains("panicked"), "{err}");
     assert_eq!(said.iter().filter(|l| l.starts_with(lost)).count(), 1, "said once: {said:#?}");
