@@ -1,7 +1,7 @@
 //! Steady-state queries and collision steps allocate nothing (the allocator aborts if they do).
 
 use assert_no_alloc::{AllocDisabler, assert_no_alloc};
-use collette::pipeline::{CollisionConfig, CollisionWorld, Command, ObjectId, TimedPose, WatcherId};
+use collette::pipeline::{CollisionConfig, CollisionWorld, Command, ObjectId, TimedPose, WatcherId, WatcherOutput};
 use collette::shape::box_buffers;
 use collette::{
     Budget, BuildOptions, ContactSet, Pose, QueryWorkspace, TriMesh, build, overlap, overlap_budgeted, overlap_volume,
@@ -41,10 +41,11 @@ fn queries_and_collision_steps_do_not_allocate_once_warmed_up() {
     let mut retired = Vec::new();
     world.apply(Command::AddObject(ObjectId(0), shared.clone(), tool_out), &mut |r| retired.push(r));
     world.apply(Command::AddObject(ObjectId(1), shared, target_out), &mut |r| retired.push(r));
-    world.apply(Command::AddWatcher(WatcherId(0), ObjectId(0), ObjectId(1), Box::new(contacts_in)), &mut |r| {
-        retired.push(r)
-    });
-    tool_in.write(TimedPose { pose: pb, timestamp_us: 5 });
+    world.apply(
+        Command::AddWatcher(WatcherId(0), ObjectId(0), ObjectId(1), WatcherOutput::Contacts(Box::new(contacts_in))),
+        &mut |r| retired.push(r),
+    );
+    tool_in.write(TimedPose { pose: pb, timestamp_us: 5, reach: 0.0 });
     world.step(None);
     assert_no_alloc(|| {
         world.step(None);

@@ -127,32 +127,6 @@ pub fn windows(
     out
 }
 
-/// Collision steps as seen from the haptic thread: one step per increase of the contact sets' sequence
-/// number, placed at the tick that first saw it (for collision threads that record no timings).
-pub fn steps_from_sequences(forces: &[ForceSample]) -> Vec<StepTiming> {
-    let mut out = Vec::with_capacity(forces.len());
-    let mut last_seq = 0u64;
-    let mut last_start: Option<u64> = None;
-    for s in forces {
-        if s.collision_sequence > last_seq {
-            let n = if last_seq == 0 { 1 } else { s.collision_sequence - last_seq };
-            for _ in 0..n {
-                let period_us = last_start.map_or(0, |l| s.t_us.saturating_sub(l)) as u32;
-                out.push(StepTiming {
-                    sequence: s.collision_sequence,
-                    start_us: s.t_us,
-                    period_us,
-                    contacts: s.contacts,
-                    ..Default::default()
-                });
-                last_start = Some(s.t_us);
-            }
-            last_seq = s.collision_sequence;
-        }
-    }
-    out
-}
-
 /// Attributes hypervisor steal to windows: `samples` are (haptic-clock µs, cumulative steal ms) taken
 /// every few tens of ms; a window gets the steal between the last sample before it and the first after it.
 pub fn add_steal(
@@ -362,18 +336,6 @@ mod tests {
         assert!((w[0].force_mean_n - 1.0).abs() < 1e-6 && w[1].force_max_n == 2.0);
         let s = summary(&w, &h, &[], &f, 1000);
         assert_eq!(s.max_force_step_n, 1.0);
-    }
-
-    #[test]
-    fn sequence_increases_count_as_collision_steps() {
-        let f: Vec<ForceSample> = [0u64, 1, 1, 3, 3, 4]
-            .iter()
-            .enumerate()
-            .map(|(i, &q)| ForceSample { t_us: i as u64 * 1000, collision_sequence: q, ..Default::default() })
-            .collect();
-        let steps = steps_from_sequences(&f);
-        assert_eq!(steps.len(), 4);
-        assert_eq!(steps.iter().map(|s| s.start_us).collect::<Vec<_>>(), vec![1000, 3000, 3000, 5000]);
     }
 
     #[test]

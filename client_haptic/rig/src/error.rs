@@ -15,9 +15,6 @@ pub enum RigError {
     /// No room for another object.
     #[error("at most {0} objects can be watched at once")]
     TooManyObjects(usize),
-    /// The operation is not available in this configuration.
-    #[error("not supported {0}")]
-    Unsupported(&'static str),
     /// The operating system refused to start the collision thread.
     #[error("cannot start the collision thread: {0}")]
     Spawn(std::io::Error),

@@ -1,18 +1,20 @@
-//! The force stage bound to the haptic thread's ForceOnHapticTick: contacts → volumetric penalty →
-//! virtual coupling → safety layer → device, then the tool pose goes back to the collision thread.
+//! The force stage bound to the haptic thread's ForceOnHapticTick: each watched object's contacts from
+//! collette's pipeline → volumetric penalty → virtual coupling (or the spheres near the tip → 3-DOF
+//! god-object) → safety layer → device, then the tool pose goes back to the pipeline.
 //!
-//! You need this module to assemble the loop yourself (the rig binds it for you). Everything it touches
-//! per tick is preallocated: the triple buffers' frames, the force-sample ring, the coupling and safety
-//! state.
+//! You need this module to see what the haptic thread does each tick (the rig binds it for you).
+//! Everything it touches per tick is preallocated: the watchers' triple buffers, the objects' slots and
+//! the sphere buffer, the rings of changes, the force-sample ring, the coupling and safety state.
 
+use collette::pipeline::{ContactReader, NearReader, PoseWriter};
 use forcecomp::{
-    BodyMotion, GodObject, ProxyConfig, SafetyLayer, SafetyPhase, SafetyStats, VirtualCoupling, volumetric_penalty,
+    Ball, BodyMotion, GodObject, Material, ProxyConfig, SafetyLayer, SafetyPhase, SafetyStats, VirtualCoupling,
+    volumetric_penalty,
 };
 use glam::Vec3;
 use haptic_common::{DeviceState, ForceOnHapticTick, ForceTorque, Pose};
 
 use crate::WorkspaceMap;
-use crate::frame::{CollisionFrame, ToolPoseMsg};
 
 /// One tick's forces, recorded for plots (preallocated ring; lost when full).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -45,11 +47,12 @@ pub struct RigTelemetry {
     pub tool_pose: Pose,
     /// Force and torque sent to the device on the last tick.
     pub output: ForceTorque,
-    /// Contacts in the frame used.
+    /// Contacts (or spheres near the tip) used.
     pub contacts: u32,
-    /// Sequence of the collision frame used.
+    /// Newest collision step whose results were used (0: none yet, or nothing watched).
     pub collision_sequence: u64,
-    /// Age of that frame's data, µs.
+    /// Age of the oldest tool pose those results rest on, µs (`u64::MAX` while a watcher has published
+    /// nothing; 0 with nothing watched).
     pub data_age_us: u64,
     /// Safety phase.
     pub safety_phase: SafetyPhase,
@@ -112,22 +115,25 @@ impl Default for ProxyRendering {
     }
 }
 
-/// Where the force stage gets contacts from and sends the tool pose to.
-pub(crate) enum Source {
-    /// The rig's own collision thread ([`crate::collision`]).
-    Rig { frames: triple_buffer::Output<CollisionFrame>, poses: triple_buffer::Input<ToolPoseMsg> },
-    /// collette's collision pipeline thread.
-    Collette(Box<ColletteSource>),
+/// A watched object as the haptic thread sees it: the reader of its watcher, its material and motion.
+pub(crate) struct WatchedObject {
+    pub(crate) id: u32,
+    pub(crate) reader: ObjectReader,
+    pub(crate) material: Material,
+    pub(crate) motion: BodyMotion,
 }
 
-/// The haptic thread's end of collette's pipeline: the tool's pose writer and one reader per object.
-pub(crate) struct ColletteSource {
-    pub(crate) tool: collette::pipeline::PoseWriter,
-    pub(crate) tool_center_of_mass: Vec3,
-    pub(crate) tool_material: forcecomp::Material,
-    pub(crate) objects: Vec<(collette::pipeline::ContactReader, forcecomp::Material, BodyMotion)>,
-    pub(crate) last_sequence: u64,
-    pub(crate) last_change_us: u64,
+/// The reader of an object's watcher: overlaps (volumetric) or spheres near the tip (proxy).
+pub(crate) enum ObjectReader {
+    Contacts(ContactReader),
+    Near(NearReader),
+}
+
+/// Changes the game thread sends the force stage (boxed there; the replaced boxes come back).
+pub(crate) enum ForceCommand {
+    Add(Box<WatchedObject>),
+    Remove(u32),
+    SetTool { center_of_mass: Vec3, material: Material },
 }
 
 /// The force stage's state (lives on the haptic thread).
@@ -140,7 +146,19 @@ pub struct ForceStage {
     pub(crate) proxy: ProxyRendering,
     /// The device's stiffness limit, N/m (the proxy's spring never exceeds it).
     pub(crate) max_stiffness_n_per_m: f32,
-    pub(crate) source: Source,
+    /// Writes the tool's pose (and the proxy's reach) to the collision thread.
+    pub(crate) tool: PoseWriter,
+    pub(crate) tool_center_of_mass: Vec3,
+    pub(crate) tool_material: Material,
+    // Boxed so that objects move in and out through the rings whole: unboxing here would free the box
+    // on this thread.
+    #[allow(clippy::vec_box)]
+    pub(crate) objects: Vec<Box<WatchedObject>>,
+    pub(crate) commands: rtrb::Consumer<ForceCommand>,
+    pub(crate) garbage: rtrb::Producer<Box<WatchedObject>>,
+    /// Proxy rendering: every object's spheres near the tip this tick, with the object's index.
+    pub(crate) balls: Vec<Ball>,
+    pub(crate) ball_objects: Vec<u8>,
     pub(crate) telemetry: triple_buffer::Input<RigTelemetry>,
     pub(crate) samples: rtrb::Producer<ForceSample>,
 }
@@ -149,6 +167,7 @@ impl ForceStage {
     /// One tick: adds the safe contact force to whatever earlier delegates added, then replaces the
     /// tick's total with the safety layer's output. Allocation-free.
     pub fn on_tick(&mut self, tick: &ForceOnHapticTick) {
+        self.apply_commands();
         if self.rendering == Rendering::Proxy {
             return self.on_proxy_tick(tick);
         }
@@ -164,16 +183,7 @@ impl ForceStage {
             Rendering::Direct | Rendering::Proxy => (device.linear_velocity, device.angular_velocity),
         };
         let tool_scene = self.map.to_scene(&tool_device);
-        let (tool_com_local, tool_material) = match &mut self.source {
-            Source::Rig { frames, .. } => {
-                // Take the newest frame once per tick; both uses below see the same one.
-                frames.update();
-                let f = frames.output_buffer();
-                (f.tool_center_of_mass, f.tool_material)
-            }
-            Source::Collette(c) => (c.tool_center_of_mass, c.tool_material),
-        };
-        let com = tool_scene.transform_point(tool_com_local);
+        let com = tool_scene.transform_point(self.tool_center_of_mass);
         let tool_motion = BodyMotion {
             center_of_mass: com,
             orientation: tool_scene.rotation,
@@ -181,38 +191,17 @@ impl ForceStage {
             angular_velocity: self.map.angular_velocity_to_scene(w),
         };
         let mut contact = ForceTorque::ZERO;
-        let mut contacts = 0u32;
-        let mut add = |set: &haptic_common::ContactSet, material: &forcecomp::Material, motion: &BodyMotion| {
-            let ft = volumetric_penalty(set, &tool_motion, motion, &tool_material.combine(material));
+        let mut freshness = Freshness::new(self.objects.len());
+        for object in self.objects.iter_mut() {
+            let ObjectReader::Contacts(reader) = &mut object.reader else { continue };
+            let set = reader.latest();
+            freshness.saw(set.sequence, set.timestamp_us, set.len());
+            let ft =
+                volumetric_penalty(set, &tool_motion, &object.motion, &self.tool_material.combine(&object.material));
             contact.force += ft.force;
             contact.torque += ft.torque;
-            contacts += set.len() as u32;
-        };
-        // (sequence of the data used, age of that data in µs; u64::MAX when there is none yet)
-        let (sequence, age_us) = match &mut self.source {
-            Source::Rig { frames, .. } => {
-                let frame = frames.output_buffer();
-                for object in frame.touched() {
-                    add(&object.contacts, &object.material, &object.motion);
-                }
-                (frame.sequence, frame.age_us(device.timestamp_us))
-            }
-            Source::Collette(c) => {
-                let mut sequence = 0;
-                for (reader, material, motion) in &mut c.objects {
-                    let set = reader.latest();
-                    sequence = sequence.max(set.sequence);
-                    add(set, material, motion);
-                }
-                // Freshness from arrival: static objects' poses carry old timestamps in collette's sets.
-                if sequence != c.last_sequence {
-                    c.last_sequence = sequence;
-                    c.last_change_us = device.timestamp_us;
-                }
-                let age = if sequence == 0 { u64::MAX } else { device.timestamp_us.saturating_sub(c.last_change_us) };
-                (sequence, age)
-            }
-        };
+        }
+        let used = freshness.used(device.timestamp_us);
         // Torque about the tool frame's origin (where the coupling acts) instead of the centre of mass.
         contact.torque += (com - tool_scene.translation).cross(contact.force);
         let contact_device = self.map.wrench_to_device(contact);
@@ -222,7 +211,6 @@ impl ForceStage {
             Rendering::Coupled => self.coupling.step(&device, contact_device, dt),
             Rendering::Direct | Rendering::Proxy => contact_device,
         };
-        let used = Used { contacts, sequence, age_us };
         let before = tick.total();
         let requested = ForceTorque { force: before.force + wanted.force, torque: before.torque + wanted.torque };
         let out = self.safety.apply(requested, dt, used.age_s());
@@ -232,40 +220,71 @@ impl ForceStage {
             Rendering::Coupled => self.map.to_scene(&self.coupling.tool_pose()),
             Rendering::Direct | Rendering::Proxy => self.map.to_scene(&device.pose),
         };
-        match &mut self.source {
-            Source::Rig { poses, .. } => poses.write(ToolPoseMsg {
-                tick: tick.tick,
-                pose: tool_now,
-                linear_velocity: tool_motion.linear_velocity,
-                angular_velocity: tool_motion.angular_velocity,
-                timestamp_us: device.timestamp_us,
-                reach: 0.0,
-            }),
-            Source::Collette(c) => c.tool.set(tool_now, device.timestamp_us),
-        }
+        self.tool.set(tool_now, device.timestamp_us);
         self.report(device, out, contact_device.force, tool_now.translation, tool_now, used);
+    }
+
+    /// Applies the game thread's changes; what they replace goes back to be freed there.
+    fn apply_commands(&mut self) {
+        while let Ok(command) = self.commands.pop() {
+            match command {
+                ForceCommand::Add(object) => {
+                    if let Some(i) = self.objects.iter().position(|o| o.id == object.id) {
+                        let old = std::mem::replace(&mut self.objects[i], object);
+                        self.discard(old);
+                    } else if self.objects.len() < self.objects.capacity() {
+                        self.objects.push(object);
+                    } else {
+                        self.discard(object);
+                    }
+                }
+                ForceCommand::Remove(id) => {
+                    if let Some(i) = self.objects.iter().position(|o| o.id == id) {
+                        let old = self.objects.remove(i);
+                        self.discard(old);
+                    }
+                }
+                ForceCommand::SetTool { center_of_mass, material } => {
+                    self.tool_center_of_mass = center_of_mass;
+                    self.tool_material = material;
+                }
+            }
+        }
+    }
+
+    fn discard(&mut self, object: Box<WatchedObject>) {
+        if let Err(rtrb::PushError::Full(object)) = self.garbage.push(object) {
+            std::mem::forget(object); // leak rather than free on this thread (the ring is sized not to fill)
+        }
     }
 
     /// One tick of 3-DOF proxy rendering: the tip against the spheres near it, no coupling, no torque.
     fn on_proxy_tick(&mut self, tick: &ForceOnHapticTick) {
         let device = tick.device;
         let tip = self.map.to_scene(&device.pose);
-        let Source::Rig { frames, poses } = &mut self.source else {
-            return; // refused at start: collette's pipeline gives overlaps, not the spheres near the tip
-        };
-        frames.update();
-        let frame = frames.output_buffer();
-        let balls = frame.balls.as_slice();
+        self.balls.clear();
+        self.ball_objects.clear();
+        let mut freshness = Freshness::new(self.objects.len());
+        for (slot, object) in self.objects.iter_mut().enumerate() {
+            let ObjectReader::Near(reader) = &mut object.reader else { continue };
+            let set = reader.latest();
+            freshness.saw(set.sequence, set.timestamp_us, set.len());
+            for s in set.as_slice().iter().take(self.balls.capacity() - self.balls.len()) {
+                self.balls.push(Ball { center: s.center, radius: s.radius });
+                self.ball_objects.push(slot as u8);
+            }
+        }
+        let balls = self.balls.as_slice();
         // The spring of the material the proxy rests on: the object of the sphere nearest to it.
         let near = if self.god.in_contact() { self.god.proxy() } else { tip.translation };
-        let slot = balls
+        let nearest = balls
             .iter()
             .enumerate()
             .min_by(|a, b| {
                 (a.1.center.distance(near) - a.1.radius).total_cmp(&(b.1.center.distance(near) - b.1.radius))
             })
-            .map(|(i, _)| i);
-        let material = slot.map(|i| frame.tool_material.combine(&frame.objects[frame.balls.object_of(i)].material));
+            .map(|(i, _)| &self.objects[usize::from(self.ball_objects[i])]);
+        let material = nearest.map(|o| self.tool_material.combine(&o.material));
         let config = ProxyConfig {
             stiffness_n_per_m: material
                 .map_or(0.0, |m| m.stiffness_n_per_m3 * self.proxy.volume_per_depth_m2)
@@ -280,10 +299,10 @@ impl ForceStage {
         let mut force_scene = self.god.update(&config, tip.translation, velocity, balls, scale);
         // Ridges: the spring's push along the surface normal becomes that of the ridged surface.
         let texture = material.and_then(|m| m.texture);
-        if let (Some(t), Some(i)) = (texture, slot.filter(|_| self.god.in_contact())) {
+        if let (Some(t), Some(object)) = (texture, nearest.filter(|_| self.god.in_contact())) {
             let n = self.god.normal();
             let push = n * force_scene.dot(n).max(0.0);
-            let body = &frame.objects[frame.balls.object_of(i)].motion;
+            let body = &object.motion;
             let ridged = t.apply(
                 push,
                 self.god.proxy(),
@@ -293,21 +312,14 @@ impl ForceStage {
             force_scene += ridged - push;
         }
         let contact_device = self.map.wrench_to_device(ForceTorque { force: force_scene, torque: Vec3::ZERO });
-        let used =
-            Used { contacts: balls.len() as u32, sequence: frame.sequence, age_us: frame.age_us(device.timestamp_us) };
+        let used = freshness.used(device.timestamp_us);
         let before = tick.total();
         let requested = ForceTorque { force: before.force + contact_device.force, torque: before.torque };
         let out = self.safety.apply(requested, tick.dt_s, used.age_s());
         tick.set(out);
         let proxy_pose = Pose::new(self.god.proxy(), tip.rotation);
-        poses.write(ToolPoseMsg {
-            tick: tick.tick,
-            pose: tip,
-            linear_velocity: velocity * scale,
-            angular_velocity: Vec3::ZERO,
-            timestamp_us: device.timestamp_us,
-            reach: self.god.proxy().distance(tip.translation) + self.proxy.margin + self.proxy.tip_radius,
-        });
+        let reach = self.god.proxy().distance(tip.translation) + self.proxy.margin + self.proxy.tip_radius;
+        self.tool.set_with_reach(tip, device.timestamp_us, reach);
         self.report(device, out, contact_device.force, tip.translation, proxy_pose, used);
     }
 
@@ -343,6 +355,43 @@ impl ForceStage {
             safety_gain: self.safety.gain(),
             safety: self.safety.stats(),
         });
+    }
+}
+
+/// What a tick learns about the watchers' data while reading it: the newest step, the oldest pose.
+struct Freshness {
+    objects: usize,
+    sequence: u64,
+    oldest_us: Option<u64>,
+    unread: bool,
+    contacts: u32,
+}
+
+impl Freshness {
+    fn new(objects: usize) -> Self {
+        Self { objects, sequence: 0, oldest_us: None, unread: false, contacts: 0 }
+    }
+
+    /// Notes one watcher's result: its step, the timestamp of the pose it used, its size.
+    fn saw(&mut self, sequence: u64, timestamp_us: u64, len: usize) {
+        self.contacts += len as u32;
+        if sequence == 0 {
+            self.unread = true;
+            return;
+        }
+        self.sequence = self.sequence.max(sequence);
+        self.oldest_us = Some(self.oldest_us.map_or(timestamp_us, |t| t.min(timestamp_us)));
+    }
+
+    /// The data used at `now_us`: its age is that of the oldest tool pose a watcher's result rests on
+    /// (`u64::MAX` while a watcher has published nothing yet; 0 with nothing watched: no data can be stale).
+    fn used(&self, now_us: u64) -> Used {
+        let age_us = match (self.objects, self.unread, self.oldest_us) {
+            (0, _, _) => 0,
+            (_, true, _) | (_, _, None) => u64::MAX,
+            (_, false, Some(t)) => now_us.saturating_sub(t),
+        };
+        Used { contacts: self.contacts, sequence: self.sequence, age_us }
     }
 }
 

@@ -1,9 +1,9 @@
 //! haptic_rig: the wiring of haptico, collette and forcecomp (the paper's EventHandler, §3.6).
 //!
 //! Three threads: the game thread steers a [`HapticRig`]; the haptic thread (haptico, 1 kHz) reads the
-//! device and runs the [`force::ForceStage`] on `ForceOnHapticTick` (penalty force, virtual coupling,
-//! safety); the collision thread ([`collision`], collette's budgeted queries, 1 kHz) turns the latest
-//! tool pose into contacts. The threads exchange latest values through triple buffers and commands
+//! device and runs the [`force::ForceStage`] on `ForceOnHapticTick` (penalty force or 3-DOF proxy,
+//! virtual coupling, safety); the collision thread (collette's pipeline, paced by [`collision`], 1 kHz)
+//! turns the latest tool pose into each watched object's contacts (or its spheres near the tip). The threads exchange latest values through triple buffers and commands
 //! through fixed-capacity ring buffers; nothing on either real-time thread allocates, locks or logs in
 //! steady state.
 //!
@@ -15,14 +15,15 @@ pub mod bench;
 pub mod collision;
 pub mod error;
 pub mod force;
-pub mod frame;
 pub mod lockstep;
 pub mod rig;
+mod scene;
+pub mod spec;
 pub mod workspace;
 
 pub use collision::{CollisionConfig, StepTiming};
 pub use error::{Result, RigError};
 pub use force::{ForceSample, ProxyRendering, Rendering, RigTelemetry};
-pub use frame::{Balls, CollisionFrame, MAX_BALLS, MAX_OBJECTS, ObjectContacts, ObjectSpec, ToolPoseMsg, ToolSpec};
 pub use rig::{HapticRig, RigConfig};
+pub use spec::{MAX_OBJECTS, ObjectSpec, ToolSpec};
 pub use workspace::WorkspaceMap;

@@ -4,25 +4,26 @@
 //! You need this module for deterministic tests and offline analysis (e.g. checking the safety limits
 //! along the whole benchmark trajectory); it says nothing about real-time rates.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
+use collette::pipeline::CollisionStepper;
 use haptic_common::{Delegator, ForceTorque};
-use haptico::{Device, HapticClock, HapticCore, HapticEvents};
+use haptico::{Device, HapticCore, HapticEvents};
 
-use crate::collision::{CollisionWorld, WatchedObject, WorldCommand};
 use crate::force::{ForceSample, RigTelemetry};
-use crate::frame::{ObjectSpec, ToolSpec};
-use crate::rig::{Parts, RigInner};
-use crate::{Result, RigConfig, RigError};
+use crate::rig::{Outputs, Parts};
+use crate::scene::Scene;
+use crate::spec::{MAX_OBJECTS, ObjectSpec, ToolSpec};
+use crate::{Result, RigConfig};
 
 /// A rig without threads.
 pub struct Lockstep<D: Device> {
     core: HapticCore<D>,
-    world: CollisionWorld,
-    inner: RigInner,
-    clock: HapticClock,
+    stepper: CollisionStepper,
+    scene: Scene,
+    outputs: Outputs,
     collision_every: u64,
-    budget: Option<Duration>,
+    budgeted: bool,
     paused: bool,
 }
 
@@ -37,27 +38,47 @@ impl<D: Device> Lockstep<D> {
         collision_every: u64,
         budget: Option<Duration>,
     ) -> Result<Self> {
-        let Parts { mut stage, world, inner } = Parts::new(device.specs(), tool, config, Delegator::new())?;
+        let (collision, stepper) =
+            collette::pipeline::pipeline(&config.collision.pipeline(MAX_OBJECTS, budget), Delegator::new());
+        let Parts { mut stage, scene, outputs } = Parts::new(device.specs(), tool, config, collision)?;
         let mut events = HapticEvents::default();
         events.force_on_haptic_tick.add_delegate(move |tick| stage.on_tick(tick));
         let core = HapticCore::new(device, events, config.haptic.rate_hz);
         Ok(Self {
             core,
-            world,
-            inner,
-            clock: HapticClock::new(),
+            stepper,
+            scene,
+            outputs,
             collision_every: collision_every.max(1),
-            budget,
+            budgeted: budget.is_some(),
             paused: false,
         })
     }
 
     /// Watches an object.
     pub fn add_object(&mut self, object: ObjectSpec) -> Result<()> {
-        self.inner
-            .commands
-            .push(WorldCommand::AddObject(WatchedObject::boxed(object)))
-            .map_err(|_| RigError::QueueFull("collision"))
+        self.scene.add_object(object)
+    }
+
+    /// Stops watching object `id`.
+    pub fn remove_object(&mut self, id: u32) -> Result<()> {
+        self.scene.remove_object(id)
+    }
+
+    /// Replaces the tool.
+    pub fn set_tool(&mut self, tool: ToolSpec) -> Result<()> {
+        self.scene.set_tool(tool)
+    }
+
+    /// Frees what the stages handed back; returns how many objects the force stage returned.
+    pub fn collect_garbage(&mut self) -> usize {
+        self.scene.collect_garbage()
+    }
+
+    /// Removed or replaced objects, trees and watchers the collision stage could not hand back (leaked
+    /// rather than freed on its thread): always 0, its return ring cannot fill.
+    pub fn collision_leaks(&self) -> u64 {
+        self.scene.collision.leaked()
     }
 
     /// Stops or restarts collision steps (stale data: the watchdog fades forces out).
@@ -68,8 +89,7 @@ impl<D: Device> Lockstep<D> {
     /// One haptic tick at `t_us` (preceded by a collision step when due); returns the device command.
     pub fn tick(&mut self, t_us: u64) -> ForceTorque {
         if !self.paused && self.core.ticks().is_multiple_of(self.collision_every) {
-            self.world.apply_commands();
-            self.world.step(&self.clock, t_us, self.budget.map(|b| Instant::now() + b));
+            self.stepper.step(t_us, self.budgeted, || t_us);
         }
         self.core.tick(t_us)
     }
@@ -81,13 +101,13 @@ impl<D: Device> Lockstep<D> {
 
     /// Latest force-stage telemetry.
     pub fn telemetry(&mut self) -> RigTelemetry {
-        *self.inner.telemetry.read()
+        *self.outputs.telemetry.read()
     }
 
     /// Moves recorded per-tick force samples into `out`.
     pub fn drain_force_samples(&mut self, out: &mut Vec<ForceSample>) -> usize {
         let mut n = 0;
-        while let Ok(s) = self.inner.samples.pop() {
+        while let Ok(s) = self.outputs.samples.pop() {
             out.push(s);
             n += 1;
         }

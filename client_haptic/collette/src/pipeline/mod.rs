@@ -1,18 +1,27 @@
 //! The collision pipeline (the paper's ColletteVolume with AddCollisionWatcher): a thread that owns the
 //! loaded trees, reads the latest object poses lock-free, checks the watched pairs inside a region, and
-//! publishes each pair's latest [`ContactSet`] lock-free.
+//! publishes each pair's latest result lock-free: a [`ContactSet`] of overlapping sphere pairs
+//! (volumetric rendering) or the [`NearSpheres`] around a point tool's tip (3-DOF proxy rendering).
 //!
 //! You need this module to run collision detection beside a 1 kHz haptic loop. Start it with
-//! [`CollisionThread::spawn`]; add objects (you get a [`PoseWriter`] to move them from any thread) and
-//! watchers (you get a [`ContactReader`] for the force thread); objects and watchers can be added and
-//! removed while it runs. The thread never locks or allocates: commands and retired objects travel
-//! through fixed-capacity ring buffers, poses and contacts through triple buffers. The core,
-//! [`CollisionWorld`], takes the deadline as input and can be stepped by hand in tests.
+//! [`CollisionThread::spawn`] (or [`CollisionThread::spawn_with`] and your own [`Pacer`]); add objects
+//! (you get a [`PoseWriter`] to move them from any thread) and watchers (you get a reader for the force
+//! thread); objects, trees and watchers can be added, replaced and removed while it runs, and it can be
+//! paused. The thread never locks or allocates: commands and retired objects travel through
+//! fixed-capacity ring buffers (the return ring sized so that it cannot fill), poses and results through
+//! triple buffers, step timings through a bounded ring. The core, [`CollisionWorld`], takes the deadline
+//! as input; [`pipeline`] gives a [`CollisionStepper`] to step by hand in tests and lockstep runs.
 
 mod thread;
 mod world;
 
-pub use thread::{CollisionHandle, CollisionThread, ContactReader, PoseWriter};
-pub use world::{CollisionConfig, CollisionWorld, Command, ObjectId, Retired, TimedPose, WatcherId};
+pub use thread::{
+    CollisionHandle, CollisionStepper, CollisionThread, ContactReader, FixedRate, NearReader, Pacer, PoseWriter,
+    StepTiming, WatcherReader, pipeline,
+};
+pub use world::{
+    CollisionConfig, CollisionWorld, Command, MAX_NEAR_SPHERES, NearSphere, NearSpheres, ObjectId, Retired, StepReport,
+    TimedPose, WatcherId, WatcherOutput,
+};
 
 pub use haptic_common::ContactSet;

@@ -1,13 +1,21 @@
-//! The collision thread and the handles that steer it, feed it poses and read its contacts.
+//! The collision thread and the handles that steer it, feed it poses and read its results.
+//!
+//! [`pipeline`] makes the two ends: the [`CollisionHandle`] (any thread: objects, watchers, region,
+//! pause, timings) and the [`CollisionStepper`] (the world with its command ring; steps once per call).
+//! [`CollisionThread`] runs a stepper on its own thread, paced by a [`Pacer`]; tests and lockstep
+//! simulations call the stepper by hand.
 
-use super::world::{CollisionConfig, CollisionWorld, Command, ObjectId, Retired, TimedPose, WatcherId};
+use super::world::{
+    CollisionConfig, CollisionWorld, Command, NearSpheres, ObjectId, Retired, StepReport, TimedPose, WatcherId,
+    WatcherOutput,
+};
 use crate::bounding_volume::Aabb;
 use crate::partitioning::InnerSphereTree;
-use haptic_common::{ContactSet, Pose};
+use haptic_common::{ContactSet, Delegator, OnCollision, Pose};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::thread::JoinHandle;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// Writes an object's latest pose (lock-free); give it to whichever thread moves the object.
 pub struct PoseWriter {
@@ -23,39 +31,192 @@ impl PoseWriter {
 
     /// Publishes a new pose sampled at `timestamp_us`. Never blocks or allocates.
     pub fn set(&mut self, pose: Pose, timestamp_us: u64) {
-        self.input.write(TimedPose { pose, timestamp_us });
+        self.input.write(TimedPose { pose, timestamp_us, reach: 0.0 });
+    }
+
+    /// Publishes a new pose with the reach of the near watchers whose A object this is.
+    pub fn set_with_reach(&mut self, pose: Pose, timestamp_us: u64, reach: f32) {
+        self.input.write(TimedPose { pose, timestamp_us, reach });
     }
 }
 
-/// Reads a watched pair's latest contacts (lock-free); give it to the force thread.
-pub struct ContactReader {
+/// Reads a watched pair's latest result (lock-free); give it to the force thread.
+pub struct WatcherReader<T: Send> {
     id: WatcherId,
-    output: triple_buffer::Output<ContactSet>,
+    output: triple_buffer::Output<T>,
 }
 
-impl ContactReader {
+/// Reads a watcher's overlapping sphere pairs.
+pub type ContactReader = WatcherReader<ContactSet>;
+/// Reads a near watcher's spheres.
+pub type NearReader = WatcherReader<NearSpheres>;
+
+impl<T: Send> WatcherReader<T> {
     /// The watcher this reader belongs to.
     pub fn id(&self) -> WatcherId {
         self.id
     }
 
-    /// The newest published contact set (sequence 0 before the first step). Never blocks or allocates.
-    pub fn latest(&mut self) -> &ContactSet {
+    /// The newest published result (sequence 0 before the first step). Never blocks or allocates.
+    pub fn latest(&mut self) -> &T {
         self.output.read()
     }
 }
 
-/// Steers a running collision thread; dropping it stops and joins the thread.
+/// Timing and size of one collision step.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct StepTiming {
+    /// Step counter.
+    pub sequence: u64,
+    /// Start on the stepper's clock, µs.
+    pub start_us: u64,
+    /// Time since the previous step's start, µs (0 for the first).
+    pub period_us: u32,
+    /// Time spent applying commands and querying, µs.
+    pub work_us: u32,
+    /// Contacts (or near spheres) found.
+    pub contacts: u32,
+    /// True when the budget cut a query short.
+    pub budget_hit: bool,
+}
+
+/// When the collision thread steps, and on which clock its timings are read.
+pub trait Pacer: Send + 'static {
+    /// Runs once on the collision thread before its first step (e.g. to raise its priority).
+    fn start(&mut self) {}
+    /// Returns when the next step is due.
+    fn wait(&mut self);
+    /// Now on the clock of the step timings, µs.
+    fn now_us(&self) -> u64;
+}
+
+/// A [`Pacer`] that sleeps to a fixed period, on a clock started with it.
+pub struct FixedRate {
+    epoch: Instant,
+    period: Duration,
+    next: Instant,
+}
+
+impl FixedRate {
+    /// Steps every `period`.
+    pub fn new(period: Duration) -> Self {
+        let epoch = Instant::now();
+        Self { epoch, period, next: epoch }
+    }
+}
+
+impl Pacer for FixedRate {
+    fn wait(&mut self) {
+        self.next += self.period;
+        let now = Instant::now();
+        if self.next > now {
+            std::thread::sleep(self.next - now);
+        } else {
+            self.next = now;
+        }
+    }
+
+    fn now_us(&self) -> u64 {
+        self.epoch.elapsed().as_micros() as u64
+    }
+}
+
+/// The world with the receiving ends of its rings: one call, one step.
+pub struct CollisionStepper {
+    world: CollisionWorld,
+    incoming: rtrb::Consumer<Command>,
+    retire: rtrb::Producer<Retired>,
+    timings: rtrb::Producer<StepTiming>,
+    leaked: Arc<AtomicU64>,
+    steps: Arc<AtomicU64>,
+    budget: Duration,
+    last_start_us: Option<u64>,
+}
+
+impl CollisionStepper {
+    /// Applies the pending commands, then checks every watched pair once; the step starts at `start_us`
+    /// on the caller's clock, `now_us` reads that clock at its end. With `budgeted`, the queries stop
+    /// refining at the configured step budget; without, they are exact (deterministic). Never allocates,
+    /// frees, locks or logs.
+    pub fn step(&mut self, start_us: u64, budgeted: bool, now_us: impl Fn() -> u64) -> StepReport {
+        let start = Instant::now();
+        let (retire, leaked) = (&mut self.retire, &self.leaked);
+        while let Ok(command) = self.incoming.pop() {
+            self.world.apply(command, &mut |r| {
+                // Unreachable (see the ring's size in `pipeline`); were it full, leak rather than free here.
+                if let Err(rtrb::PushError::Full(r)) = retire.push(r) {
+                    leaked.fetch_add(1, Ordering::Relaxed);
+                    std::mem::forget(r);
+                }
+            });
+        }
+        if self.world.paused() {
+            return StepReport::default();
+        }
+        let report = self.world.step(budgeted.then(|| start + self.budget));
+        let end_us = now_us().max(start_us);
+        let period_us = self.last_start_us.map_or(0, |s| start_us.saturating_sub(s)) as u32;
+        self.last_start_us = Some(start_us);
+        let _ = self.timings.push(StepTiming {
+            sequence: self.world.sequence(),
+            start_us,
+            period_us,
+            work_us: (end_us - start_us) as u32,
+            contacts: report.contacts,
+            budget_hit: report.budget_hit,
+        });
+        self.steps.fetch_add(1, Ordering::Release);
+        report
+    }
+}
+
+/// Steers a collision world; when it runs on a [`CollisionThread`], dropping the handle stops and joins
+/// the thread.
 pub struct CollisionHandle {
     commands: rtrb::Producer<Command>,
     retired: rtrb::Consumer<Retired>,
+    timings: rtrb::Consumer<StepTiming>,
     collected: u64,
     leaked: Arc<AtomicU64>,
     free_objects: Vec<u32>,
     free_watchers: Vec<u32>,
-    stop: Arc<AtomicBool>,
     steps: Arc<AtomicU64>,
-    thread: Option<JoinHandle<()>>,
+    thread: Option<(Arc<AtomicBool>, JoinHandle<()>)>,
+}
+
+/// The two ends of a collision world: the handle that steers it and the stepper that runs it. Every
+/// non-empty contact set is broadcast to `on_collision` on the stepping thread.
+pub fn pipeline(config: &CollisionConfig, on_collision: Delegator<OnCollision>) -> (CollisionHandle, CollisionStepper) {
+    let (commands, incoming) = rtrb::RingBuffer::new(config.command_capacity);
+    // The return ring cannot fill: a command retires at most one item, and every handle method that
+    // sends one that can retire anything first empties the ring; so at most the commands still queued
+    // at that moment (<= command_capacity) plus the one sent after it retire before the next emptying.
+    let (retire, retired) = rtrb::RingBuffer::new(config.command_capacity + config.max_objects + config.max_watchers);
+    let (timings_tx, timings) = rtrb::RingBuffer::new(config.timing_capacity.max(1));
+    let steps = Arc::new(AtomicU64::new(0));
+    let leaked = Arc::new(AtomicU64::new(0));
+    let stepper = CollisionStepper {
+        world: CollisionWorld::with_delegates(config, on_collision),
+        incoming,
+        retire,
+        timings: timings_tx,
+        leaked: leaked.clone(),
+        steps: steps.clone(),
+        budget: config.step_budget,
+        last_start_us: None,
+    };
+    let handle = CollisionHandle {
+        commands,
+        retired,
+        timings,
+        collected: 0,
+        leaked,
+        free_objects: (0..config.max_objects as u32).rev().collect(),
+        free_watchers: (0..config.max_watchers as u32).rev().collect(),
+        steps,
+        thread: None,
+    };
+    (handle, stepper)
 }
 
 /// Starts collision threads.
@@ -64,65 +225,55 @@ pub struct CollisionThread;
 impl CollisionThread {
     /// Spawns the thread, which steps every `config.period` with `config.step_budget` per step.
     pub fn spawn(config: CollisionConfig) -> std::io::Result<CollisionHandle> {
-        let (commands, mut incoming) = rtrb::RingBuffer::new(config.command_capacity);
-        // The return ring cannot fill: a command retires at most one item, and every handle method that
-        // sends one that can retire anything first empties the ring; so at most the commands still queued
-        // at that moment (<= command_capacity) plus the one sent after it retire before the next emptying.
-        let (mut retire_tx, retired) =
-            rtrb::RingBuffer::new(config.command_capacity + config.max_objects + config.max_watchers);
+        let pacer = FixedRate::new(config.period);
+        Self::spawn_with(&config, Delegator::new(), pacer)
+    }
+
+    /// Spawns the thread ("collision"), which steps whenever `pacer` says, with `config.step_budget`
+    /// per step, broadcasting contacts to `on_collision`.
+    pub fn spawn_with(
+        config: &CollisionConfig,
+        on_collision: Delegator<OnCollision>,
+        mut pacer: impl Pacer,
+    ) -> std::io::Result<CollisionHandle> {
+        let (mut handle, mut stepper) = pipeline(config, on_collision);
         let stop = Arc::new(AtomicBool::new(false));
-        let steps = Arc::new(AtomicU64::new(0));
-        let leaked = Arc::new(AtomicU64::new(0));
-        let mut world = CollisionWorld::new(&config);
-        let (stop2, steps2, leaked2) = (stop.clone(), steps.clone(), leaked.clone());
-        let thread = std::thread::Builder::new().name("collette".into()).spawn(move || {
-            let mut next = Instant::now();
+        let stop2 = stop.clone();
+        let thread = std::thread::Builder::new().name("collision".into()).spawn(move || {
+            pacer.start();
             while !stop2.load(Ordering::Acquire) {
-                while let Ok(cmd) = incoming.pop() {
-                    world.apply(cmd, &mut |r| {
-                        // Unreachable (see the ring's size); were it full, leak rather than free here.
-                        if let Err(rtrb::PushError::Full(r)) = retire_tx.push(r) {
-                            leaked2.fetch_add(1, Ordering::Relaxed);
-                            std::mem::forget(r);
-                        }
-                    });
-                }
-                world.step(Some(Instant::now() + config.step_budget));
-                steps2.fetch_add(1, Ordering::Release);
-                next += config.period;
-                let now = Instant::now();
-                if next > now {
-                    std::thread::sleep(next - now);
-                } else {
-                    next = now;
-                }
+                pacer.wait();
+                stepper.step(pacer.now_us(), true, || pacer.now_us());
             }
         })?;
-        Ok(CollisionHandle {
-            commands,
-            retired,
-            collected: 0,
-            leaked,
-            free_objects: (0..config.max_objects as u32).rev().collect(),
-            free_watchers: (0..config.max_watchers as u32).rev().collect(),
-            stop,
-            steps,
-            thread: Some(thread),
-        })
+        handle.thread = Some((stop, thread));
+        Ok(handle)
     }
 }
 
 impl CollisionHandle {
-    /// Adds an object at `pose`; returns its pose writer, or `None` when all slots or the command ring are full.
+    /// Adds an object at `pose` (a moving one: its pose ages until written again); returns its pose
+    /// writer, or `None` when all slots or the command ring are full.
     pub fn add_object(&mut self, tree: Arc<InnerSphereTree>, pose: Pose) -> Option<PoseWriter> {
+        self.add_object_at(tree, TimedPose { pose, timestamp_us: 0, reach: 0.0 })
+    }
+
+    /// Adds an object with its first timed pose (`timestamp_us: u64::MAX` for one that never moves).
+    pub fn add_object_at(&mut self, tree: Arc<InnerSphereTree>, pose: TimedPose) -> Option<PoseWriter> {
         self.collect_retired();
         let id = ObjectId(self.free_objects.pop()?);
-        let (input, output) = triple_buffer::triple_buffer(&TimedPose { pose, timestamp_us: 0 });
+        let (input, output) = triple_buffer::triple_buffer(&pose);
         if self.commands.push(Command::AddObject(id, tree, output)).is_err() {
             self.free_objects.push(id.0);
             return None;
         }
         Some(PoseWriter { id, input })
+    }
+
+    /// Gives an object a new tree (e.g. a new tool). False when the command ring is full.
+    pub fn set_tree(&mut self, id: ObjectId, tree: Arc<InnerSphereTree>) -> bool {
+        self.collect_retired();
+        self.commands.push(Command::SetTree(id, tree)).is_ok()
     }
 
     /// Removes an object (its watchers then publish empty sets). False when the command ring is full.
@@ -139,14 +290,30 @@ impl CollisionHandle {
 
     /// Watches the pair (A = tool, B = touched object); returns the reader of its contacts.
     pub fn add_watcher(&mut self, a: ObjectId, b: ObjectId) -> Option<ContactReader> {
+        self.add_any_watcher(a, b, ContactSet::new(), |input| WatcherOutput::Contacts(Box::new(input)))
+    }
+
+    /// Watches B's spheres near A's origin (A = a point tool, its reach set with its pose); returns the
+    /// reader of the spheres.
+    pub fn add_near_watcher(&mut self, a: ObjectId, b: ObjectId) -> Option<NearReader> {
+        self.add_any_watcher(a, b, NearSpheres::default(), |input| WatcherOutput::Near(Box::new(input)))
+    }
+
+    fn add_any_watcher<T: Clone + Send>(
+        &mut self,
+        a: ObjectId,
+        b: ObjectId,
+        empty: T,
+        wrap: impl FnOnce(triple_buffer::Input<T>) -> WatcherOutput,
+    ) -> Option<WatcherReader<T>> {
         self.collect_retired();
         let id = WatcherId(self.free_watchers.pop()?);
-        let (input, output) = triple_buffer::triple_buffer(&ContactSet::new());
-        if self.commands.push(Command::AddWatcher(id, a, b, Box::new(input))).is_err() {
+        let (input, output) = triple_buffer::triple_buffer(&empty);
+        if self.commands.push(Command::AddWatcher(id, a, b, wrap(input))).is_err() {
             self.free_watchers.push(id.0);
             return None;
         }
-        Some(ContactReader { id, output })
+        Some(WatcherReader { id, output })
     }
 
     /// Stops watching a pair. False when the command ring is full.
@@ -164,9 +331,26 @@ impl CollisionHandle {
         self.commands.push(Command::SetRegion(region)).is_ok()
     }
 
-    /// Steps completed by the thread so far.
+    /// Pauses or resumes the steps (paused: nothing is published, so the readers' data ages).
+    pub fn pause(&mut self, paused: bool) -> bool {
+        self.commands.push(Command::Pause(paused)).is_ok()
+    }
+
+    /// Commands that can be queued right now (each method sends one).
+    pub fn free_commands(&self) -> usize {
+        self.commands.slots()
+    }
+
+    /// Steps completed so far.
     pub fn steps(&self) -> u64 {
         self.steps.load(Ordering::Acquire)
+    }
+
+    /// Moves the recorded step timings into `out`; returns how many.
+    pub fn drain_timings(&mut self, out: &mut Vec<StepTiming>) -> usize {
+        let n = self.timings.slots();
+        out.extend((0..n).filter_map(|_| self.timings.pop().ok()));
+        n
     }
 
     /// Frees what the thread handed back (also done by every other method).
@@ -177,7 +361,7 @@ impl CollisionHandle {
         }
     }
 
-    /// Removed or replaced objects and watchers handed back by the thread and freed here so far.
+    /// Removed or replaced objects, trees and watchers handed back by the thread and freed here so far.
     pub fn collected(&self) -> u64 {
         self.collected
     }
@@ -191,9 +375,9 @@ impl CollisionHandle {
 
 impl Drop for CollisionHandle {
     fn drop(&mut self) {
-        self.stop.store(true, Ordering::Release);
-        if let Some(t) = self.thread.take() {
-            let _ = t.join();
+        if let Some((stop, thread)) = self.thread.take() {
+            stop.store(true, Ordering::Release);
+            let _ = thread.join();
         }
     }
 }
@@ -258,6 +442,53 @@ mod tests {
         assert_eq!(handle.leaked(), 0, "the return ring never filled");
         assert_eq!(handle.collected(), removals, "every removed object and watcher was freed by the handle");
         assert_eq!(Arc::strong_count(&tree), 2, "only the test's and the anchor's copies are left");
+    }
+
+    #[test]
+    fn a_stepper_by_hand_gathers_near_spheres_pauses_swaps_trees_and_times_its_steps() {
+        let tree_of = |n| {
+            let (v, t) = box_buffers(Vec3::splat(0.5));
+            Arc::new(
+                build(&TriMesh::new(v, t).expect("valid"), &BuildOptions::spheres(n), &mut |_| {}).expect("builds").0,
+            )
+        };
+        let (coarse, fine) = (tree_of(50), tree_of(400));
+        let (mut handle, mut stepper) = pipeline(&CollisionConfig::default(), Delegator::new());
+        let mut tip = handle.add_object(coarse.clone(), Pose::IDENTITY).expect("slot");
+        let still = TimedPose { pose: Pose::IDENTITY, timestamp_us: u64::MAX, reach: 0.0 };
+        let target = handle.add_object_at(coarse.clone(), still).expect("slot");
+        let mut near = handle.add_near_watcher(tip.id(), target.id()).expect("slot");
+        let point = Vec3::new(0.0, 0.6, 0.0); // 0.1 above the box's top face
+        tip.set_with_reach(Pose::from_translation(point), 40, 0.05);
+        stepper.step(100, false, || 110);
+        let set = near.latest();
+        assert!(set.is_empty() && set.sequence == 1, "nothing within 0.05 of a point 0.1 away");
+        assert_eq!(set.timestamp_us, 40, "a still object's pose never ages: the pair's time is the tip's");
+        tip.set_with_reach(Pose::from_translation(point), 50, 0.3);
+        stepper.step(200, false, || 230);
+        let set = near.latest();
+        let coarse_count = set.len();
+        assert!(coarse_count > 0 && set.sequence == 2 && set.timestamp_us == 50);
+        assert!(set.as_slice().iter().all(|s| s.center.distance(point) - s.radius <= 0.3 + 1e-5), "all within reach");
+        assert!(handle.pause(true));
+        assert_eq!(stepper.step(300, false, || 310), StepReport::default(), "a paused step does nothing");
+        assert_eq!(near.latest().sequence, 2, "and publishes nothing");
+        assert!(handle.pause(false) && handle.set_tree(target.id(), fine));
+        stepper.step(400, false, || 450);
+        let set = near.latest();
+        assert!(
+            set.sequence == 3 && set.len() != coarse_count,
+            "the finer tree's spheres: {} vs {coarse_count}",
+            set.len()
+        );
+        handle.collect_retired();
+        assert_eq!(handle.collected(), 1, "the replaced tree came back to be freed");
+        assert_eq!(Arc::strong_count(&coarse), 2, "held by the test and the tip only");
+        let mut timings = Vec::new();
+        assert_eq!(handle.drain_timings(&mut timings), 3, "three steps ran");
+        let starts: Vec<_> = timings.iter().map(|t| (t.start_us, t.period_us, t.work_us)).collect();
+        assert_eq!(starts, vec![(100, 0, 10), (200, 100, 30), (400, 200, 50)]);
+        assert_eq!(handle.steps(), 3);
     }
 
     #[test]

@@ -57,10 +57,6 @@ struct Args {
     /// Spin instead of sleeping for the last part of each period, µs (both threads).
     #[arg(long, default_value_t = 300)]
     spin_us: u32,
-    /// Collision thread: "rig" (haptic_rig's, with per-step timings) or "collette" (collette::pipeline's;
-    /// its rate is then read from the contact sets' sequence numbers seen by the haptic thread).
-    #[arg(long, default_value = "rig")]
-    collision: String,
     /// Force rendering: "volumetric" (the gemstone's inner spheres against the bunny's, coupled, 6-DOF)
     /// or "proxy" (3-DOF god-object: the gemstone's centre as a point tip held on the bunny's spheres).
     #[arg(long, default_value = "volumetric")]
@@ -178,18 +174,8 @@ fn run() -> anyhow::Result<()> {
     if args.lockstep {
         return lockstep(&args, device, tool, bunny, &config, replay.as_ref(), recording);
     }
-    let collette_mode = match args.collision.as_str() {
-        "rig" => false,
-        "collette" => true,
-        other => anyhow::bail!("--collision must be rig or collette, not {other:?}"),
-    };
-    let rig = if collette_mode {
-        HapticRig::start_with_collette(device, tool, vec![bunny], config, HapticEvents::default())?
-    } else {
-        let rig = HapticRig::start(device, tool, config, HapticEvents::default(), Delegator::new())?;
-        rig.add_object(bunny)?;
-        rig
-    };
+    let rig = HapticRig::start(device, tool, config, HapticEvents::default(), Delegator::new())?;
+    rig.add_object(bunny)?;
 
     let mut haptic = Vec::with_capacity(ticks);
     let mut collision = Vec::with_capacity(ticks);
@@ -219,9 +205,6 @@ fn run() -> anyhow::Result<()> {
         say_recorded(writer)?;
     }
 
-    if collette_mode {
-        collision = bench::steps_from_sequences(&forces);
-    }
     let period_us = (1e6 / args.rate_hz as f64).round() as u64;
     let mut windows = bench::windows(&haptic, &collision, &forces, 100_000, period_us);
     bench::add_steal(&mut windows, &haptic, &steal_samples, 100_000, period_us);
@@ -238,12 +221,7 @@ fn run() -> anyhow::Result<()> {
     let mut csv = std::io::BufWriter::new(std::fs::File::create(&csv_path)?);
     bench::write_csv(&mut csv, &windows)?;
     drop(csv);
-    let title = format!(
-        "{} on the gemstone-over-bunny path, {} rendering, {} collision thread: 100 ms windows",
-        specs.name,
-        args.rendering,
-        if collette_mode { "collette's" } else { "the rig's" }
-    );
+    let title = format!("{} on the gemstone-over-bunny path, {} rendering: 100 ms windows", specs.name, args.rendering);
     let png_path = args.out_dir.join("haptic_bench.png");
     bench::plot(&png_path, &windows, &title).map_err(|e| anyhow::anyhow!("plot: {e}"))?;
     if let Some(p) = &args.png {
@@ -293,7 +271,6 @@ fn run() -> anyhow::Result<()> {
             "max_force_step_n": s.max_force_step_n,
             "windows": s.windows,
             "device": specs.name,
-            "collision_thread": args.collision,
             "rendering": args.rendering,
             "realtime": haptic_telemetry.realtime,
             "memory_locked": locked,

@@ -1,0 +1,146 @@
+//! The game thread's end of the rig: what is watched, wired into collette's collision pipeline and the
+//! force stage.
+//!
+//! You need this module to see how an object reaches both threads: its tree goes to the collision
+//! pipeline (with one watcher against the tool: overlaps for volumetric rendering, spheres near the tip
+//! for the proxy), the watcher's reader with the object's material and motion to the force stage. Both
+//! travel through fixed-capacity rings; whatever the threads replace or remove comes back here to be
+//! freed.
+
+use collette::pipeline::{CollisionHandle, ObjectId, PoseWriter, TimedPose, WatcherId};
+use forcecomp::BodyMotion;
+
+use crate::force::{ForceCommand, ObjectReader, WatchedObject};
+use crate::spec::{MAX_OBJECTS, ObjectSpec, ToolSpec, center_of_mass};
+use crate::{Result, RigError};
+
+/// Capacity of the ring of changes to the force stage.
+pub(crate) const FORCE_COMMANDS: usize = 64;
+
+/// A watched object's place in the collision pipeline.
+struct Entry {
+    id: u32,
+    object: ObjectId,
+    watcher: WatcherId,
+    // Held so that the object's pose buffer lives (the object does not move).
+    _pose: PoseWriter,
+}
+
+/// What the rig watches, and the ends of the rings that change it.
+pub(crate) struct Scene {
+    pub(crate) collision: CollisionHandle,
+    tool: ObjectId,
+    entries: Vec<Entry>,
+    forces: rtrb::Producer<ForceCommand>,
+    garbage: rtrb::Consumer<Box<WatchedObject>>,
+    proxy: bool,
+    /// Objects freed since the last `collect_garbage` (the other methods free too, before sending).
+    freed: usize,
+}
+
+impl Scene {
+    /// A scene with only the tool (`tool`: its object in `collision`).
+    pub(crate) fn new(
+        collision: CollisionHandle,
+        tool: ObjectId,
+        forces: rtrb::Producer<ForceCommand>,
+        garbage: rtrb::Consumer<Box<WatchedObject>>,
+        proxy: bool,
+    ) -> Self {
+        Self { collision, tool, entries: Vec::with_capacity(MAX_OBJECTS), forces, garbage, proxy, freed: 0 }
+    }
+
+    /// Watches an object (replaces the one with the same id).
+    pub(crate) fn add_object(&mut self, spec: ObjectSpec) -> Result<()> {
+        self.free_returned();
+        if self.forces.slots() == 0 {
+            return Err(RigError::QueueFull("haptic"));
+        }
+        // All or nothing: removing a replaced object and adding this one take four commands.
+        if self.collision.free_commands() < 4 {
+            return Err(RigError::QueueFull("collision"));
+        }
+        if let Some(i) = self.entries.iter().position(|e| e.id == spec.id) {
+            let old = self.entries.swap_remove(i);
+            self.forget(&old)?;
+        } else if self.entries.len() >= MAX_OBJECTS {
+            return Err(RigError::TooManyObjects(MAX_OBJECTS));
+        }
+        let full = || RigError::QueueFull("collision");
+        let still = TimedPose { pose: spec.pose, timestamp_us: u64::MAX, reach: 0.0 };
+        let pose = self.collision.add_object_at(spec.tree.clone(), still).ok_or_else(full)?;
+        let (watcher, reader) = if self.proxy {
+            let r = self.collision.add_near_watcher(self.tool, pose.id()).ok_or_else(full)?;
+            (r.id(), ObjectReader::Near(r))
+        } else {
+            let r = self.collision.add_watcher(self.tool, pose.id()).ok_or_else(full)?;
+            (r.id(), ObjectReader::Contacts(r))
+        };
+        let motion = BodyMotion {
+            orientation: spec.pose.rotation,
+            ..BodyMotion::at_rest(spec.pose.transform_point(center_of_mass(&spec.tree)))
+        };
+        let object = Box::new(WatchedObject { id: spec.id, reader, material: spec.material, motion });
+        self.forces.push(ForceCommand::Add(object)).map_err(|_| RigError::QueueFull("haptic"))?;
+        self.entries.push(Entry { id: spec.id, object: pose.id(), watcher, _pose: pose });
+        Ok(())
+    }
+
+    /// Stops watching object `id` (nothing happens for an id not watched).
+    pub(crate) fn remove_object(&mut self, id: u32) -> Result<()> {
+        self.free_returned();
+        let Some(i) = self.entries.iter().position(|e| e.id == id) else { return Ok(()) };
+        if self.collision.free_commands() < 2 {
+            return Err(RigError::QueueFull("collision"));
+        }
+        self.forces.push(ForceCommand::Remove(id)).map_err(|_| RigError::QueueFull("haptic"))?;
+        let old = self.entries.swap_remove(i);
+        self.forget(&old)
+    }
+
+    /// Takes an object out of the collision pipeline (its watcher first: the slot is reused).
+    fn forget(&mut self, entry: &Entry) -> Result<()> {
+        if self.collision.remove_watcher(entry.watcher) && self.collision.remove_object(entry.object) {
+            Ok(())
+        } else {
+            Err(RigError::QueueFull("collision"))
+        }
+    }
+
+    /// Replaces the tool's tree, centre of mass and material.
+    pub(crate) fn set_tool(&mut self, tool: ToolSpec) -> Result<()> {
+        self.free_returned();
+        if self.forces.slots() == 0 {
+            return Err(RigError::QueueFull("haptic"));
+        }
+        if !self.collision.set_tree(self.tool, tool.tree) {
+            return Err(RigError::QueueFull("collision"));
+        }
+        let command = ForceCommand::SetTool { center_of_mass: tool.center_of_mass, material: tool.material };
+        self.forces.push(command).map_err(|_| RigError::QueueFull("haptic"))
+    }
+
+    /// Only checks objects whose bounds touch `region` (`None`: everywhere).
+    pub(crate) fn set_region(&mut self, region: Option<collette::bounding_volume::Aabb>) -> Result<()> {
+        if self.collision.set_region(region) { Ok(()) } else { Err(RigError::QueueFull("collision")) }
+    }
+
+    /// Pauses or resumes collision detection.
+    pub(crate) fn pause(&mut self, paused: bool) -> Result<()> {
+        if self.collision.pause(paused) { Ok(()) } else { Err(RigError::QueueFull("collision")) }
+    }
+
+    /// Frees what both threads handed back; returns how many objects the force stage has returned since
+    /// the last call.
+    pub(crate) fn collect_garbage(&mut self) -> usize {
+        self.free_returned();
+        std::mem::take(&mut self.freed)
+    }
+
+    fn free_returned(&mut self) {
+        self.collision.collect_retired();
+        while self.garbage.pop().is_ok() {
+            self.freed += 1;
+        }
+    }
+}

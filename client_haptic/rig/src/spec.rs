@@ -1,0 +1,57 @@
+//! What the game gives the rig: the tool and the watched objects, with their trees and materials.
+//!
+//! You need this module to describe a scene to a [`HapticRig`](crate::HapticRig) or a
+//! [`Lockstep`](crate::lockstep::Lockstep).
+
+use std::sync::Arc;
+
+use forcecomp::Material;
+use glam::Vec3;
+use haptic_common::Pose;
+
+/// Most objects watched at once.
+pub const MAX_OBJECTS: usize = 4;
+
+/// The tool: its Inner Sphere Tree, centre of mass and material.
+#[derive(Clone, Debug)]
+pub struct ToolSpec {
+    /// The tree, in the tool's frame (scene units).
+    pub tree: Arc<collette::InnerSphereTree>,
+    /// Centre of mass in the tool's frame.
+    pub center_of_mass: Vec3,
+    /// Material.
+    pub material: Material,
+}
+
+impl ToolSpec {
+    /// A tool whose centre of mass is the volume-weighted centre of its inner spheres.
+    pub fn new(tree: Arc<collette::InnerSphereTree>, material: Material) -> Self {
+        let center_of_mass = center_of_mass(&tree);
+        Self { tree, center_of_mass, material }
+    }
+}
+
+/// A watched object.
+#[derive(Clone, Debug)]
+pub struct ObjectSpec {
+    /// Id chosen by the game (reported in contacts).
+    pub id: u32,
+    /// The tree, in the object's frame.
+    pub tree: Arc<collette::InnerSphereTree>,
+    /// Pose in the scene.
+    pub pose: Pose,
+    /// Material.
+    pub material: Material,
+}
+
+/// Centre of a tree's inner spheres weighted by the mesh volume each stands for (the object's centre
+/// of mass at uniform density).
+pub fn center_of_mass(tree: &collette::InnerSphereTree) -> Vec3 {
+    let (mut sum, mut weight) = (Vec3::ZERO, 0.0f32);
+    for (s, share) in tree.spheres().iter().zip(tree.weights()) {
+        let w = s.radius * s.radius * s.radius * share;
+        sum += s.center * w;
+        weight += w;
+    }
+    if weight > 0.0 { sum / weight } else { Vec3::ZERO }
+}
