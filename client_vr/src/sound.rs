@@ -7,6 +7,7 @@ use heist_audio::{AudioEngine, AudioSettings};
 use heist_shared::protocol::{GameEvent, GuardAlert, GuardView, NoiseKind, Phase, Stance, ViveAvatar};
 
 use crate::client::{Happened, ViveState, ViveSystems};
+use crate::flight;
 use crate::intent::Intent;
 use crate::space;
 
@@ -22,11 +23,16 @@ pub fn add(app: &mut App, settings: &AudioSettings) -> Result<(), heist_audio::A
     Ok(())
 }
 
+/// Most thuds waiting for their thrown item to land (older ones are played at once).
+const MAX_PENDING_THUDS: usize = 8;
+
 #[derive(Resource, Default)]
 struct Steps {
     guards: Vec<(u16, Vec2)>,
     own: Option<Vec2>,
     alarm_s: f32,
+    /// Thuds of thrown items still in the air: (clock time it lands, where).
+    thuds: Vec<(f64, Vec2)>,
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -46,7 +52,15 @@ fn play(
     for Happened(e) in happened.read() {
         match e {
             GameEvent::Noise { kind: NoiseKind::Glass, position, .. } => audio.glass(at(*position, 1.2)),
-            GameEvent::Noise { kind: NoiseKind::Thud, position, .. } => audio.thud(at(*position, 0.0)),
+            GameEvent::Noise { kind: NoiseKind::Thud, position, .. } => {
+                // The server lands a throw at once; it is drawn flying there, so it is heard landing then.
+                if steps.thuds.len() == MAX_PENDING_THUDS {
+                    let (_, p) = steps.thuds.remove(0);
+                    audio.thud(at(p, 0.0));
+                }
+                let lands = time.elapsed_secs_f64() + flight::flight_time_s(position.distance(me)) as f64;
+                steps.thuds.push((lands, *position));
+            }
             GameEvent::Noise { kind: NoiseKind::Alarm, position, .. } => audio.alarm(at(*position, 2.8)),
             GameEvent::GuardAlert { alert, position, .. }
                 if matches!(alert, GuardAlert::Suspicious | GuardAlert::Chasing) =>
@@ -59,6 +73,11 @@ fn play(
             }
             _ => {}
         }
+    }
+    let now = time.elapsed_secs_f64();
+    while let Some(i) = steps.thuds.iter().position(|(lands, _)| *lands <= now) {
+        let (_, p) = steps.thuds.remove(i);
+        audio.thud(at(p, 0.0));
     }
     // A step every 0.7 m a guard walks, when near enough to hear.
     for g in &guards {
@@ -142,6 +161,43 @@ mod tests {
         // Turned to face south, the same glass is on the left.
         let (l, r) = hear_glass(-std::f32::consts::FRAC_PI_2, Vec2::new(4.0, 0.0));
         assert!(l > 2.0 * r, "right {r} left {l}");
+    }
+
+    #[test]
+    fn a_thrown_item_is_heard_landing_when_it_is_drawn_landing_not_when_thrown() {
+        let mut app = App::new();
+        app.add_plugins(MinimalPlugins).add_message::<Happened>();
+        app.insert_resource(bevy::time::TimeUpdateStrategy::ManualDuration(std::time::Duration::from_millis(100)));
+        let state = ViveState {
+            predictor: Some(crate::predict::Predictor::new(WallSet::default(), Vec2::ZERO)),
+            ..Default::default()
+        };
+        app.insert_resource(state).insert_resource(Intent::default());
+        let settings = AudioSettings { output: AudioOutput::Manual, spatial: SpatialMode::Hrtf, ..Default::default() };
+        add(&mut app, &settings).expect("audio starts");
+        app.update();
+        let landing = Vec2::new(9.0, 0.0);
+        app.world_mut().write_message(Happened(GameEvent::Noise {
+            kind: NoiseKind::Thud,
+            position: landing,
+            loudness: 8.0,
+        }));
+        // Read on the next frame, 100 ms on.
+        let thrown = app.world().resource::<Time>().elapsed_secs_f64() + 0.1;
+        let mut heard = None;
+        for _ in 0..40 {
+            app.update();
+            let engine = app.world().non_send::<AudioEngine>();
+            if heard.is_none() && engine.played.iter().any(|c| c.what == "thud") {
+                heard = Some(app.world().resource::<Time>().elapsed_secs_f64() - thrown);
+            }
+        }
+        let flight = crate::flight::flight_time_s(9.0) as f64;
+        let heard = heard.expect("the thud was played");
+        assert!(
+            (heard - flight).abs() <= 0.1 + 1e-6,
+            "heard {heard:.2} s after the throw, it lands after {flight:.2} s"
+        );
     }
 
     #[test]

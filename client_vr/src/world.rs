@@ -4,7 +4,8 @@
 //! Rooms are floors and 3 m walls without ceilings (the sky shows above); display cases are pedestals
 //! with a glass box that shatters into falling shards; every copy of one artifact is drawn from the same
 //! [`ArtifactLook`](heist_shared::artifact::ArtifactLook) — the client cannot tell the real one; guards
-//! carry a lamp over the head in their alert colour; Phantom sits at the workbench with his tool.
+//! carry a lamp over the head in their alert colour; Phantom sits at the workbench with his tool; a
+//! thrown item flies from the hand to where the server landed it along a ballistic arc ([`Flight`]).
 
 use bevy::prelude::*;
 use glam::{Vec2, Vec3};
@@ -13,6 +14,7 @@ use heist_shared::level::Level;
 use heist_shared::protocol::{CaseView, GuardAlert, GuardView, ItemKind, ItemPlace, ItemView, PhantomTool};
 
 use crate::client::{ViveState, ViveSystems};
+use crate::flight::Flight;
 use crate::interp::{DELAY_S, Track};
 use crate::space::{self, BENCH_TOP_M};
 
@@ -292,6 +294,7 @@ fn dress_items(
         };
         commands.entity(e).insert((
             Dressed,
+            Drawn { place: item.place, flight: None },
             Mesh3d(meshes.add(mesh)),
             MeshMaterial3d(materials.add(StandardMaterial { base_color: colour, metallic: 0.3, ..default() })),
             Transform::default(),
@@ -300,14 +303,25 @@ fn dress_items(
     }
 }
 
-fn move_items(
-    mut items: Query<(&ItemView, &mut Transform, &mut Visibility), Without<CaseView>>,
+/// Where an item was when last drawn, and the arc it is drawn along while a throw is in the air.
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub struct Drawn {
+    /// The server's place for it at the last frame.
+    pub place: ItemPlace,
+    /// Its throw, until it lands.
+    pub flight: Option<Flight>,
+}
+
+pub(crate) fn move_items(
+    mut items: Query<(&ItemView, &mut Drawn, &mut Transform, &mut Visibility), Without<CaseView>>,
     cases: Query<&CaseView>,
     state: Res<ViveState>,
     hands: Res<Hands>,
+    time: Res<Time>,
 ) {
     let bench = state.level.as_ref().map_or(Vec2::ZERO, |l| l.workbench);
-    for (item, mut t, mut vis) in &mut items {
+    let now = time.elapsed_secs_f64();
+    for (item, mut drawn, mut t, mut vis) in &mut items {
         let at = match item.place {
             ItemPlace::InCase(c) => {
                 cases.iter().find(|cv| cv.id == c).map(|cv| space::world(cv.position, PEDESTAL_M + 0.1))
@@ -320,7 +334,19 @@ fn move_items(
             ItemPlace::Workbench => Some(space::world(bench, BENCH_TOP_M + 0.08)),
             ItemPlace::Secured | ItemPlace::Discarded => None,
         };
-        match at {
+        // Carried one frame, on the floor the next: thrown. It flies from where it was drawn (the hand).
+        if let (ItemPlace::Carried, ItemPlace::Floor(_), Some(landing)) = (drawn.place, item.place, at) {
+            drawn.flight = Some(Flight::between(t.translation, landing, now));
+        }
+        if !matches!(item.place, ItemPlace::Floor(_)) {
+            drawn.flight = None; // picked up again (or gone) before it landed
+        }
+        drawn.place = item.place;
+        let flying = drawn.flight.and_then(|f| f.at(now));
+        if flying.is_none() {
+            drawn.flight = None;
+        }
+        match flying.or(at) {
             Some(p) => {
                 t.translation = p;
                 *vis = Visibility::Inherited;
@@ -435,5 +461,64 @@ fn move_tool(mut tool: Query<(&Track, &mut Transform), With<PhantomTool>>, time:
             transform.translation = p;
             transform.rotation = r;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use heist_shared::protocol::ItemId;
+    use std::time::Duration;
+
+    #[test]
+    fn a_thrown_item_is_drawn_along_its_arc_from_the_hand_to_where_it_lands() {
+        let hand = Vec3::new(2.0, 1.3, -3.0);
+        let landing_floor = Vec2::new(8.0, 7.0);
+        let mut app = App::new();
+        app.insert_resource(ViveState::default())
+            .insert_resource(Hands { main: hand, other: hand })
+            .insert_resource(Time::<()>::default())
+            .add_systems(Update, move_items);
+        let item = app
+            .world_mut()
+            .spawn((
+                ItemView { id: ItemId(1), kind: ItemKind::Prop, place: ItemPlace::Carried },
+                Drawn { place: ItemPlace::Carried, flight: None },
+                Transform::default(),
+                Visibility::Hidden,
+            ))
+            .id();
+        let step = |app: &mut App, ms: u64| {
+            app.world_mut().resource_mut::<Time>().advance_by(Duration::from_millis(ms));
+            app.update();
+            app.world().get::<Transform>(item).expect("drawn").translation
+        };
+        assert_eq!(step(&mut app, 16), hand, "carried: in the hand");
+        app.world_mut().get_mut::<ItemView>(item).expect("item").place = ItemPlace::Floor(landing_floor);
+        let landing = space::world(landing_floor, 0.08);
+        let thrown_at = app.world().resource::<Time>().elapsed_secs_f64() + 0.016;
+        let arc = Flight::between(hand, landing, thrown_at);
+        let mut drawn = Vec::new();
+        for _ in 0..200 {
+            drawn.push((app.world().resource::<Time>().elapsed_secs_f64() + 0.016, step(&mut app, 16)));
+        }
+        let in_air: Vec<_> = drawn.iter().filter(|(t, _)| *t < thrown_at + arc.duration_s as f64).collect();
+        assert!(in_air.len() > 30, "it flew for {} frames", in_air.len());
+        for (t, p) in &in_air {
+            let expected = arc.at(*t).expect("in the air");
+            assert!(p.distance(expected) < 1e-4, "at {t:.3} s drawn at {p}, the arc says {expected}");
+        }
+        assert!(in_air.iter().any(|(_, p)| p.y > hand.y + 1.0), "it rose above the hand");
+        assert!(drawn.iter().skip(in_air.len()).all(|(_, p)| *p == landing), "then it lies where it landed");
+
+        // Thrown again and caught mid-air: back in the hand at once.
+        app.world_mut().get_mut::<ItemView>(item).expect("item").place = ItemPlace::Carried;
+        step(&mut app, 16);
+        app.world_mut().get_mut::<ItemView>(item).expect("item").place = ItemPlace::Floor(landing_floor);
+        assert_eq!(step(&mut app, 16), hand, "the throw starts from the hand");
+        let mid = step(&mut app, 200);
+        assert!(mid.y > 1.0 && mid != landing, "in the air again: {mid}");
+        app.world_mut().get_mut::<ItemView>(item).expect("item").place = ItemPlace::Carried;
+        assert_eq!(step(&mut app, 16), hand, "picked up: no flight left");
     }
 }
