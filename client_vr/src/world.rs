@@ -22,8 +22,16 @@ use crate::space::{self, BENCH_TOP_M};
 pub const WALL_HEIGHT_M: f32 = 3.0;
 /// Height of a case's pedestal top, metres.
 pub const PEDESTAL_M: f32 = 1.0;
-/// The sky's colour (the screenshot test looks for it).
-pub const SKY: Color = Color::srgb(0.45, 0.65, 0.92);
+/// The night sky's colour.
+pub const SKY: Color = Color::srgb(0.01, 0.015, 0.04);
+/// Moonlight through the open roof, lux (a dim blue wash: the museum is dark but readable).
+pub const MOONLIGHT_LUX: f32 = 200.0;
+/// Light of a display case's spotlight, lumens (as a point light: about 2,000 lux on the artifact).
+pub const CASE_LIGHT_LM: f32 = 100_000.0;
+/// Light of a guard's torch, lumens (as a point light: about 3,000 lux 6 m ahead).
+pub const TORCH_LM: f32 = 1_500_000.0;
+/// Torches that cast shadows at once (shadow maps are the expensive part of a light).
+pub const MAX_SHADOWED_TORCHES: u32 = 4;
 /// The floor's colour.
 pub const FLOOR: Color = Color::srgb(0.55, 0.45, 0.35);
 
@@ -47,7 +55,7 @@ impl Plugin for WorldPlugin {
     fn build(&self, app: &mut App) {
         app.insert_resource(ClearColor(SKY))
             .init_resource::<Hands>()
-            .insert_resource(GlobalAmbientLight { color: Color::WHITE, brightness: 1500.0, ..default() })
+            .insert_resource(GlobalAmbientLight { color: Color::srgb(0.55, 0.62, 0.9), brightness: 60.0, ..default() })
             .add_systems(
                 Update,
                 (
@@ -176,9 +184,14 @@ fn spawn_museum(
             Name::new("exit"),
         ));
     });
-    // Light from above, like a skylight.
+    // Moonlight from above, cold and dim.
     commands.spawn((
-        DirectionalLight { illuminance: 7000.0, shadow_maps_enabled: false, ..default() },
+        DirectionalLight {
+            color: Color::srgb(0.6, 0.7, 1.0),
+            illuminance: MOONLIGHT_LUX,
+            shadow_maps_enabled: false,
+            ..default()
+        },
         Transform::from_xyz(-3.0, 10.0, 6.0).looking_at(Vec3::ZERO, Vec3::Y),
         ChildOf(root),
     ));
@@ -216,6 +229,20 @@ fn dress_cases(
                     Mesh3d(meshes.add(Cuboid::new(0.6, PEDESTAL_M, 0.6))),
                     MeshMaterial3d(pedestal),
                     Transform::from_xyz(0.0, PEDESTAL_M * 0.5, 0.0),
+                ));
+                // A warm spotlight from above onto the artifact (no shadows: there are a dozen).
+                c.spawn((
+                    SpotLight {
+                        color: Color::srgb(1.0, 0.9, 0.75),
+                        intensity: CASE_LIGHT_LM,
+                        range: 4.0,
+                        outer_angle: 0.45,
+                        inner_angle: 0.3,
+                        shadow_maps_enabled: false,
+                        ..default()
+                    },
+                    Transform::from_xyz(0.0, PEDESTAL_M + 1.8, 0.0)
+                        .looking_at(Vec3::new(0.0, PEDESTAL_M, 0.0), Vec3::Z),
                 ));
                 if !case.broken {
                     c.spawn((
@@ -368,13 +395,20 @@ pub fn alert_colour(alert: GuardAlert) -> Color {
     }
 }
 
+/// A guard's torch: where its light falls is where he looks.
+#[derive(Component)]
+pub struct Torch;
+
 fn dress_guards(
     mut commands: Commands,
     guards: Query<(Entity, &GuardView), Without<Dressed>>,
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
+    mut shadowed: Local<u32>,
 ) {
     for (e, g) in &guards {
+        let shadows = *shadowed < MAX_SHADOWED_TORCHES;
+        *shadowed += u32::from(shadows);
         let uniform = materials.add(StandardMaterial { base_color: Color::srgb(0.1, 0.12, 0.3), ..default() });
         let skin = materials.add(StandardMaterial { base_color: Color::srgb(0.85, 0.7, 0.6), ..default() });
         let colour = alert_colour(g.alert);
@@ -405,6 +439,20 @@ fn dress_guards(
                     Mesh3d(meshes.add(Sphere::new(0.08))),
                     MeshMaterial3d(lamp),
                     Transform::from_xyz(0.0, 1.9, 0.0),
+                ));
+                // The torch at the shoulder, aimed ahead and a little down: its cone is the sight cone.
+                c.spawn((
+                    Torch,
+                    SpotLight {
+                        color: Color::srgb(1.0, 0.96, 0.85),
+                        intensity: TORCH_LM,
+                        range: 14.0,
+                        outer_angle: 0.4,
+                        inner_angle: 0.25,
+                        shadow_maps_enabled: shadows,
+                        ..default()
+                    },
+                    Transform::from_xyz(0.25, 1.35, -0.2).with_rotation(Quat::from_rotation_x(-0.12)),
                 ));
             });
     }
