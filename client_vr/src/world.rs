@@ -92,6 +92,25 @@ struct Shard {
 #[derive(Component)]
 struct AlertLamp;
 
+/// The awareness meter over a guard's head: a bar that fills as he grows alert.
+#[derive(Component)]
+pub struct AwarenessMeter;
+
+/// Width of a full awareness meter, metres.
+pub const METER_WIDTH_M: f32 = 0.6;
+
+/// How full a guard's awareness meter is, as stealth games show it: empty on patrol, a third when
+/// something caught his eye, two thirds while he investigates or searches, full in a chase; a guard
+/// going back to his round keeps a third (he is still wary).
+pub fn awareness(alert: GuardAlert) -> f32 {
+    match alert {
+        GuardAlert::Patrolling => 0.0,
+        GuardAlert::Suspicious | GuardAlert::Returning => 1.0 / 3.0,
+        GuardAlert::Investigating | GuardAlert::Searching => 2.0 / 3.0,
+        GuardAlert::Chasing => 1.0,
+    }
+}
+
 #[derive(Component)]
 struct Dressed;
 
@@ -339,7 +358,7 @@ pub struct Drawn {
     pub flight: Option<Flight>,
 }
 
-pub(crate) fn move_items(
+fn move_items(
     mut items: Query<(&ItemView, &mut Drawn, &mut Transform, &mut Visibility), Without<CaseView>>,
     cases: Query<&CaseView>,
     state: Res<ViveState>,
@@ -437,8 +456,15 @@ fn dress_guards(
                 c.spawn((
                     AlertLamp,
                     Mesh3d(meshes.add(Sphere::new(0.08))),
-                    MeshMaterial3d(lamp),
+                    MeshMaterial3d(lamp.clone()),
                     Transform::from_xyz(0.0, 1.9, 0.0),
+                ));
+                c.spawn((
+                    AwarenessMeter,
+                    Mesh3d(meshes.add(Cuboid::new(METER_WIDTH_M, 0.06, 0.02))),
+                    MeshMaterial3d(lamp),
+                    meter_transform(g.alert),
+                    if awareness(g.alert) > 0.0 { Visibility::Inherited } else { Visibility::Hidden },
                 ));
                 // The torch at the shoulder, aimed ahead and a little down: its cone is the sight cone.
                 c.spawn((
@@ -458,9 +484,16 @@ fn dress_guards(
     }
 }
 
+/// The meter's place over the head, its bar scaled to the awareness (growing from the left end).
+fn meter_transform(alert: GuardAlert) -> Transform {
+    let fill = awareness(alert).max(1e-3);
+    Transform::from_xyz(-METER_WIDTH_M * 0.5 * (1.0 - fill), 2.1, 0.0).with_scale(Vec3::new(fill, 1.0, 1.0))
+}
+
 fn move_guards(
-    mut guards: Query<(&GuardView, &Track, &mut Transform, &Children)>,
-    lamps: Query<&MeshMaterial3d<StandardMaterial>, With<AlertLamp>>,
+    mut guards: Query<(&GuardView, &Track, &mut Transform, &Children), Without<AwarenessMeter>>,
+    mut meters: Query<(&mut Transform, &mut Visibility), With<AwarenessMeter>>,
+    lamps: Query<&MeshMaterial3d<StandardMaterial>, Or<(With<AlertLamp>, With<AwarenessMeter>)>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
     time: Res<Time>,
 ) {
@@ -472,6 +505,10 @@ fn move_guards(
         }
         let c = alert_colour(g.alert);
         for child in children.iter() {
+            if let Ok((mut t, mut vis)) = meters.get_mut(child) {
+                t.set_if_neq(meter_transform(g.alert));
+                vis.set_if_neq(if awareness(g.alert) > 0.0 { Visibility::Inherited } else { Visibility::Hidden });
+            }
             if let Ok(m) = lamps.get(child)
                 && let Some(mut mat) = materials.get_mut(&m.0)
                 && mat.base_color != c
@@ -517,6 +554,47 @@ mod tests {
     use super::*;
     use heist_shared::protocol::ItemId;
     use std::time::Duration;
+
+    #[test]
+    fn the_awareness_meter_over_a_guard_fills_as_he_grows_alert_and_hides_on_patrol() {
+        let mut app = App::new();
+        app.insert_resource(Time::<()>::default())
+            .init_resource::<Assets<StandardMaterial>>()
+            .add_systems(Update, move_guards);
+        let view = |alert| GuardView {
+            id: heist_shared::protocol::GuardId(1),
+            name: "Bruno".into(),
+            position: Vec2::ZERO,
+            facing: 0.0,
+            alert,
+        };
+        let guard = app.world_mut().spawn((view(GuardAlert::Patrolling), Track::default(), Transform::default())).id();
+        let meter =
+            app.world_mut().spawn((AwarenessMeter, Transform::default(), Visibility::Inherited, ChildOf(guard))).id();
+        let mut seen = Vec::new();
+        for alert in [
+            GuardAlert::Patrolling,
+            GuardAlert::Suspicious,
+            GuardAlert::Investigating,
+            GuardAlert::Chasing,
+            GuardAlert::Searching,
+            GuardAlert::Returning,
+            GuardAlert::Patrolling,
+        ] {
+            *app.world_mut().get_mut::<GuardView>(guard).expect("guard") = view(alert);
+            app.update();
+            let t = *app.world().get::<Transform>(meter).expect("meter");
+            let shown = *app.world().get::<Visibility>(meter).expect("meter") != Visibility::Hidden;
+            // The bar grows from its left end, which stays put.
+            assert!((t.translation.x - t.scale.x * METER_WIDTH_M * 0.5 + METER_WIDTH_M * 0.5).abs() < 1e-4);
+            seen.push((shown, (t.scale.x * 3.0).round() as u8));
+        }
+        assert_eq!(
+            seen,
+            vec![(false, 0), (true, 1), (true, 2), (true, 3), (true, 2), (true, 1), (false, 0)],
+            "hidden on patrol; a third when suspicious, two thirds investigating or searching, full chasing"
+        );
+    }
 
     #[test]
     fn a_thrown_item_is_drawn_along_its_arc_from_the_hand_to_where_it_lands() {
