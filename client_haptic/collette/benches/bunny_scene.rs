@@ -23,24 +23,23 @@ fn env_or<T: std::str::FromStr>(name: &str, default: T) -> T {
     std::env::var(name).ok().and_then(|v| v.parse().ok()).unwrap_or(default)
 }
 
-/// p50, p99 and max of a list of durations in microseconds.
-fn stats(mut us: Vec<f64>) -> [f64; 3] {
+/// The given percentiles (0–1; 1 is the max) of a list of durations in microseconds.
+fn percentiles(mut us: Vec<f64>, at: [f64; 3]) -> [f64; 3] {
     if us.is_empty() {
         return [f64::NAN; 3];
     }
     us.sort_by(f64::total_cmp);
-    let at = |p: f64| us[((us.len() - 1) as f64 * p).round() as usize];
-    [at(0.5), at(0.99), us[us.len() - 1]]
+    at.map(|p| us[((us.len() - 1) as f64 * p).round() as usize])
 }
 
-/// p99, p99.9 and max of a list of durations in microseconds.
-fn tail(mut us: Vec<f64>) -> [f64; 3] {
-    if us.is_empty() {
-        return [f64::NAN; 3];
-    }
-    us.sort_by(f64::total_cmp);
-    let at = |p: f64| us[((us.len() - 1) as f64 * p).round() as usize];
-    [at(0.99), at(0.999), us[us.len() - 1]]
+/// p50, p99 and max.
+fn stats(us: Vec<f64>) -> [f64; 3] {
+    percentiles(us, [0.5, 0.99, 1.0])
+}
+
+/// p99, p99.9 and max.
+fn tail(us: Vec<f64>) -> [f64; 3] {
+    percentiles(us, [0.99, 0.999, 1.0])
 }
 
 /// A size entry: `N` (both trees) or `TOOL:BUNNY`.
