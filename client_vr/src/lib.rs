@@ -4,7 +4,7 @@
 //! [`intent`] (game-level intents and what they are about), [`predict`] and [`interp`] (the body's
 //! prediction and reconciliation; smooth motion for the rest), the inputs — [`xr`] (headset and
 //! controllers, and the probe that decides whether XR can run), [`desktop`] (keyboard and mouse),
-//! [`bot`] (the Vive bot's brain) — and the presentation: [`world`] (the museum; thrown items fly along [`flight`]'s arcs), [`hud`], [`sound`], and [`walkie`] (the walkie-talkie to Phantom).
+//! [`bot`] (the Vive bot's brain) — and the presentation: [`world`] (the museum, dressed from [`palette`]'s shared meshes and materials; thrown items fly along [`flight`]'s arcs), [`hud`], [`sound`], and [`walkie`] (the walkie-talkie to Phantom).
 //! [`cli`] assembles them into one app per mode (headless, desktop, XR).
 #![warn(missing_docs)]
 // Bevy queries with filters are long by nature.
@@ -18,6 +18,7 @@ pub mod flight;
 pub mod hud;
 pub mod intent;
 pub mod interp;
+pub mod palette;
 pub mod predict;
 pub mod sound;
 pub mod space;

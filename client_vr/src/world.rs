@@ -16,6 +16,7 @@ use heist_shared::protocol::{CaseView, GuardAlert, GuardView, ItemKind, ItemPlac
 use crate::client::{ViveState, ViveSystems};
 use crate::flight::Flight;
 use crate::interp::{DELAY_S, Track};
+use crate::palette::Palette;
 use crate::space::{self, BENCH_TOP_M};
 
 /// Height of the walls, metres.
@@ -55,6 +56,7 @@ impl Plugin for WorldPlugin {
     fn build(&self, app: &mut App) {
         app.insert_resource(ClearColor(SKY))
             .init_resource::<Hands>()
+            .init_resource::<Palette>()
             .insert_resource(GlobalAmbientLight { color: Color::srgb(0.55, 0.62, 0.9), brightness: 60.0, ..default() })
             .add_systems(
                 Update,
@@ -226,27 +228,15 @@ pub fn look_mesh(look: &ArtifactLook) -> Mesh {
     }
 }
 
-fn dress_cases(
-    mut commands: Commands,
-    cases: Query<(Entity, &CaseView), Without<Dressed>>,
-    mut meshes: ResMut<Assets<Mesh>>,
-    mut materials: ResMut<Assets<StandardMaterial>>,
-) {
+fn dress_cases(mut commands: Commands, cases: Query<(Entity, &CaseView), Without<Dressed>>, palette: Res<Palette>) {
     for (e, case) in &cases {
-        let pedestal = materials.add(StandardMaterial { base_color: Color::srgb(0.92, 0.92, 0.9), ..default() });
-        let glass = materials.add(StandardMaterial {
-            base_color: Color::srgba(0.7, 0.9, 1.0, 0.25),
-            alpha_mode: AlphaMode::Blend,
-            perceptual_roughness: 0.05,
-            ..default()
-        });
         commands
             .entity(e)
             .insert((Dressed, Transform::from_translation(space::world(case.position, 0.0)), Visibility::default()))
             .with_children(|c| {
                 c.spawn((
-                    Mesh3d(meshes.add(Cuboid::new(0.6, PEDESTAL_M, 0.6))),
-                    MeshMaterial3d(pedestal),
+                    Mesh3d(palette.pedestal.0.clone()),
+                    MeshMaterial3d(palette.pedestal.1.clone()),
                     Transform::from_xyz(0.0, PEDESTAL_M * 0.5, 0.0),
                 ));
                 // A warm spotlight from above onto the artifact (no shadows: there are a dozen).
@@ -266,8 +256,8 @@ fn dress_cases(
                 if !case.broken {
                     c.spawn((
                         Glass,
-                        Mesh3d(meshes.add(Cuboid::new(0.5, 0.45, 0.5))),
-                        MeshMaterial3d(glass),
+                        Mesh3d(palette.glass.0.clone()),
+                        MeshMaterial3d(palette.glass.1.clone()),
                         Transform::from_xyz(0.0, PEDESTAL_M + 0.225, 0.0),
                     ));
                 }
@@ -279,18 +269,17 @@ fn dress_cases(
 fn shatter(
     mut commands: Commands,
     cases: Query<(&CaseView, &Children), Changed<CaseView>>,
-    glass: Query<(Entity, &GlobalTransform, &MeshMaterial3d<StandardMaterial>), With<Glass>>,
-    mut meshes: ResMut<Assets<Mesh>>,
+    glass: Query<(Entity, &GlobalTransform), With<Glass>>,
+    palette: Res<Palette>,
 ) {
     for (case, children) in &cases {
         if !case.broken {
             continue;
         }
         for child in children.iter() {
-            let Ok((e, at, material)) = glass.get(child) else { continue };
+            let Ok((e, at)) = glass.get(child) else { continue };
             let centre = at.translation();
             commands.entity(e).despawn();
-            let shard = meshes.add(Cuboid::new(0.08, 0.005, 0.06));
             for i in 0..24u32 {
                 // A fixed spray pattern: the look, not physics, is the point.
                 let a = i as f32 * 2.399_963;
@@ -298,8 +287,8 @@ fn shatter(
                 let velocity = Vec3::new(a.cos() * r, 1.0 + (i % 3) as f32 * 0.6, a.sin() * r);
                 commands.spawn((
                     Shard { velocity, spin: Vec3::new(3.0 + i as f32 * 0.3, 5.0, 2.0) },
-                    Mesh3d(shard.clone()),
-                    MeshMaterial3d(material.0.clone()),
+                    Mesh3d(palette.shard.clone()),
+                    MeshMaterial3d(palette.glass.1.clone()),
                     Transform::from_translation(centre + Vec3::new(a.cos(), 0.0, a.sin()) * 0.2),
                 ));
             }
@@ -329,20 +318,18 @@ fn dress_items(
     items: Query<(Entity, &ItemView), Without<Dressed>>,
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
+    mut palette: ResMut<Palette>,
 ) {
     for (e, item) in &items {
-        let (mesh, colour) = match &item.kind {
-            ItemKind::Copy { look, .. } => {
-                let [r, g, b] = look.colour_srgb;
-                (look_mesh(look), Color::srgb_u8(r, g, b))
-            }
-            ItemKind::Prop => (Cuboid::new(0.15, 0.15, 0.15).into(), Color::srgb(0.35, 0.35, 0.38)),
+        let (mesh, material) = match &item.kind {
+            ItemKind::Copy { look, .. } => palette.look(look, &mut meshes, &mut materials),
+            ItemKind::Prop => palette.prop.clone(),
         };
         commands.entity(e).insert((
             Dressed,
             Drawn { place: item.place, flight: None },
-            Mesh3d(meshes.add(mesh)),
-            MeshMaterial3d(materials.add(StandardMaterial { base_color: colour, metallic: 0.3, ..default() })),
+            Mesh3d(mesh),
+            MeshMaterial3d(material),
             Transform::default(),
             Visibility::Hidden,
         ));
@@ -421,47 +408,42 @@ pub struct Torch;
 fn dress_guards(
     mut commands: Commands,
     guards: Query<(Entity, &GuardView), Without<Dressed>>,
-    mut meshes: ResMut<Assets<Mesh>>,
-    mut materials: ResMut<Assets<StandardMaterial>>,
+    palette: Res<Palette>,
     mut shadowed: Local<u32>,
 ) {
     for (e, g) in &guards {
         let shadows = *shadowed < MAX_SHADOWED_TORCHES;
         *shadowed += u32::from(shadows);
-        let uniform = materials.add(StandardMaterial { base_color: Color::srgb(0.1, 0.12, 0.3), ..default() });
-        let skin = materials.add(StandardMaterial { base_color: Color::srgb(0.85, 0.7, 0.6), ..default() });
-        let colour = alert_colour(g.alert);
-        let lamp =
-            materials.add(StandardMaterial { base_color: colour, emissive: colour.to_linear() * 4.0, ..default() });
+        let lamp = palette.alert(g.alert);
         commands
             .entity(e)
             .insert((Dressed, Transform::from_translation(space::world(g.position, 0.0)), Visibility::default()))
             .with_children(|c| {
                 c.spawn((
-                    Mesh3d(meshes.add(Capsule3d::new(0.25, 0.9))),
-                    MeshMaterial3d(uniform),
+                    Mesh3d(palette.guard_body.0.clone()),
+                    MeshMaterial3d(palette.guard_body.1.clone()),
                     Transform::from_xyz(0.0, 0.7, 0.0),
                 ));
                 c.spawn((
-                    Mesh3d(meshes.add(Sphere::new(0.14))),
-                    MeshMaterial3d(skin.clone()),
+                    Mesh3d(palette.guard_head.0.clone()),
+                    MeshMaterial3d(palette.guard_head.1.clone()),
                     Transform::from_xyz(0.0, 1.5, 0.0),
                 ));
                 // The nose shows where the guard looks.
                 c.spawn((
-                    Mesh3d(meshes.add(Cuboid::new(0.06, 0.06, 0.12))),
-                    MeshMaterial3d(skin),
+                    Mesh3d(palette.guard_nose.clone()),
+                    MeshMaterial3d(palette.guard_head.1.clone()),
                     Transform::from_xyz(0.0, 1.5, -0.16),
                 ));
                 c.spawn((
                     AlertLamp,
-                    Mesh3d(meshes.add(Sphere::new(0.08))),
+                    Mesh3d(palette.lamp.clone()),
                     MeshMaterial3d(lamp.clone()),
                     Transform::from_xyz(0.0, 1.9, 0.0),
                 ));
                 c.spawn((
                     AwarenessMeter,
-                    Mesh3d(meshes.add(Cuboid::new(METER_WIDTH_M, 0.06, 0.02))),
+                    Mesh3d(palette.meter.clone()),
                     MeshMaterial3d(lamp),
                     meter_transform(g.alert),
                     if awareness(g.alert) > 0.0 { Visibility::Inherited } else { Visibility::Hidden },
@@ -493,8 +475,8 @@ fn meter_transform(alert: GuardAlert) -> Transform {
 fn move_guards(
     mut guards: Query<(&GuardView, &Track, &mut Transform, &Children), Without<AwarenessMeter>>,
     mut meters: Query<(&mut Transform, &mut Visibility), With<AwarenessMeter>>,
-    lamps: Query<&MeshMaterial3d<StandardMaterial>, Or<(With<AlertLamp>, With<AwarenessMeter>)>>,
-    mut materials: ResMut<Assets<StandardMaterial>>,
+    mut lamps: Query<&mut MeshMaterial3d<StandardMaterial>, Or<(With<AlertLamp>, With<AwarenessMeter>)>>,
+    palette: Res<Palette>,
     time: Res<Time>,
 ) {
     let t = time.elapsed_secs_f64() - DELAY_S;
@@ -503,18 +485,14 @@ fn move_guards(
             transform.translation = p;
             transform.rotation = r;
         }
-        let c = alert_colour(g.alert);
+        let glow = palette.alert(g.alert);
         for child in children.iter() {
             if let Ok((mut t, mut vis)) = meters.get_mut(child) {
                 t.set_if_neq(meter_transform(g.alert));
                 vis.set_if_neq(if awareness(g.alert) > 0.0 { Visibility::Inherited } else { Visibility::Hidden });
             }
-            if let Ok(m) = lamps.get(child)
-                && let Some(mut mat) = materials.get_mut(&m.0)
-                && mat.base_color != c
-            {
-                mat.base_color = c;
-                mat.emissive = c.to_linear() * 4.0;
+            if let Ok(mut m) = lamps.get_mut(child) {
+                m.set_if_neq(MeshMaterial3d(glow.clone()));
             }
         }
     }
@@ -523,16 +501,13 @@ fn move_guards(
 fn dress_tool(
     mut commands: Commands,
     tool: Query<Entity, (With<PhantomTool>, Without<Dressed>)>,
-    mut meshes: ResMut<Assets<Mesh>>,
-    mut materials: ResMut<Assets<StandardMaterial>>,
+    palette: Res<Palette>,
 ) {
     for e in &tool {
-        let steel =
-            materials.add(StandardMaterial { base_color: Color::srgb(0.8, 0.8, 0.85), metallic: 0.9, ..default() });
         commands.entity(e).insert((
             Dressed,
-            Mesh3d(meshes.add(Cylinder::new(0.006, 0.14))),
-            MeshMaterial3d(steel),
+            Mesh3d(palette.tool.0.clone()),
+            MeshMaterial3d(palette.tool.1.clone()),
             Transform::default(),
             Visibility::default(),
         ));
@@ -559,7 +534,9 @@ mod tests {
     fn the_awareness_meter_over_a_guard_fills_as_he_grows_alert_and_hides_on_patrol() {
         let mut app = App::new();
         app.insert_resource(Time::<()>::default())
+            .init_resource::<Assets<Mesh>>()
             .init_resource::<Assets<StandardMaterial>>()
+            .init_resource::<Palette>()
             .add_systems(Update, move_guards);
         let view = |alert| GuardView {
             id: heist_shared::protocol::GuardId(1),
@@ -569,8 +546,16 @@ mod tests {
             alert,
         };
         let guard = app.world_mut().spawn((view(GuardAlert::Patrolling), Track::default(), Transform::default())).id();
-        let meter =
-            app.world_mut().spawn((AwarenessMeter, Transform::default(), Visibility::Inherited, ChildOf(guard))).id();
+        let meter = app
+            .world_mut()
+            .spawn((
+                AwarenessMeter,
+                MeshMaterial3d::<StandardMaterial>::default(),
+                Transform::default(),
+                Visibility::Inherited,
+                ChildOf(guard),
+            ))
+            .id();
         let mut seen = Vec::new();
         for alert in [
             GuardAlert::Patrolling,
@@ -587,6 +572,12 @@ mod tests {
             let shown = *app.world().get::<Visibility>(meter).expect("meter") != Visibility::Hidden;
             // The bar grows from its left end, which stays put.
             assert!((t.translation.x - t.scale.x * METER_WIDTH_M * 0.5 + METER_WIDTH_M * 0.5).abs() < 1e-4);
+            let glow = app.world().get::<MeshMaterial3d<StandardMaterial>>(meter).map(|m| m.0.clone());
+            assert_eq!(
+                glow,
+                Some(app.world().resource::<Palette>().alert(alert)),
+                "the meter glows in the alert's colour"
+            );
             seen.push((shown, (t.scale.x * 3.0).round() as u8));
         }
         assert_eq!(
@@ -594,6 +585,42 @@ mod tests {
             vec![(false, 0), (true, 1), (true, 2), (true, 3), (true, 2), (true, 1), (false, 0)],
             "hidden on patrol; a third when suspicious, two thirds investigating or searching, full chasing"
         );
+    }
+
+    #[test]
+    fn every_case_guard_and_copy_is_dressed_from_the_shared_palette() {
+        use heist_shared::artifact::{ArtifactKind, look};
+        use heist_shared::protocol::{CaseId, GuardId, ItemId};
+        let mut app = App::new();
+        app.init_resource::<Assets<Mesh>>()
+            .init_resource::<Assets<StandardMaterial>>()
+            .init_resource::<Palette>()
+            .add_systems(Update, (dress_cases, dress_items, dress_guards));
+        let counts = |app: &App| {
+            (app.world().resource::<Assets<Mesh>>().len(), app.world().resource::<Assets<StandardMaterial>>().len())
+        };
+        let before = counts(&app);
+        for i in 0..12u16 {
+            app.world_mut().spawn(CaseView { id: CaseId(i), position: Vec2::new(f32::from(i), 0.0), broken: false });
+            let kind = if i % 2 == 0 { ArtifactKind::Crown } else { ArtifactKind::Idol };
+            let item = ItemKind::Copy { artifact: kind, look: look(kind) };
+            app.world_mut().spawn(ItemView { id: ItemId(i), kind: item, place: ItemPlace::InCase(CaseId(i)) });
+            app.world_mut().spawn(ItemView { id: ItemId(100 + i), kind: ItemKind::Prop, place: ItemPlace::Carried });
+        }
+        for (i, alert) in [GuardAlert::Patrolling, GuardAlert::Chasing, GuardAlert::Searching].into_iter().enumerate() {
+            app.world_mut().spawn(GuardView {
+                id: GuardId(i as u16),
+                name: format!("guard {i}"),
+                position: Vec2::ZERO,
+                facing: 0.0,
+                alert,
+            });
+        }
+        app.update();
+        let after = counts(&app);
+        assert_eq!(after, (before.0 + 2, before.1 + 2), "only the two looks were new: one mesh and material each");
+        let dressed = app.world_mut().query_filtered::<(), With<Dressed>>().iter(app.world()).count();
+        assert_eq!(dressed, 12 + 24 + 3, "everything was dressed");
     }
 
     #[test]

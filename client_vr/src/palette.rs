@@ -1,0 +1,132 @@
+//! The meshes and materials the museum is dressed with, made once and shared: every case, guard, copy
+//! of a kind and shard uses the same handles (so the renderer batches them and nothing is created per
+//! object at run time). A guard's alert shows by swapping his lamp's and meter's material for the
+//! alert's, never by editing a material.
+//!
+//! You need this module to dress something new: take its handles from [`Palette`].
+
+use bevy::prelude::*;
+use heist_shared::artifact::ArtifactLook;
+use heist_shared::protocol::GuardAlert;
+
+use crate::world::{METER_WIDTH_M, PEDESTAL_M, alert_colour, look_mesh};
+
+/// Every alert state, in the order of [`Palette::alert`].
+pub const ALERTS: [GuardAlert; 6] = [
+    GuardAlert::Patrolling,
+    GuardAlert::Suspicious,
+    GuardAlert::Investigating,
+    GuardAlert::Chasing,
+    GuardAlert::Returning,
+    GuardAlert::Searching,
+];
+
+/// A mesh with its material.
+pub type Look = (Handle<Mesh>, Handle<StandardMaterial>);
+
+/// The shared meshes and materials.
+#[derive(Resource)]
+pub struct Palette {
+    /// A display case's pedestal.
+    pub pedestal: Look,
+    /// Its glass box (the shards use its material).
+    pub glass: Look,
+    /// A glass shard.
+    pub shard: Handle<Mesh>,
+    /// A guard's body, in uniform.
+    pub guard_body: Look,
+    /// His head.
+    pub guard_head: Look,
+    /// His nose (shows where he looks).
+    pub guard_nose: Handle<Mesh>,
+    /// The alert lamp over his head.
+    pub lamp: Handle<Mesh>,
+    /// The awareness meter's bar.
+    pub meter: Handle<Mesh>,
+    /// A worthless prop.
+    pub prop: Look,
+    /// Phantom's steel tool.
+    pub tool: Look,
+    alerts: [Handle<StandardMaterial>; 6],
+    looks: Vec<(ArtifactLook, Look)>,
+}
+
+impl FromWorld for Palette {
+    fn from_world(world: &mut World) -> Self {
+        let mut m = |mesh: Mesh| world.resource_mut::<Assets<Mesh>>().add(mesh);
+        let (pedestal, glass, shard) = (
+            m(Cuboid::new(0.6, PEDESTAL_M, 0.6).into()),
+            m(Cuboid::new(0.5, 0.45, 0.5).into()),
+            m(Cuboid::new(0.08, 0.005, 0.06).into()),
+        );
+        let (body, head, nose, lamp, meter) = (
+            m(Capsule3d::new(0.25, 0.9).into()),
+            m(Sphere::new(0.14).into()),
+            m(Cuboid::new(0.06, 0.06, 0.12).into()),
+            m(Sphere::new(0.08).into()),
+            m(Cuboid::new(METER_WIDTH_M, 0.06, 0.02).into()),
+        );
+        let (prop, tool) = (m(Cuboid::new(0.15, 0.15, 0.15).into()), m(Cylinder::new(0.006, 0.14).into()));
+        let mut materials = world.resource_mut::<Assets<StandardMaterial>>();
+        let mut plain = |c: Color| materials.add(StandardMaterial { base_color: c, ..default() });
+        let (white, uniform, skin) = (
+            plain(Color::srgb(0.92, 0.92, 0.9)),
+            plain(Color::srgb(0.1, 0.12, 0.3)),
+            plain(Color::srgb(0.85, 0.7, 0.6)),
+        );
+        let glass_material = materials.add(StandardMaterial {
+            base_color: Color::srgba(0.7, 0.9, 1.0, 0.25),
+            alpha_mode: AlphaMode::Blend,
+            perceptual_roughness: 0.05,
+            ..default()
+        });
+        let prop_material =
+            materials.add(StandardMaterial { base_color: Color::srgb(0.35, 0.35, 0.38), metallic: 0.3, ..default() });
+        let steel =
+            materials.add(StandardMaterial { base_color: Color::srgb(0.8, 0.8, 0.85), metallic: 0.9, ..default() });
+        let alerts = ALERTS.map(|a| {
+            let c = alert_colour(a);
+            materials.add(StandardMaterial { base_color: c, emissive: c.to_linear() * 4.0, ..default() })
+        });
+        Self {
+            pedestal: (pedestal, white),
+            glass: (glass, glass_material),
+            shard,
+            guard_body: (body, uniform),
+            guard_head: (head, skin),
+            guard_nose: nose,
+            lamp,
+            meter,
+            prop: (prop, prop_material),
+            tool: (tool, steel),
+            alerts,
+            looks: Vec::new(),
+        }
+    }
+}
+
+impl Palette {
+    /// The glowing material of an alert state (lamp and meter).
+    pub fn alert(&self, alert: GuardAlert) -> Handle<StandardMaterial> {
+        let i = ALERTS.iter().position(|a| *a == alert).unwrap_or(0);
+        self.alerts[i].clone()
+    }
+
+    /// The mesh and material every copy with this look is drawn with (made on first use).
+    pub fn look(
+        &mut self,
+        look: &ArtifactLook,
+        meshes: &mut Assets<Mesh>,
+        materials: &mut Assets<StandardMaterial>,
+    ) -> Look {
+        if let Some((_, handles)) = self.looks.iter().find(|(l, _)| l == look) {
+            return handles.clone();
+        }
+        let [r, g, b] = look.colour_srgb;
+        let material =
+            materials.add(StandardMaterial { base_color: Color::srgb_u8(r, g, b), metallic: 0.3, ..default() });
+        let handles = (meshes.add(look_mesh(look)), material);
+        self.looks.push((look.clone(), handles.clone()));
+        handles
+    }
+}
