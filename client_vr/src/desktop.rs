@@ -53,11 +53,14 @@ impl Plugin for DesktopPlugin {
     }
 }
 
+/// The desktop camera's vertical field of view, degrees.
+pub const FOV_DEG: f32 = 70.0;
+
 fn spawn_camera(mut commands: Commands) {
     commands.spawn((
         PlayerCamera,
         Camera3d::default(),
-        Projection::Perspective(PerspectiveProjection { fov: 70f32.to_radians(), ..default() }),
+        Projection::Perspective(PerspectiveProjection { fov: FOV_DEG.to_radians(), ..default() }),
         Transform::from_xyz(0.0, space::EYE_HEIGHT_M, 0.0),
     ));
 }

@@ -1,13 +1,15 @@
 //! The desktop mode renders the museum: the real binary under Xvfb on Mesa's CPU Vulkan (lavapipe) joins
 //! a running server, takes a screenshot, and the picture is checked — a museum at night: mostly dark,
-//! with what is lit standing out, enough distinct colours. It also checks the start-up line: no OpenXR runtime here.
+//! with what is lit standing out, enough distinct colours, and every guard in view drawn where the server
+//! says he is. It also checks the start-up line: no OpenXR runtime here.
 
 use std::io::Read as _;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+use client_vr::space;
 use heist_server::{ServerOptions, build_server};
-use heist_shared::protocol::TICK_HZ;
+use heist_shared::protocol::{GuardView, TICK_HZ};
 
 fn decode(path: &std::path::Path) -> (u32, u32, Vec<[u8; 3]>) {
     let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).expect("screenshot exists")));
@@ -95,4 +97,39 @@ fn desktop_mode_joins_a_server_and_shows_the_museum() {
     assert!(median > 4.0, "but not black: the rooms are readable (median luma {median:.1})");
     assert!(lit > 0.001, "the lit things stand out ({:.2} % of the picture over 5 x its median)", lit * 100.0);
     assert!(colours.len() > 200, "a scene, not a blank");
+
+    // Every guard the camera can see is drawn where the server says he is: his alert lamp (green on
+    // patrol, glowing, 1.9 m up) lies within 10 px of his server position projected to the screen.
+    let level = heist_shared::level::Level::museum();
+    let walls = heist_shared::level::WallSet::new(&level);
+    let guards: Vec<(String, glam::Vec2)> = {
+        let world = server.app.world_mut();
+        world.query::<&GuardView>().iter(world).map(|g| (g.name.clone(), g.position)).collect()
+    };
+    let eye = space::world(level.vive_spawn, space::EYE_HEIGHT_M);
+    // The desktop camera faces east (facing 0) with the default pitch until the mouse moves it.
+    let pitch = client_vr::desktop::Look::default().pitch;
+    let turn = (space::rotation(0.0) * glam::Quat::from_rotation_x(pitch)).inverse();
+    let half = (client_vr::desktop::FOV_DEG.to_radians() * 0.5).tan();
+    let is_lamp = |p: [u8; 3]| {
+        let [r, g, b] = p.map(i32::from);
+        g > 120 && g > r + 40 && g > b + 30
+    };
+    let mut checked = Vec::new();
+    for (name, at) in &guards {
+        let local = turn * (space::world(*at, 1.9) - eye);
+        let (x, y) = (local.x / (-local.z * half * w as f32 / h as f32), local.y / (-local.z * half));
+        if local.z > -0.5 || x.abs() > 0.95 || y.abs() > 0.95 || !walls.line_of_sight(level.vive_spawn, *at) {
+            continue; // behind, off screen or behind a wall
+        }
+        let (sx, sy) = (((x + 1.0) * 0.5 * w as f32) as i64, ((1.0 - y) * 0.5 * h as f32) as i64);
+        let near = (-10..=10i64).flat_map(|dy| (-10..=10i64).map(move |dx| (sx + dx, sy + dy)));
+        let lamp = near
+            .filter(|(x, y)| (0..w as i64).contains(x) && (0..h as i64).contains(y))
+            .any(|(x, y)| is_lamp(px[(y as u32 * w + x as u32) as usize]));
+        println!("guard {name} at {at} projects to ({sx}, {sy}): lamp {}", if lamp { "seen" } else { "missing" });
+        assert!(lamp, "{name}'s lamp is drawn where the server puts him, at ({sx}, {sy})");
+        checked.push(name.clone());
+    }
+    assert!(!checked.is_empty(), "at least one guard is in view from the spawn: {guards:?}");
 }
