@@ -9,6 +9,8 @@ use std::time::Duration;
 use haptico::HapticClock;
 use haptico::timing::{make_current_thread_realtime, next_deadline, wait_until};
 
+use crate::spec::MAX_OBJECTS;
+
 pub use collette::pipeline::StepTiming;
 
 /// Settings of the collision thread.
@@ -47,11 +49,12 @@ impl CollisionConfig {
         (1e9 / self.rate_hz.max(1.0) as f64) as u64
     }
 
-    /// collette's settings for these (objects: the tool and `max_objects`; one watcher each).
-    pub(crate) fn pipeline(&self, max_objects: usize, budget: Option<Duration>) -> collette::pipeline::CollisionConfig {
+    /// collette's settings for these (objects: the tool and [`MAX_OBJECTS`], one watcher each; `budget`
+    /// overrides `budget_us`).
+    pub(crate) fn pipeline(&self, budget: Option<Duration>) -> collette::pipeline::CollisionConfig {
         collette::pipeline::CollisionConfig {
-            max_objects: max_objects + 1,
-            max_watchers: max_objects,
+            max_objects: MAX_OBJECTS + 1,
+            max_watchers: MAX_OBJECTS,
             command_capacity: 64,
             period: Duration::from_nanos(self.period_ns()),
             step_budget: budget.unwrap_or(Duration::from_micros(self.budget_us as u64)),

@@ -13,7 +13,7 @@ use haptico::{Device, HapticCore, HapticEvents};
 use crate::force::{ForceSample, RigTelemetry};
 use crate::rig::{Outputs, Parts};
 use crate::scene::Scene;
-use crate::spec::{MAX_OBJECTS, ObjectSpec, ToolSpec};
+use crate::spec::{ObjectSpec, ToolSpec};
 use crate::{Result, RigConfig};
 
 /// A rig without threads.
@@ -38,8 +38,7 @@ impl<D: Device> Lockstep<D> {
         collision_every: u64,
         budget: Option<Duration>,
     ) -> Result<Self> {
-        let (collision, stepper) =
-            collette::pipeline::pipeline(&config.collision.pipeline(MAX_OBJECTS, budget), Delegator::new());
+        let (collision, stepper) = collette::pipeline::pipeline(&config.collision.pipeline(budget), Delegator::new());
         let Parts { mut stage, scene, outputs } = Parts::new(device.specs(), tool, config, collision)?;
         let mut events = HapticEvents::default();
         events.force_on_haptic_tick.add_delegate(move |tick| stage.on_tick(tick));

@@ -141,7 +141,7 @@ impl<D: Device + 'static> HapticRig<D> {
     ) -> Result<Self> {
         let clock = HapticClock::new();
         let pacer = RigPacer::new(clock, &config.collision);
-        let pipeline = config.collision.pipeline(MAX_OBJECTS, None);
+        let pipeline = config.collision.pipeline(None);
         let collision = CollisionThread::spawn_with(&pipeline, on_collision, pacer).map_err(RigError::Spawn)?;
         // On error, dropping the scene stops the collision thread.
         let Parts { mut stage, scene, outputs } = Parts::new(device.specs(), tool, &config, collision)?;

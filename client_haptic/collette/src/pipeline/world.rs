@@ -296,38 +296,18 @@ impl CollisionWorld {
             });
             remaining = remaining.saturating_sub(1);
             let pair = match (self.objects.get(w.a.0 as usize), self.objects.get(w.b.0 as usize)) {
-                (Some(Some(a)), Some(Some(b))) => {
-                    let (pa, pb) = (*a.pose.output_buffer(), *b.pose.output_buffer());
-                    let region = self.region;
-                    let inside = |tree: &InnerSphereTree, pose: &Pose| {
-                        region.is_none_or(|r| {
-                            r.intersects_sphere(
-                                pose.transform_point(tree.root().bound.center),
-                                tree.root().bound.radius,
-                            )
-                        })
-                    };
-                    let timestamp_us = pa.timestamp_us.min(pb.timestamp_us);
-                    Some((
-                        &*a.tree,
-                        pa,
-                        &*b.tree,
-                        pb,
-                        timestamp_us,
-                        inside(&a.tree, &pa.pose) && inside(&b.tree, &pb.pose),
-                    ))
-                }
+                (Some(Some(a)), Some(Some(b))) => Some(Pair::of(a, b, self.region)),
                 _ => None,
             };
-            let timestamp_us = pair.map_or(0, |p| p.4);
+            let timestamp_us = pair.as_ref().map_or(0, |p| p.timestamp_us);
             let (ids, sequence) = ((w.a.0, w.b.0), self.sequence);
             match &mut w.out {
                 WatcherOutput::Contacts(out) => {
                     let set = out.input_buffer_mut();
                     set.clear();
-                    if let Some((ta, pa, tb, pb, _, true)) = pair {
+                    if let Some(Pair { a, pa, b, pb, inside: true, .. }) = pair {
                         let budget = share.map_or(Budget::Unlimited, Budget::Deadline);
-                        let result = overlap_budgeted(ta, &pa.pose, tb, &pb.pose, budget, &mut self.workspace, set);
+                        let result = overlap_budgeted(a, &pa.pose, b, &pb.pose, budget, &mut self.workspace, set);
                         report.budget_hit |= !result.complete;
                         report.queried += 1;
                     }
@@ -342,8 +322,8 @@ impl CollisionWorld {
                 WatcherOutput::Near(out) => {
                     let set = out.input_buffer_mut();
                     set.clear();
-                    if let Some((_, pa, tb, pb, _, true)) = pair {
-                        gather_near(tb, &pb.pose, pa.pose.translation, pa.reach, &mut self.workspace, set);
+                    if let Some(Pair { pa, b, pb, inside: true, .. }) = pair {
+                        gather_near(b, &pb.pose, pa.pose.translation, pa.reach, &mut self.workspace, set);
                         report.queried += 1;
                     }
                     (set.object_a, set.object_b) = ids;
@@ -354,6 +334,36 @@ impl CollisionWorld {
             }
         }
         report
+    }
+}
+
+/// A watched pair whose two objects are present: their trees and latest poses, the older pose's time,
+/// and whether both lie in the region.
+struct Pair<'a> {
+    a: &'a InnerSphereTree,
+    pa: TimedPose,
+    b: &'a InnerSphereTree,
+    pb: TimedPose,
+    timestamp_us: u64,
+    inside: bool,
+}
+
+impl<'a> Pair<'a> {
+    fn of(a: &'a ObjectSlot, b: &'a ObjectSlot, region: Option<Aabb>) -> Self {
+        let (pa, pb) = (*a.pose.output_buffer(), *b.pose.output_buffer());
+        let inside = |tree: &InnerSphereTree, pose: &Pose| {
+            region.is_none_or(|r| {
+                r.intersects_sphere(pose.transform_point(tree.root().bound.center), tree.root().bound.radius)
+            })
+        };
+        Self {
+            a: &a.tree,
+            pa,
+            b: &b.tree,
+            pb,
+            timestamp_us: pa.timestamp_us.min(pb.timestamp_us),
+            inside: inside(&a.tree, &pa.pose) && inside(&b.tree, &pb.pose),
+        }
     }
 }
 
