@@ -131,8 +131,8 @@ mod tests {
         frames.iter().fold((0.0, 0.0), |(l, r), f| (l + f.0 * f.0, r + f.1 * f.1))
     }
 
-    /// Glass breaking at `glass` heard by Vive at the origin facing `facing`: (left, right) energy.
-    fn hear_glass(facing: f32, glass: Vec2) -> (f32, f32) {
+    /// An app with the sound system, memory output and Vive at the origin facing `facing`.
+    fn listener(facing: f32) -> App {
         let mut app = App::new();
         app.add_plugins(MinimalPlugins).add_message::<Happened>();
         let state = ViveState {
@@ -142,6 +142,12 @@ mod tests {
         app.insert_resource(state).insert_resource(Intent { facing, ..Default::default() });
         let settings = AudioSettings { output: AudioOutput::Manual, spatial: SpatialMode::Hrtf, ..Default::default() };
         add(&mut app, &settings).expect("audio starts");
+        app
+    }
+
+    /// Glass breaking at `glass` heard by Vive at the origin facing `facing`: (left, right) energy.
+    fn hear_glass(facing: f32, glass: Vec2) -> (f32, f32) {
+        let mut app = listener(facing);
         app.world_mut().write_message(Happened(GameEvent::Noise {
             kind: NoiseKind::Glass,
             position: glass,
@@ -165,16 +171,8 @@ mod tests {
 
     #[test]
     fn a_thrown_item_is_heard_landing_when_it_is_drawn_landing_not_when_thrown() {
-        let mut app = App::new();
-        app.add_plugins(MinimalPlugins).add_message::<Happened>();
+        let mut app = listener(0.0);
         app.insert_resource(bevy::time::TimeUpdateStrategy::ManualDuration(std::time::Duration::from_millis(100)));
-        let state = ViveState {
-            predictor: Some(crate::predict::Predictor::new(WallSet::default(), Vec2::ZERO)),
-            ..Default::default()
-        };
-        app.insert_resource(state).insert_resource(Intent::default());
-        let settings = AudioSettings { output: AudioOutput::Manual, spatial: SpatialMode::Hrtf, ..Default::default() };
-        add(&mut app, &settings).expect("audio starts");
         app.update();
         let landing = Vec2::new(9.0, 0.0);
         app.world_mut().write_message(Happened(GameEvent::Noise {
