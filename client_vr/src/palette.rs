@@ -9,6 +9,7 @@ use bevy::prelude::*;
 use heist_shared::artifact::ArtifactLook;
 use heist_shared::protocol::GuardAlert;
 
+use crate::textures::{self, SIZE};
 use crate::world::{METER_WIDTH_M, PEDESTAL_M, alert_colour, look_mesh};
 
 /// Every alert state, in the order of [`Palette::alert`].
@@ -27,14 +28,26 @@ pub type Look = (Handle<Mesh>, Handle<StandardMaterial>);
 /// The shared meshes and materials.
 #[derive(Resource)]
 pub struct Palette {
+    /// Parquet for the floors (their meshes' UVs in metres, see [`textures::tile_uvs`]).
+    pub parquet: Handle<StandardMaterial>,
+    /// Painted plaster for the walls.
+    pub plaster: Handle<StandardMaterial>,
+    /// Dark wood: skirting boards, doors, the workbench.
+    pub wood: Handle<StandardMaterial>,
+    /// A unit cube (sized by its transform: skirting boards).
+    pub unit_cube: Handle<Mesh>,
     /// A display case's pedestal.
     pub pedestal: Look,
     /// Its glass box (the shards use its material).
     pub glass: Look,
     /// A glass shard.
     pub shard: Handle<Mesh>,
-    /// A guard's body, in uniform.
+    /// A guard's torso, in uniform (his legs and arms share the material).
     pub guard_body: Look,
+    /// A guard's leg (hung from the hip joint).
+    pub guard_leg: Handle<Mesh>,
+    /// A guard's arm (hung from the shoulder joint).
+    pub guard_arm: Handle<Mesh>,
     /// His head.
     pub guard_head: Look,
     /// His nose (shows where he looks).
@@ -59,18 +72,44 @@ impl FromWorld for Palette {
             m(Cuboid::new(0.5, 0.45, 0.5).into()),
             m(Cuboid::new(0.08, 0.005, 0.06).into()),
         );
+        // Low-poly figures: eight sides round, as stealth games draw guards far off.
+        let limb = |r: f32, l: f32| Capsule3d::new(r, l).mesh().longitudes(8).latitudes(4).build();
+        let (leg, arm) = (m(limb(0.075, 0.7)), m(limb(0.055, 0.56)));
         let (body, head, nose, lamp, meter) = (
-            m(Capsule3d::new(0.25, 0.9).into()),
-            m(Sphere::new(0.14).into()),
+            m(limb(0.19, 0.4)),
+            m(Sphere::new(0.13).mesh().uv(10, 6)),
             m(Cuboid::new(0.06, 0.06, 0.12).into()),
             m(Sphere::new(0.08).into()),
             m(Cuboid::new(METER_WIDTH_M, 0.06, 0.02).into()),
         );
         let (prop, tool) = (m(Cuboid::new(0.15, 0.15, 0.15).into()), m(Cylinder::new(0.006, 0.14).into()));
+        let mut images = world.resource_mut::<Assets<Image>>();
+        let (parquet, plaster, marble) = (
+            images.add(textures::parquet(SIZE).image()),
+            images.add(textures::plaster(SIZE).image()),
+            images.add(textures::marble(SIZE).image()),
+        );
+        let unit_cube = world.resource_mut::<Assets<Mesh>>().add(Cuboid::new(1.0, 1.0, 1.0));
         let mut materials = world.resource_mut::<Assets<StandardMaterial>>();
+        let parquet = materials.add(StandardMaterial {
+            base_color_texture: Some(parquet),
+            perceptual_roughness: 0.45,
+            reflectance: 0.4,
+            ..default()
+        });
+        let plaster = materials.add(StandardMaterial {
+            base_color_texture: Some(plaster),
+            perceptual_roughness: 0.95,
+            ..default()
+        });
+        let marble = materials.add(StandardMaterial {
+            base_color_texture: Some(marble),
+            perceptual_roughness: 0.25,
+            ..default()
+        });
         let mut plain = |c: Color| materials.add(StandardMaterial { base_color: c, ..default() });
-        let (white, uniform, skin) = (
-            plain(Color::srgb(0.92, 0.92, 0.9)),
+        let (wood, uniform, skin) = (
+            plain(Color::srgb(0.22, 0.12, 0.06)),
             plain(Color::srgb(0.1, 0.12, 0.3)),
             plain(Color::srgb(0.85, 0.7, 0.6)),
         );
@@ -89,10 +128,16 @@ impl FromWorld for Palette {
             materials.add(StandardMaterial { base_color: c, emissive: c.to_linear() * 4.0, ..default() })
         });
         Self {
-            pedestal: (pedestal, white),
+            parquet,
+            plaster,
+            wood,
+            unit_cube,
+            pedestal: (pedestal, marble),
             glass: (glass, glass_material),
             shard,
             guard_body: (body, uniform),
+            guard_leg: leg,
+            guard_arm: arm,
             guard_head: (head, skin),
             guard_nose: nose,
             lamp,

@@ -14,10 +14,12 @@ use heist_shared::level::Level;
 use heist_shared::protocol::{CaseView, GuardAlert, GuardView, ItemKind, ItemPlace, ItemView, PhantomTool};
 
 use crate::client::{ViveState, ViveSystems};
+use crate::figure::{self, Gait, Limb, Neck};
 use crate::flight::Flight;
 use crate::interp::{DELAY_S, Track};
 use crate::palette::Palette;
 use crate::space::{self, BENCH_TOP_M};
+use crate::textures::tile_uvs;
 
 /// Height of the walls, metres.
 pub const WALL_HEIGHT_M: f32 = 3.0;
@@ -33,8 +35,6 @@ pub const CASE_LIGHT_LM: f32 = 100_000.0;
 pub const TORCH_LM: f32 = 1_500_000.0;
 /// Torches that cast shadows at once (shadow maps are the expensive part of a light).
 pub const MAX_SHADOWED_TORCHES: u32 = 4;
-/// The floor's colour.
-pub const FLOOR: Color = Color::srgb(0.55, 0.45, 0.35);
 
 /// Where carried items are held, world positions (the desktop camera's or the controllers').
 #[derive(Resource, Clone, Copy, Debug, Default)]
@@ -122,13 +122,19 @@ fn build_museum(
     built: Query<(), With<Museum>>,
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
+    palette: Res<Palette>,
 ) {
     let Some(level) = state.level.as_ref() else { return };
     if !built.is_empty() {
         return;
     }
-    spawn_museum(&mut commands, level, state.walls.as_ref(), &mut meshes, &mut materials);
+    spawn_museum(&mut commands, level, state.walls.as_ref(), &mut meshes, &mut materials, &palette);
 }
+
+/// Height of the skirting boards along the walls, metres.
+pub const SKIRTING_M: f32 = 0.15;
+/// Light of the exit sign, lumens (a green glow on the floor around it).
+pub const EXIT_SIGN_LM: f32 = 20_000.0;
 
 fn spawn_museum(
     commands: &mut Commands,
@@ -136,12 +142,9 @@ fn spawn_museum(
     walls: Option<&heist_shared::level::WallSet>,
     meshes: &mut Assets<Mesh>,
     materials: &mut Assets<StandardMaterial>,
+    palette: &Palette,
 ) {
     let root = commands.spawn((Museum, Transform::default(), Visibility::default())).id();
-    let floor = materials.add(StandardMaterial { base_color: FLOOR, perceptual_roughness: 0.9, ..default() });
-    let wall = materials.add(StandardMaterial { base_color: Color::srgb(0.86, 0.84, 0.78), ..default() });
-    let door = materials.add(StandardMaterial { base_color: Color::srgb(0.45, 0.28, 0.15), ..default() });
-    let wood = materials.add(StandardMaterial { base_color: Color::srgb(0.5, 0.33, 0.2), ..default() });
     let cloth = materials.add(StandardMaterial { base_color: Color::srgb(0.15, 0.15, 0.2), ..default() });
     let exit = materials.add(StandardMaterial {
         base_color: Color::srgb(0.1, 0.8, 0.3),
@@ -153,15 +156,15 @@ fn spawn_museum(
             let size = room.max - room.min;
             let centre = room.centre();
             museum.spawn((
-                Mesh3d(meshes.add(Cuboid::new(size.x, 0.1, size.y))),
-                MeshMaterial3d(floor.clone()),
+                Mesh3d(meshes.add(tile_uvs(Cuboid::new(size.x, 0.1, size.y).into(), size))),
+                MeshMaterial3d(palette.parquet.clone()),
                 Transform::from_translation(space::world(centre, -0.05)),
                 Name::new(format!("floor {}", room.id)),
             ));
         }
         if let Some(walls) = walls {
             for (segments, material, height) in
-                [(&walls.walls, &wall, WALL_HEIGHT_M), (&walls.closed_doors, &door, 2.2)]
+                [(&walls.walls, &palette.plaster, WALL_HEIGHT_M), (&walls.closed_doors, &palette.wood, 2.2)]
             {
                 for s in segments {
                     let d = s.b - s.a;
@@ -170,19 +173,29 @@ fn spawn_museum(
                         continue;
                     }
                     let mid = (s.a + s.b) * 0.5;
+                    let along = Quat::from_rotation_y(d.y.atan2(d.x));
                     museum.spawn((
-                        Mesh3d(meshes.add(Cuboid::new(len + 0.15, height, 0.15))),
+                        Mesh3d(
+                            meshes.add(tile_uvs(Cuboid::new(len + 0.15, height, 0.15).into(), Vec2::new(len, height))),
+                        ),
                         MeshMaterial3d(material.clone()),
-                        Transform::from_translation(space::world(mid, height * 0.5))
-                            .with_rotation(Quat::from_rotation_y(d.y.atan2(d.x))),
+                        Transform::from_translation(space::world(mid, height * 0.5)).with_rotation(along),
+                    ));
+                    // A dark skirting board along both faces (one shared cube, sized by its transform).
+                    museum.spawn((
+                        Mesh3d(palette.unit_cube.clone()),
+                        MeshMaterial3d(palette.wood.clone()),
+                        Transform::from_translation(space::world(mid, SKIRTING_M * 0.5))
+                            .with_rotation(along)
+                            .with_scale(Vec3::new(len + 0.17, SKIRTING_M, 0.19)),
                     ));
                 }
             }
         }
-        // The workbench, Phantom at it, and the exit marker.
+        // The workbench, Phantom at it, and the exit marker under its sign.
         museum.spawn((
             Mesh3d(meshes.add(Cuboid::new(1.4, BENCH_TOP_M, 0.8))),
-            MeshMaterial3d(wood.clone()),
+            MeshMaterial3d(palette.wood.clone()),
             Transform::from_translation(space::world(level.workbench, BENCH_TOP_M * 0.5)),
             Name::new("workbench"),
         ));
@@ -200,9 +213,25 @@ fn spawn_museum(
         ));
         museum.spawn((
             Mesh3d(meshes.add(Cylinder::new(0.5, 0.02))),
-            MeshMaterial3d(exit),
+            MeshMaterial3d(exit.clone()),
             Transform::from_translation(space::world(level.exit, 0.01)),
             Name::new("exit"),
+        ));
+        museum.spawn((
+            Mesh3d(palette.unit_cube.clone()),
+            MeshMaterial3d(exit),
+            Transform::from_translation(space::world(level.exit, 2.4)).with_scale(Vec3::new(0.5, 0.2, 0.05)),
+            Name::new("exit sign"),
+        ));
+        museum.spawn((
+            PointLight {
+                color: Color::srgb(0.2, 1.0, 0.4),
+                intensity: EXIT_SIGN_LM,
+                range: 5.0,
+                shadow_maps_enabled: false,
+                ..default()
+            },
+            Transform::from_translation(space::world(level.exit, 2.2)),
         ));
     });
     // Moonlight from above, cold and dim.
@@ -411,30 +440,30 @@ fn dress_guards(
     palette: Res<Palette>,
     mut shadowed: Local<u32>,
 ) {
+    let mut torch_on = Vec::new();
     for (e, g) in &guards {
         let shadows = *shadowed < MAX_SHADOWED_TORCHES;
         *shadowed += u32::from(shadows);
         let lamp = palette.alert(g.alert);
         commands
             .entity(e)
-            .insert((Dressed, Transform::from_translation(space::world(g.position, 0.0)), Visibility::default()))
+            .insert((
+                Dressed,
+                Gait::default(),
+                Transform::from_translation(space::world(g.position, 0.0)),
+                Visibility::default(),
+            ))
             .with_children(|c| {
-                c.spawn((
-                    Mesh3d(palette.guard_body.0.clone()),
-                    MeshMaterial3d(palette.guard_body.1.clone()),
-                    Transform::from_xyz(0.0, 0.7, 0.0),
-                ));
-                c.spawn((
-                    Mesh3d(palette.guard_head.0.clone()),
-                    MeshMaterial3d(palette.guard_head.1.clone()),
-                    Transform::from_xyz(0.0, 1.5, 0.0),
-                ));
-                // The nose shows where the guard looks.
-                c.spawn((
-                    Mesh3d(palette.guard_nose.clone()),
-                    MeshMaterial3d(palette.guard_head.1.clone()),
-                    Transform::from_xyz(0.0, 1.5, -0.16),
-                ));
+                let neck = figure::spawn(
+                    c,
+                    &figure::Parts {
+                        torso: (&palette.guard_body.0, &palette.guard_body.1),
+                        leg: &palette.guard_leg,
+                        arm: &palette.guard_arm,
+                        head: (&palette.guard_head.0, &palette.guard_nose, &palette.guard_head.1),
+                    },
+                );
+                torch_on.push((neck, shadows));
                 c.spawn((
                     AlertLamp,
                     Mesh3d(palette.lamp.clone()),
@@ -448,21 +477,23 @@ fn dress_guards(
                     meter_transform(g.alert),
                     if awareness(g.alert) > 0.0 { Visibility::Inherited } else { Visibility::Hidden },
                 ));
-                // The torch at the shoulder, aimed ahead and a little down: its cone is the sight cone.
-                c.spawn((
-                    Torch,
-                    SpotLight {
-                        color: Color::srgb(1.0, 0.96, 0.85),
-                        intensity: TORCH_LM,
-                        range: 14.0,
-                        outer_angle: 0.4,
-                        inner_angle: 0.25,
-                        shadow_maps_enabled: shadows,
-                        ..default()
-                    },
-                    Transform::from_xyz(0.25, 1.35, -0.2).with_rotation(Quat::from_rotation_x(-0.12)),
-                ));
             });
+        // The torch in his right hand at the shoulder, turning with his head: its cone is where he looks.
+        for (neck, shadows) in torch_on.drain(..) {
+            commands.entity(neck).with_child((
+                Torch,
+                SpotLight {
+                    color: Color::srgb(1.0, 0.96, 0.85),
+                    intensity: TORCH_LM,
+                    range: 14.0,
+                    outer_angle: 0.4,
+                    inner_angle: 0.25,
+                    shadow_maps_enabled: shadows,
+                    ..default()
+                },
+                Transform::from_xyz(0.25, -0.15, -0.2).with_rotation(Quat::from_rotation_x(-0.12)),
+            ));
+        }
     }
 }
 
@@ -472,19 +503,29 @@ fn meter_transform(alert: GuardAlert) -> Transform {
     Transform::from_xyz(-METER_WIDTH_M * 0.5 * (1.0 - fill), 2.1, 0.0).with_scale(Vec3::new(fill, 1.0, 1.0))
 }
 
+#[allow(clippy::type_complexity)]
 fn move_guards(
-    mut guards: Query<(&GuardView, &Track, &mut Transform, &Children), Without<AwarenessMeter>>,
-    mut meters: Query<(&mut Transform, &mut Visibility), With<AwarenessMeter>>,
+    mut guards: Query<(&GuardView, &Track, &mut Gait, &mut Transform, &Children), Without<AwarenessMeter>>,
+    mut meters: Query<(&mut Transform, &mut Visibility), (With<AwarenessMeter>, Without<Limb>, Without<Neck>)>,
     mut lamps: Query<&mut MeshMaterial3d<StandardMaterial>, Or<(With<AlertLamp>, With<AwarenessMeter>)>>,
+    mut limbs: Query<(&Limb, &mut Transform), (Without<Neck>, Without<Gait>)>,
+    mut necks: Query<&mut Transform, (With<Neck>, Without<Limb>, Without<Gait>)>,
     palette: Res<Palette>,
     time: Res<Time>,
 ) {
     let t = time.elapsed_secs_f64() - DELAY_S;
-    for (g, track, mut transform, children) in &mut guards {
-        if let Some((p, r)) = track.sample(t) {
-            transform.translation = p;
-            transform.rotation = r;
-        }
+    for (g, track, mut gait, mut transform, children) in &mut guards {
+        // Drawn where the track says he was; his body turns the way he walks, his head the way he looks.
+        let look = match track.sample(t) {
+            Some((p, r)) => {
+                transform.translation = p;
+                let look = space::facing(r);
+                gait.step(space::floor(p), look, time.delta_secs());
+                look
+            }
+            None => gait.body,
+        };
+        figure::pose(&gait, look, &mut transform, children, &mut limbs, &mut necks);
         let glow = palette.alert(g.alert);
         for child in children.iter() {
             if let Ok((mut t, mut vis)) = meters.get_mut(child) {
@@ -536,6 +577,7 @@ mod tests {
         app.insert_resource(Time::<()>::default())
             .init_resource::<Assets<Mesh>>()
             .init_resource::<Assets<StandardMaterial>>()
+            .init_resource::<Assets<Image>>()
             .init_resource::<Palette>()
             .add_systems(Update, move_guards);
         let view = |alert| GuardView {
@@ -545,7 +587,10 @@ mod tests {
             facing: 0.0,
             alert,
         };
-        let guard = app.world_mut().spawn((view(GuardAlert::Patrolling), Track::default(), Transform::default())).id();
+        let guard = app
+            .world_mut()
+            .spawn((view(GuardAlert::Patrolling), Track::default(), Gait::default(), Transform::default()))
+            .id();
         let meter = app
             .world_mut()
             .spawn((
@@ -588,12 +633,91 @@ mod tests {
     }
 
     #[test]
+    fn a_guard_walking_one_way_and_looking_another_is_drawn_so_with_his_torch_where_he_looks() {
+        use crate::interp::Snapshot;
+        use heist_shared::protocol::GuardId;
+        let mut app = App::new();
+        app.insert_resource(Time::<()>::default())
+            .init_resource::<Assets<Mesh>>()
+            .init_resource::<Assets<StandardMaterial>>()
+            .init_resource::<Assets<Image>>()
+            .init_resource::<Palette>()
+            .add_systems(Update, (dress_guards, move_guards).chain());
+        // The server's guard walks east at a patrol's 1.1 m/s, looking north (his track, as replicated).
+        let look = std::f32::consts::FRAC_PI_2;
+        let snapshot = |t: f64| Snapshot {
+            t,
+            position: space::world(Vec2::new(1.1 * t as f32, 0.0), 0.0),
+            rotation: space::rotation(look),
+        };
+        let view = GuardView {
+            id: GuardId(1),
+            name: "Bruno".into(),
+            position: Vec2::ZERO,
+            facing: look,
+            alert: GuardAlert::Patrolling,
+        };
+        let guard = app.world_mut().spawn((view, Track::default())).id();
+        let mut legs = Vec::new();
+        let mut sent = 0u32;
+        for _ in 0..180 {
+            app.world_mut().resource_mut::<Time>().advance_by(Duration::from_millis(16));
+            let now = app.world().resource::<Time>().elapsed_secs_f64();
+            while f64::from(sent) / 30.0 <= now {
+                app.world_mut().get_mut::<Track>(guard).expect("track").push(snapshot(f64::from(sent) / 30.0));
+                sent += 1;
+            }
+            app.update();
+            let world = app.world_mut();
+            let mut q = world.query::<(&Limb, &Transform, &ChildOf)>();
+            let swing: Vec<f32> = q
+                .iter(world)
+                .filter(|(l, _, parent)| !l.arm && parent.parent() == guard)
+                .map(|(l, t, _)| l.side * t.rotation.to_axis_angle().1 * t.rotation.x.signum())
+                .collect();
+            legs.push(swing);
+        }
+        let world = app.world_mut();
+        let root = *world.get::<Transform>(guard).expect("placed");
+        assert!(
+            (space::facing(root.rotation)).abs() < 0.01,
+            "his body faces east, where he walks: {} at {}",
+            space::facing(root.rotation),
+            root.translation
+        );
+        assert!(
+            (root.translation.x - 1.1 * (180.0 * 0.016 - DELAY_S as f32)).abs() < 0.1,
+            "drawn where the track says"
+        );
+        let (neck, torch) = {
+            let mut q = world.query_filtered::<(&Transform, &Children), With<Neck>>();
+            let (neck, children) = q.iter(world).next().expect("a neck");
+            let torch =
+                children.iter().find_map(|c| world.get::<SpotLight>(c).map(|_| c)).expect("the torch on the neck");
+            (*neck, *world.get::<Transform>(torch).expect("torch"))
+        };
+        let beam = root.rotation * neck.rotation * torch.rotation * Vec3::NEG_Z;
+        let beam_facing = space::floor(beam).to_angle();
+        assert!(
+            (beam_facing - (space::facing(root.rotation) + figure::MAX_HEAD_TURN)).abs() < 0.01,
+            "the head and torch turn as far to his left (north) as a head turns: beam at {beam_facing}"
+        );
+        // Both legs swing, against each other, as wide as a patrol's walk.
+        let settled = &legs[90..];
+        assert!(settled.iter().all(|s| s.len() == 2), "two legs");
+        let peak = settled.iter().map(|s| s[0].abs()).fold(0.0, f32::max);
+        assert!((peak - figure::swing(1.1)).abs() < 0.05, "swing {peak}");
+        assert!(settled.iter().all(|s| (s[0] - s[1]).abs() < 1e-3), "mirrored legs: {:?}", &settled[..4]);
+    }
+
+    #[test]
     fn every_case_guard_and_copy_is_dressed_from_the_shared_palette() {
         use heist_shared::artifact::{ArtifactKind, look};
         use heist_shared::protocol::{CaseId, GuardId, ItemId};
         let mut app = App::new();
         app.init_resource::<Assets<Mesh>>()
             .init_resource::<Assets<StandardMaterial>>()
+            .init_resource::<Assets<Image>>()
             .init_resource::<Palette>()
             .add_systems(Update, (dress_cases, dress_items, dress_guards));
         let counts = |app: &App| {
