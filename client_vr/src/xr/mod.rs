@@ -8,9 +8,11 @@
 //!   over the workbench places a copy there, elsewhere it drops;
 //! - trigger: with an empty hand, break the case the hand points at; holding an item, throw it on release
 //!   — the landing point follows the hand's velocity (ballistic, capped at the throw range);
-//! - the off hand's stick (trackpad on a Vive): teleport by default — point, release, and the body walks
-//!   there under the server's authority while the view fades down; or smooth locomotion with a comfort
-//!   vignette (`--locomotion smooth`); clicking it toggles running;
+//! - the off hand's stick (trackpad on a Vive): teleport by default — push to aim an arc ([`arc`]: green
+//!   to a valid target, red when refused), release on green and the view blinks dark while the body goes
+//!   there under the server's authority; or smooth locomotion with a comfort vignette
+//!   (`--locomotion smooth`); clicking it toggles running;
+//! - an empty hand rings the item its grip would take;
 //! - the main hand's stick: snap turn (30°);
 //! - walking in the room moves the body too (the head pulls it); walls hold the view back;
 //! - crouching in the room crouches (standing mode); seated mode lifts the view to standing height;
@@ -19,6 +21,7 @@
 //!
 //! Controllers pulse on a grab and on breaking glass ([`Pulse`]).
 
+pub mod arc;
 pub mod probe;
 
 use std::borrow::Cow;
@@ -48,7 +51,7 @@ use crate::world::Hands;
 /// How the sticks move the player.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
 pub enum Locomotion {
-    /// Point and release; the view fades while the body walks there.
+    /// Aim an arc and release; the view blinks dark while the body goes there.
     #[default]
     Teleport,
     /// Continuous movement with a comfort vignette.
@@ -146,7 +149,18 @@ struct HandState {
     locomoting: bool,
     fade: f32,
     vignette: f32,
+    /// The teleport arc while the off hand's stick is pushed.
+    arc: Option<arc::TeleportArc>,
+    /// What each empty hand would pick up if its grip closed now (shown by a highlight ring).
+    grabbable: [Option<heist_shared::protocol::ItemId>; 2],
 }
+
+/// The ring around what an empty hand would pick up (one per hand).
+#[derive(Component)]
+struct GrabHighlight(usize);
+
+/// Radius of the grab highlight ring, metres.
+pub const HIGHLIGHT_RADIUS_M: f32 = 0.16;
 
 /// Adds XR input to an app built with `bevy_mod_openxr::add_xr_plugins`.
 pub struct XrInputPlugin {
@@ -168,11 +182,17 @@ impl Plugin for XrInputPlugin {
                 RunFixedMainLoop,
                 (read_hands, comfort).chain().in_set(IntentSystems::Gather).run_if(openxr_session_running),
             )
-            .add_systems(Startup, spawn_mirror)
+            .add_systems(Startup, (spawn_mirror, spawn_highlights))
             .add_systems(Update, talk_button.run_if(openxr_session_running))
             .add_systems(
                 Update,
-                (pulse, strap_wrist_panel, follow_head)
+                (
+                    pulse,
+                    strap_wrist_panel,
+                    follow_head,
+                    draw_arc,
+                    show_grab_highlights.after(crate::world::WorldSystems),
+                )
                     .in_set(crate::client::ViveSystems::Present)
                     .run_if(openxr_session_running),
             );
@@ -462,8 +482,11 @@ fn read_hands(
         hand_pos[g.0.min(1)] = t.translation();
     }
     let mut pointing = [Vec2::new(intent.facing.cos(), intent.facing.sin()); 2];
+    let mut aims = [(head, head_rot * Vec3::NEG_Z); 2];
     for (p, t) in &pointers {
-        let f = space::floor(t.forward().as_vec3());
+        let forward = t.forward().as_vec3();
+        aims[p.0.min(1)] = (t.translation(), forward);
+        let f = space::floor(forward);
         if f.length() > 0.1 {
             pointing[p.0.min(1)] = f;
         }
@@ -479,6 +502,7 @@ fn read_hands(
         history[5] = hand_pos[hand];
         let velocity = (history[5] - history[0]) / (5.0 * dt);
         let aim = Aim { from: space::floor(hand_pos[hand]), towards: pointing[hand] };
+        hs.grabbable[hand] = if hs.holding[hand].is_none() { aim.item(items.iter(), &case_refs) } else { None };
         if squeeze
             && !hs.squeezed[hand]
             && hs.holding[hand].is_none()
@@ -567,11 +591,20 @@ fn read_hands(
         }
         Locomotion::Teleport => {
             if stick.y > 0.6 {
-                // Aiming: the target is along the off hand's pointer, up to the range.
-                let target =
-                    space::floor(hand_pos[off]) + pointing[off].normalize_or_zero() * TELEPORT_RANGE_M * stick.y;
-                hs.travel = Some(target);
+                // Aiming: the arc from the off hand shows where, green when the body may go there.
+                if let (Some(level), Some(walls)) = (state.level.as_ref(), state.walls.as_ref()) {
+                    let (from, along) = aims[off];
+                    hs.arc = Some(arc::teleport_arc(from, along, body, level, walls));
+                }
+                hs.travel = None;
                 hs.fade = 0.0;
+            } else if let Some(aimed) = hs.arc.take() {
+                // Let go: a valid target blinks the body there (the view goes dark while the server
+                // walks it); a refused one does nothing.
+                if aimed.valid() {
+                    hs.travel = Some(aimed.landing);
+                    hs.fade = 0.95;
+                }
             } else if let Some(target) = hs.travel {
                 let d = target - body;
                 if d.length() < 0.1 {
@@ -593,6 +626,58 @@ fn read_hands(
     if lead.length() > HEAD_LEASH_M {
         let back = lead - lead.normalize() * HEAD_LEASH_M;
         root.translation -= space::world(back, 0.0);
+    }
+}
+
+/// Draws the teleport arc while aiming: green to a valid target (with a ring where the body will
+/// stand), red and ending where it is refused.
+fn draw_arc(hs: Res<HandState>, mut gizmos: Gizmos) {
+    let Some(aimed) = hs.arc.as_ref() else { return };
+    let colour = if aimed.valid() { Color::srgb(0.2, 1.0, 0.4) } else { Color::srgb(1.0, 0.2, 0.15) };
+    gizmos.linestrip(aimed.points.iter().copied(), colour);
+    let ring = Isometry3d::new(space::world(aimed.landing, 0.02), Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2));
+    gizmos.circle(ring, heist_shared::rules::BODY_RADIUS, colour);
+}
+
+fn spawn_highlights(
+    mut commands: Commands,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    let ring = meshes.add(Torus::new(HIGHLIGHT_RADIUS_M - 0.01, HIGHLIGHT_RADIUS_M + 0.01));
+    let glow = materials.add(StandardMaterial {
+        base_color: Color::srgb(1.0, 0.9, 0.4),
+        emissive: LinearRgba::rgb(4.0, 3.2, 1.0),
+        unlit: true,
+        ..default()
+    });
+    for hand in 0..2 {
+        commands.spawn((
+            GrabHighlight(hand),
+            Mesh3d(ring.clone()),
+            MeshMaterial3d(glow.clone()),
+            Transform::default(),
+            Visibility::Hidden,
+        ));
+    }
+}
+
+/// Puts each hand's highlight ring around the item it would pick up, where that item is drawn; hides it
+/// when the hand holds something or reaches nothing.
+fn show_grab_highlights(
+    hs: Res<HandState>,
+    items: Query<(&ItemView, &Transform), Without<GrabHighlight>>,
+    mut rings: Query<(&GrabHighlight, &mut Transform, &mut Visibility)>,
+) {
+    for (hand, mut t, mut vis) in &mut rings {
+        let target = hs.grabbable[hand.0.min(1)].and_then(|id| items.iter().find(|(i, _)| i.id == id));
+        match target {
+            Some((_, at)) => {
+                t.translation = at.translation;
+                *vis = Visibility::Inherited;
+            }
+            None => *vis = Visibility::Hidden,
+        }
     }
 }
 
@@ -657,6 +742,36 @@ fn pulse(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn each_empty_hand_rings_what_it_would_pick_up_where_that_is_drawn() {
+        use heist_shared::protocol::{ItemId, ItemKind};
+        let mut app = App::new();
+        app.init_resource::<HandState>().add_systems(Update, show_grab_highlights);
+        let at = Vec3::new(3.0, 1.1, -4.0);
+        app.world_mut().spawn((
+            ItemView { id: ItemId(7), kind: ItemKind::Prop, place: ItemPlace::Floor(Vec2::new(3.0, 4.0)) },
+            Transform::from_translation(at),
+        ));
+        let rings: Vec<Entity> = (0..2)
+            .map(|h| app.world_mut().spawn((GrabHighlight(h), Transform::default(), Visibility::Hidden)).id())
+            .collect();
+        let shown = |app: &App| {
+            rings
+                .iter()
+                .map(|r| {
+                    let vis = *app.world().get::<Visibility>(*r).expect("ring");
+                    (vis != Visibility::Hidden).then(|| app.world().get::<Transform>(*r).expect("ring").translation)
+                })
+                .collect::<Vec<_>>()
+        };
+        app.world_mut().resource_mut::<HandState>().grabbable = [None, Some(ItemId(7))];
+        app.update();
+        assert_eq!(shown(&app), vec![None, Some(at)], "the right hand's ring is round the item");
+        app.world_mut().resource_mut::<HandState>().grabbable = [Some(ItemId(9)), None];
+        app.update();
+        assert_eq!(shown(&app), vec![None, None], "an item not drawn is not ringed; an empty reach shows nothing");
+    }
 
     #[test]
     fn the_vignette_narrows_with_speed() {
