@@ -220,6 +220,8 @@ pub struct ShotRequest {
     pub path: PathBuf,
     /// Frames of the museum to wait.
     pub after_frames: u32,
+    /// Shoot the headset's left eye (XR mode) instead of the window.
+    pub left_eye: bool,
 }
 
 /// The Vive client's Bevy app, not yet connected.
@@ -252,16 +254,20 @@ pub fn app(args: &ViveArgs, mode: &Mode) -> anyhow::Result<App> {
         }
         Mode::Xr => {
             app.add_plugins(
-                bevy_mod_openxr::add_xr_plugins(
-                    DefaultPlugins.set(WindowPlugin { primary_window: Some(window), ..default() }),
-                )
-                .set(bevy_mod_openxr::init::OxrInitPlugin {
-                    app_info: bevy_mod_openxr::types::AppInfo {
-                        name: "Phantom Heist".into(),
-                        version: bevy_mod_openxr::types::Version(0, 1, 0),
-                    },
-                    ..default()
-                }),
+                bevy_mod_openxr::add_xr_plugins(DefaultPlugins)
+                    // The mirror window at `--size` (add_xr_plugins puts in its own 1280x720 window), never
+                    // waiting for the display: the headset's frame loop (xrWaitFrame) paces the app.
+                    .set(WindowPlugin {
+                        primary_window: Some(Window { present_mode: PresentMode::AutoNoVsync, ..window }),
+                        ..default()
+                    })
+                    .set(bevy_mod_openxr::init::OxrInitPlugin {
+                        app_info: bevy_mod_openxr::types::AppInfo {
+                            name: "Phantom Heist".into(),
+                            version: bevy_mod_openxr::types::Version(0, 1, 0),
+                        },
+                        ..default()
+                    }),
             );
         }
     }
@@ -276,11 +282,12 @@ pub fn app(args: &ViveArgs, mode: &Mode) -> anyhow::Result<App> {
             app.add_plugins(crate::desktop::DesktopPlugin { input: !args.bot });
         }
         Mode::Xr if args.bot => {
-            warn!("--bot in XR: the bot plays; the headset shows the museum from the room's origin");
+            info!("--bot in XR: the bot plays; the headset is carried with its body and looks its way");
+            app.add_plugins(crate::xr::XrViewPlugin { follow_body: true });
         }
         Mode::Xr => {
             let options = XrOptions { locomotion: args.locomotion, seated: args.seated, hand: args.hand };
-            app.add_plugins(crate::xr::XrInputPlugin { options });
+            app.add_plugins((crate::xr::XrInputPlugin { options }, crate::xr::XrViewPlugin { follow_body: false }));
         }
         Mode::Headless => {}
     }
@@ -289,8 +296,12 @@ pub fn app(args: &ViveArgs, mode: &Mode) -> anyhow::Result<App> {
     }
     app.insert_resource(args.voice_settings()).add_plugins((heist_voice::VoicePlugin, crate::walkie::WalkiePlugin));
     if let Some(path) = &args.screenshot {
-        app.insert_resource(ShotRequest { path: path.clone(), after_frames: args.shot_after })
-            .add_systems(Update, shoot);
+        app.insert_resource(ShotRequest {
+            path: path.clone(),
+            after_frames: args.shot_after,
+            left_eye: *mode == Mode::Xr,
+        })
+        .add_systems(Update, shoot);
     }
     Ok(app)
 }
@@ -310,7 +321,13 @@ fn shoot(
     if *frames == shot.after_frames && !*requested {
         *requested = true;
         info!("screenshot: saving {}", shot.path.display());
-        commands.spawn(Screenshot::primary_window()).observe(save_to_disk(shot.path.clone()));
+        // In XR the left eye's swapchain image (what the headset shows); on the desktop the window.
+        let target = if shot.left_eye {
+            Screenshot::texture_view(bevy::camera::ManualTextureViewHandle(bevy_mod_openxr::render::XR_TEXTURE_INDEX))
+        } else {
+            Screenshot::primary_window()
+        };
+        commands.spawn(target).observe(save_to_disk(shot.path.clone()));
     }
     // Saving happens a few frames later, on another thread: wait for the file.
     if *frames > shot.after_frames + 5 && shot.path.exists() || *frames > shot.after_frames + 600 {
