@@ -131,6 +131,42 @@ fn build_museum(
     spawn_museum(&mut commands, level, state.walls.as_ref(), &mut meshes, &mut materials, &palette);
 }
 
+/// Width and height of a window pane, metres, and the height of its centre.
+pub const WINDOW_M: (f32, f32, f32) = (1.2, 1.4, 2.0);
+/// Space between window centres along an outer wall, metres.
+pub const WINDOW_EVERY_M: f32 = 4.0;
+
+/// Where the windows go: along every outer wall (one with no room behind it) longer than a window's
+/// spacing, every [`WINDOW_EVERY_M`], centred on the wall, each given as its centre on the floor plan,
+/// the wall's direction (radians) and the normal into the room.
+pub fn window_spots(level: &Level, walls: &heist_shared::level::WallSet) -> Vec<(Vec2, f32, Vec2)> {
+    let inside = |p: Vec2| level.rooms.iter().any(|r| r.contains(p, 0.0));
+    let mut spots = Vec::new();
+    for s in &walls.walls {
+        let d = s.b - s.a;
+        let len = d.length();
+        if len < WINDOW_EVERY_M {
+            continue;
+        }
+        let dir = d / len;
+        let normal = Vec2::new(-dir.y, dir.x);
+        let n = (len / WINDOW_EVERY_M).floor() as usize;
+        for i in 0..n {
+            let at = s.a + dir * ((i as f32 + 0.5) * len / n as f32);
+            // Each pane (and both its edges) must have a room on one side only: outer wall.
+            let ends = [at, at + dir * WINDOW_M.0 * 0.5, at - dir * WINDOW_M.0 * 0.5];
+            let side =
+                |n: Vec2| ends.iter().all(|e| inside(*e + n * 0.3)) && ends.iter().all(|e| !inside(*e - n * 0.3));
+            if side(normal) {
+                spots.push((at, d.y.atan2(d.x), normal));
+            } else if side(-normal) {
+                spots.push((at, d.y.atan2(d.x), -normal));
+            }
+        }
+    }
+    spots
+}
+
 /// Height of the skirting boards along the walls, metres.
 pub const SKIRTING_M: f32 = 0.15;
 /// Light of the exit sign, lumens (a green glow on the floor around it).
@@ -151,7 +187,26 @@ fn spawn_museum(
         emissive: LinearRgba::rgb(0.0, 2.0, 0.5),
         ..default()
     });
+    // Moonlit window panes: the night outside glows cold through them.
+    let moonlit = materials.add(StandardMaterial {
+        base_color: Color::srgb(0.02, 0.03, 0.06),
+        emissive: LinearRgba::rgb(0.004, 0.006, 0.014),
+        perceptual_roughness: 0.3,
+        ..default()
+    });
+    let windows = walls.map(|w| window_spots(level, w)).unwrap_or_default();
     commands.entity(root).with_children(|museum| {
+        let (w, h, centre) = WINDOW_M;
+        for (at, along, into) in &windows {
+            museum.spawn((
+                Mesh3d(palette.unit_cube.clone()),
+                MeshMaterial3d(moonlit.clone()),
+                Transform::from_translation(space::world(*at + *into * 0.085, centre))
+                    .with_rotation(Quat::from_rotation_y(*along))
+                    .with_scale(Vec3::new(w, h, 0.02)),
+                Name::new("window"),
+            ));
+        }
         for room in &level.rooms {
             let size = room.max - room.min;
             let centre = room.centre();
@@ -745,6 +800,29 @@ mod tests {
         assert_eq!(after, (before.0 + 2, before.1 + 2), "only the two looks were new: one mesh and material each");
         let dressed = app.world_mut().query_filtered::<(), With<Dressed>>().iter(app.world()).count();
         assert_eq!(dressed, 12 + 24 + 3, "everything was dressed");
+    }
+
+    #[test]
+    fn windows_look_out_of_the_outer_walls_only_and_face_into_their_room() {
+        let level = Level::museum();
+        let walls = heist_shared::level::WallSet::new(&level);
+        let spots = window_spots(&level, &walls);
+        let outside = |p: Vec2| !level.rooms.iter().any(|r| r.contains(p, 0.0));
+        assert!(spots.len() >= 12, "the museum's outer walls have windows: {}", spots.len());
+        for (at, _, into) in &spots {
+            assert!(outside(*at - *into * 0.3), "{at}: outside behind the window");
+            assert!(!outside(*at + *into * 0.3), "{at}: a room in front of it");
+        }
+        // Every room with an outer wall of a window's spacing gets one; the walls between rooms none.
+        for room in &level.rooms {
+            assert!(
+                spots.iter().any(|(at, _, into)| room.contains(*at + *into * 0.3, 0.0)),
+                "{} has a window",
+                room.id
+            );
+        }
+        let between = Vec2::new(10.0, 6.0); // the lobby–west gallery wall
+        assert!(spots.iter().all(|(at, ..)| at.distance(between) > 1.0));
     }
 
     #[test]
