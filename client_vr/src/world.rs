@@ -626,15 +626,21 @@ mod tests {
     use heist_shared::protocol::ItemId;
     use std::time::Duration;
 
-    #[test]
-    fn the_awareness_meter_over_a_guard_fills_as_he_grows_alert_and_hides_on_patrol() {
+    /// An app with a clock, the asset stores and the palette: what dressing and moving need.
+    fn dressing_app() -> App {
         let mut app = App::new();
         app.insert_resource(Time::<()>::default())
             .init_resource::<Assets<Mesh>>()
             .init_resource::<Assets<StandardMaterial>>()
             .init_resource::<Assets<Image>>()
-            .init_resource::<Palette>()
-            .add_systems(Update, move_guards);
+            .init_resource::<Palette>();
+        app
+    }
+
+    #[test]
+    fn the_awareness_meter_over_a_guard_fills_as_he_grows_alert_and_hides_on_patrol() {
+        let mut app = dressing_app();
+        app.add_systems(Update, move_guards);
         let view = |alert| GuardView {
             id: heist_shared::protocol::GuardId(1),
             name: "Bruno".into(),
@@ -691,13 +697,8 @@ mod tests {
     fn a_guard_walking_one_way_and_looking_another_is_drawn_so_with_his_torch_where_he_looks() {
         use crate::interp::Snapshot;
         use heist_shared::protocol::GuardId;
-        let mut app = App::new();
-        app.insert_resource(Time::<()>::default())
-            .init_resource::<Assets<Mesh>>()
-            .init_resource::<Assets<StandardMaterial>>()
-            .init_resource::<Assets<Image>>()
-            .init_resource::<Palette>()
-            .add_systems(Update, (dress_guards, move_guards).chain());
+        let mut app = dressing_app();
+        app.add_systems(Update, (dress_guards, move_guards).chain());
         // The server's guard walks east at a patrol's 1.1 m/s, looking north (his track, as replicated).
         let look = std::f32::consts::FRAC_PI_2;
         let snapshot = |t: f64| Snapshot {
@@ -769,12 +770,8 @@ mod tests {
     fn every_case_guard_and_copy_is_dressed_from_the_shared_palette() {
         use heist_shared::artifact::{ArtifactKind, look};
         use heist_shared::protocol::{CaseId, GuardId, ItemId};
-        let mut app = App::new();
-        app.init_resource::<Assets<Mesh>>()
-            .init_resource::<Assets<StandardMaterial>>()
-            .init_resource::<Assets<Image>>()
-            .init_resource::<Palette>()
-            .add_systems(Update, (dress_cases, dress_items, dress_guards));
+        let mut app = dressing_app();
+        app.add_systems(Update, (dress_cases, dress_items, dress_guards));
         let counts = |app: &App| {
             (app.world().resource::<Assets<Mesh>>().len(), app.world().resource::<Assets<StandardMaterial>>().len())
         };
