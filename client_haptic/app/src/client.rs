@@ -222,8 +222,8 @@ fn receive(
     }
 }
 
-/// Guides the player through the real device's set-up as the session goes (the Falcon's homing) and
-/// tells them, once, when it stopped answering (its link went: no force reaches it).
+/// Guides the player through the real device's set-up as the session goes (the Falcon's homing, a grip
+/// read out of reach) and tells them, once, when it stopped answering (its link went: no force reaches it).
 fn watch_device(
     haptics: NonSend<Haptics>,
     mut speaker: NonSendMut<Speaker>,
@@ -231,7 +231,7 @@ fn watch_device(
     mut started: Local<Option<std::time::Instant>>,
 ) {
     let started = *started.get_or_insert_with(std::time::Instant::now);
-    if let Some(notice) = guide.next(haptics.health.reading(), started.elapsed().as_secs_f64()) {
+    if let Some(notice) = guide.next(haptics.device_reading(), started.elapsed().as_secs_f64()) {
         log::info!("device: {notice}");
         speaker.say(notice);
     }

@@ -236,26 +236,46 @@ pub enum DeviceHealth {
 }
 
 /// What the link says now, for a [`Guide`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Reading {
     /// What to tell the player once the device stopped answering (no force reaches it any more), else
     /// `None`.
     pub lost: Option<&'static str>,
     /// For a device that must be homed (the Falcon): whether every arm is home.
     pub homed: Option<bool>,
+    /// The grip is read outside the device's workspace, so the safety layer keeps forces off.
+    pub outside_workspace: bool,
 }
 
+/// What the player hears while the grip is read outside the device's workspace.
+pub const BACK_TO_THE_MIDDLE: &str =
+    "Move the grip back towards the middle of its reach: forces stay off while it is that far out.";
+
+/// What the player hears when it is back.
+pub const BACK_IN_REACH: &str = "The grip is back in reach: you will feel the copies now.";
+
 impl DeviceHealth {
+    /// Where a real device's grip must be read for forces to engage: the ball of its published workspace
+    /// around the device frame's origin (the Falcon's centre of travel; with the Inverse3, the point the
+    /// copy is felt at, a little below and behind where the grip was held still to centre it). `None` for
+    /// simulated, recorded and HID devices, whose grip goes where the program puts it.
+    pub fn workspace(&self, specs: &DeviceSpecs) -> Option<forcecomp::Workspace> {
+        let real = matches!(self, Self::Falcon(_) | Self::Haply(_));
+        (real && specs.workspace_radius_m > 0.0)
+            .then_some(forcecomp::Workspace { centre: Vec3::ZERO, radius_m: specs.workspace_radius_m })
+    }
+
     /// The link's state now.
     pub fn reading(&self) -> Reading {
         match self {
-            Self::Local => Reading { lost: None, homed: None },
+            Self::Local => Reading::default(),
             Self::Falcon(s) => Reading {
                 lost: s.disconnected().then_some(
                     "The Falcon stopped answering: no force reaches it. Check its cable and power, then start again.",
                 ),
                 // Homing starts once the firmware answers.
                 homed: (s.replies() > 0).then(|| s.homed().iter().all(|&h| h)),
+                outside_workspace: false,
             },
             Self::Haply(s) => Reading {
                 lost: s.disconnected().then_some(
@@ -263,6 +283,7 @@ impl DeviceHealth {
                      Service runs and the Inverse3 is on, then start again.",
                 ),
                 homed: None,
+                outside_workspace: false,
             },
         }
     }
@@ -270,10 +291,13 @@ impl DeviceHealth {
 
 /// What to tell the player of a real device as a session goes on: the homing instruction when homing
 /// starts and every [`haptico::falcon::homing::Homing::REMIND`] while it lasts, once that forces are on
-/// when it is done, and once that the device was lost (nothing after that).
+/// when it is done; once homed, [`BACK_TO_THE_MIDDLE`] when the grip is read outside the workspace (and
+/// as often while it stays out), [`BACK_IN_REACH`] when it returns; and once that the device was lost
+/// (nothing after that).
 #[derive(Debug, Default)]
 pub struct Guide {
     instructed_at_s: Option<f64>,
+    outside_told_at_s: Option<f64>,
     lost_told: bool,
 }
 
@@ -287,20 +311,35 @@ impl Guide {
             self.lost_told = true;
             return Some(notice);
         }
+        let remind = haptico::falcon::homing::Homing::REMIND.as_secs_f64();
         match (reading.homed, self.instructed_at_s) {
             (Some(false), None) => {
                 self.instructed_at_s = Some(now_s);
-                Some(haptico::falcon::homing::INSTRUCTION)
+                return Some(haptico::falcon::homing::INSTRUCTION);
             }
-            (Some(false), Some(t)) if now_s - t >= haptico::falcon::homing::Homing::REMIND.as_secs_f64() => {
+            (Some(false), Some(t)) if now_s - t >= remind => {
                 self.instructed_at_s = Some(now_s);
-                Some(haptico::falcon::homing::INSTRUCTION)
+                return Some(haptico::falcon::homing::INSTRUCTION);
             }
+            // Before homing the grip's position means nothing.
+            (Some(false), _) => return None,
             (Some(true), Some(_)) => {
                 self.instructed_at_s = None;
-                Some("The Falcon is homed: you will feel the copies now.")
+                return Some("The Falcon is homed: you will feel the copies now.");
             }
-            _ => None,
+            _ => {}
+        }
+        match (reading.outside_workspace, self.outside_told_at_s) {
+            (true, Some(t)) if now_s - t < remind => None,
+            (true, _) => {
+                self.outside_told_at_s = Some(now_s);
+                Some(BACK_TO_THE_MIDDLE)
+            }
+            (false, Some(_)) => {
+                self.outside_told_at_s = None;
+                Some(BACK_IN_REACH)
+            }
+            (false, None) => None,
         }
     }
 }
@@ -439,13 +478,13 @@ mod tests {
 
     #[test]
     fn the_guide_repeats_the_homing_instruction_until_homed_then_tells_forces_are_on_and_a_loss_once() {
-        let homing = Reading { lost: None, homed: Some(false) };
-        let homed = Reading { lost: None, homed: Some(true) };
-        let lost = Reading { lost: Some("gone"), homed: Some(true) };
+        let homing = Reading { homed: Some(false), ..Reading::default() };
+        let homed = Reading { homed: Some(true), ..Reading::default() };
+        let lost = Reading { lost: Some("gone"), homed: Some(true), ..Reading::default() };
         let instruction = Some(haptico::falcon::homing::INSTRUCTION);
         let mut g = Guide::default();
         // Before the firmware answers, nothing; then the instruction at once and every 8 s.
-        assert_eq!(g.next(Reading { lost: None, homed: None }, 0.0), None);
+        assert_eq!(g.next(Reading::default(), 0.0), None);
         assert_eq!(g.next(homing, 1.0), instruction);
         assert_eq!(g.next(homing, 8.9), None);
         assert_eq!(g.next(homing, 9.0), instruction);
@@ -458,8 +497,38 @@ mod tests {
         assert_eq!(g.next(homing, 60.0), None);
         // A device without homing only ever hears of a loss.
         let mut g = Guide::default();
-        assert_eq!(g.next(Reading { lost: None, homed: None }, 0.0), None);
-        assert_eq!(DeviceHealth::Local.reading(), Reading { lost: None, homed: None });
+        assert_eq!(g.next(Reading::default(), 0.0), None);
+        assert_eq!(DeviceHealth::Local.reading(), Reading::default());
+    }
+
+    #[test]
+    fn the_guide_sends_a_grip_read_out_of_reach_back_to_the_middle_but_not_before_homing() {
+        let out = Reading { outside_workspace: true, ..Reading::default() };
+        let mut g = Guide::default();
+        assert_eq!(g.next(out, 0.0), Some(BACK_TO_THE_MIDDLE));
+        assert_eq!(g.next(out, 7.9), None);
+        assert_eq!(g.next(out, 8.0), Some(BACK_TO_THE_MIDDLE), "again while it stays out");
+        assert_eq!(g.next(Reading::default(), 9.0), Some(BACK_IN_REACH));
+        assert_eq!(g.next(Reading::default(), 20.0), None, "said once");
+        // A Falcon that is not homed reads anything: only the homing instruction is heard.
+        let mut g = Guide::default();
+        let homing_out = Reading { homed: Some(false), outside_workspace: true, ..Reading::default() };
+        assert_eq!(g.next(homing_out, 0.0), Some(haptico::falcon::homing::INSTRUCTION));
+        assert_eq!(g.next(homing_out, 1.0), None);
+        let homed_out = Reading { homed: Some(true), outside_workspace: true, ..Reading::default() };
+        assert_eq!(g.next(homed_out, 2.0), Some("The Falcon is homed: you will feel the copies now."));
+        assert_eq!(g.next(homed_out, 2.1), Some(BACK_TO_THE_MIDDLE));
+    }
+
+    #[test]
+    fn real_devices_keep_forces_to_their_published_workspace_and_programs_steer_anywhere() {
+        let falcon = DeviceHealth::Falcon(Arc::default());
+        let w = falcon.workspace(&haptico::presets::falcon()).expect("a Falcon has a workspace");
+        assert_eq!((w.centre, w.radius_m), (Vec3::ZERO, 0.04));
+        let inverse3 = haptico::presets::inverse3();
+        let haply = DeviceHealth::Haply(Arc::default()).workspace(&inverse3).expect("an Inverse3 has one");
+        assert!(haply.holds(START), "the grip is centred inside the Inverse3's reach: {START} in {haply:?}");
+        assert_eq!(DeviceHealth::Local.workspace(&haptico::presets::phantom_desktop()), None);
     }
 
     #[test]

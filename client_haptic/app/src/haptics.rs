@@ -199,7 +199,8 @@ impl Haptics {
             volume_per_depth_m2: tool_reference_volume_m3 / REFERENCE_DEPTH_M * stiffness_scale,
             ..ProxyRendering::default()
         };
-        let mut config = RigConfig { map, rendering, proxy, ..RigConfig::default() };
+        let workspace = health.workspace(&specs);
+        let mut config = RigConfig { map, rendering, proxy, workspace, ..RigConfig::default() };
         config.haptic.realtime_priority = settings.realtime_priority;
         config.collision.realtime_priority = settings.realtime_priority.map(|p| (p - 1).max(1));
         let rig = HapticRig::start(device, tool, config, HapticEvents::default(), haptic_common::Delegator::new())?;
@@ -223,6 +224,11 @@ impl Haptics {
             rates: Vec::new(),
             settings,
         })
+    }
+
+    /// What the device's link and the safety layer say now, for the [`device::Guide`].
+    pub fn device_reading(&self) -> device::Reading {
+        device::Reading { outside_workspace: self.telemetry().outside_workspace, ..self.health.reading() }
     }
 
     /// Microseconds on the haptic clock.

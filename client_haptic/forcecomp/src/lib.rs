@@ -26,5 +26,5 @@ pub use error::{ForceCompError, Result};
 pub use material::{BodyMotion, Material};
 pub use penalty::volumetric_penalty;
 pub use proxy::{Ball, GodObject, ProxyConfig};
-pub use safety::{SafetyConfig, SafetyLayer, SafetyPhase, SafetyStats};
+pub use safety::{SafetyConfig, SafetyLayer, SafetyPhase, SafetyStats, Workspace};
 pub use texture::Texture;

@@ -7,14 +7,21 @@
 //!    than `engage_ticks` ticks, then the gain ramps from 0 to 1 over `ramp_in_s`;
 //! 3. **watchdog**: when the contact data is older than `watchdog_timeout_s`, the gain ramps to zero over
 //!    `ramp_out_s`; fresh data ramps it back over `ramp_in_s`;
-//! 4. **clamp** to `max_force_n` / `max_torque_nm`;
-//! 5. **rate limit**: the output moves towards the target by at most `max_force_rate_n_per_s · dt` (and
+//! 4. **workspace**: with a [`Workspace`], forces engage only while the grip is inside it, and disengage
+//!    (back to step 2) when it goes [`Workspace::LEAVE`] times its radius from its centre — a grip read
+//!    outside where the device can be is a device that is not homed or not centred;
+//! 5. **clamp** to `max_force_n` / `max_torque_nm`, and to less as the device heats: once the force's
+//!    mean square over `heat_time_s` passes half of `continuous_force_n`², the limit slides from the peak
+//!    force down to the continuous one (reached at the whole square), so the peak is there for a touch and
+//!    a long push settles at the continuous force (10 N on the Inverse3 holds for about 2.5 s, then slides
+//!    to 4 N);
+//! 6. **rate limit**: the output moves towards the target by at most `max_force_rate_n_per_s · dt` (and
 //!    the torque likewise), so no tick kicks.
 
 use glam::Vec3;
 use haptic_common::ForceTorque;
 
-use crate::error::{Result, non_negative, positive};
+use crate::error::{ForceCompError, Result, non_negative, positive};
 
 /// Limits and timings of the safety layer.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -37,6 +44,38 @@ pub struct SafetyConfig {
     pub watchdog_timeout_s: f32,
     /// Ramp-out time once the watchdog trips, s (default 0.05).
     pub ramp_out_s: f32,
+    /// The force the device can hold for long, N (its continuous force; default: `max_force_n`, no
+    /// heating limit).
+    pub continuous_force_n: f32,
+    /// Time constant of the force's mean square that stands for the motors' heat, s (default 30).
+    pub heat_time_s: f32,
+    /// Where the grip may be for forces to engage (device frame); `None`: anywhere (default).
+    pub workspace: Option<Workspace>,
+}
+
+/// A ball in the device frame where the grip must be for forces to engage.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Workspace {
+    /// Its centre, m.
+    pub centre: Vec3,
+    /// Its radius, m.
+    pub radius_m: f32,
+}
+
+impl Workspace {
+    /// Forces engaged disengage when the grip is this many radii from the centre (the ball is the
+    /// device's published workspace; its real reach goes a little beyond in places).
+    pub const LEAVE: f32 = 1.5;
+
+    /// True when `p` is inside the ball.
+    pub fn holds(&self, p: Vec3) -> bool {
+        p.distance(self.centre) <= self.radius_m
+    }
+
+    /// True when `p` is so far out that forces must stop.
+    pub fn lost(&self, p: Vec3) -> bool {
+        !(p.distance(self.centre) <= Self::LEAVE * self.radius_m)
+    }
 }
 
 impl SafetyConfig {
@@ -52,7 +91,20 @@ impl SafetyConfig {
             ramp_in_s: 2.0,
             watchdog_timeout_s: 0.032,
             ramp_out_s: 0.05,
+            continuous_force_n: max_force_n,
+            heat_time_s: 30.0,
+            workspace: None,
         }
+    }
+
+    /// The same limits, heating down to `continuous_force_n` (at most the peak force) on a long push.
+    pub fn with_continuous_force(self, continuous_force_n: f32) -> Self {
+        Self { continuous_force_n: continuous_force_n.min(self.max_force_n), ..self }
+    }
+
+    /// The same limits, engaging forces only while the grip is inside `workspace`.
+    pub fn with_workspace(self, workspace: Workspace) -> Self {
+        Self { workspace: Some(workspace), ..self }
     }
 
     /// Checks every value.
@@ -64,7 +116,20 @@ impl SafetyConfig {
         non_negative("engage_threshold_n", self.engage_threshold_n)?;
         positive("ramp_in_s", self.ramp_in_s)?;
         positive("watchdog_timeout_s", self.watchdog_timeout_s)?;
-        positive("ramp_out_s", self.ramp_out_s)
+        positive("ramp_out_s", self.ramp_out_s)?;
+        non_negative("continuous_force_n", self.continuous_force_n)?;
+        positive("heat_time_s", self.heat_time_s)?;
+        if let Some(w) = self.workspace {
+            positive("workspace.radius_m", w.radius_m)?;
+            let c = w.centre;
+            for (name, value) in [("workspace.centre.x", c.x), ("workspace.centre.y", c.y), ("workspace.centre.z", c.z)]
+            {
+                if !value.is_finite() {
+                    return Err(ForceCompError::OutOfRange { name, value, expected: "finite" });
+                }
+            }
+        }
+        Ok(())
     }
 }
 
@@ -90,6 +155,11 @@ pub struct SafetyStats {
     pub rate_limited: u64,
     /// Ticks with stale contact data.
     pub stale: u64,
+    /// Ticks with the grip outside the workspace while forces were not engaged, or far enough out to
+    /// disengage them.
+    pub outside_workspace: u64,
+    /// Ticks whose limit was below the peak force because the device had been pushing long and hard.
+    pub heat_limited: u64,
 }
 
 /// The safety layer's state (one per device).
@@ -102,6 +172,8 @@ pub struct SafetyLayer {
     watchdog_gain: f32,
     last: ForceTorque,
     stats: SafetyStats,
+    heat_n2: f32,
+    outside: bool,
 }
 
 impl SafetyLayer {
@@ -115,6 +187,8 @@ impl SafetyLayer {
             watchdog_gain: 1.0,
             last: ForceTorque::ZERO,
             stats: SafetyStats::default(),
+            heat_n2: 0.0,
+            outside: false,
         }
     }
 
@@ -143,6 +217,22 @@ impl SafetyLayer {
         self.engage_gain * self.watchdog_gain
     }
 
+    /// True when, on the last tick, the grip was outside the workspace with forces off for it.
+    pub fn outside_workspace(&self) -> bool {
+        self.outside
+    }
+
+    /// The largest force allowed now, N: the peak force, less once the device has pushed long and hard.
+    pub fn force_limit_n(&self) -> f32 {
+        let c = &self.config;
+        let half = 0.5 * c.continuous_force_n * c.continuous_force_n;
+        if c.continuous_force_n >= c.max_force_n || self.heat_n2 <= half {
+            return c.max_force_n;
+        }
+        let over = ((self.heat_n2 - half) / half.max(f32::MIN_POSITIVE)).min(1.0);
+        c.max_force_n + (c.continuous_force_n - c.max_force_n) * over
+    }
+
     /// Goes back to waiting for a small force (e.g. after the user put the stylus down).
     pub fn disengage(&mut self) {
         self.phase = SafetyPhase::WaitingForSmallForce;
@@ -151,8 +241,14 @@ impl SafetyLayer {
     }
 
     /// Filters `requested` for a tick of `dt_s` seconds, given that the contact data behind it is
-    /// `data_age_s` seconds old. Always returns finite values within the limits. Allocation-free.
+    /// `data_age_s` seconds old, with no grip position (a configured workspace then never lets forces
+    /// engage). Always returns finite values within the limits. Allocation-free.
     pub fn apply(&mut self, requested: ForceTorque, dt_s: f32, data_age_s: f32) -> ForceTorque {
+        self.apply_at(requested, dt_s, data_age_s, Vec3::NAN)
+    }
+
+    /// [`Self::apply`] with the grip at `grip` (device frame, m), checked against the workspace.
+    pub fn apply_at(&mut self, requested: ForceTorque, dt_s: f32, data_age_s: f32, grip: Vec3) -> ForceTorque {
         let c = self.config;
         let dt = if dt_s.is_finite() { dt_s.clamp(0.0, 0.1) } else { 0.0 };
         let mut req = requested;
@@ -165,9 +261,23 @@ impl SafetyLayer {
             self.stats.non_finite += 1;
         }
 
+        let (inside, lost) = match c.workspace {
+            Some(w) => (w.holds(grip), w.lost(grip)),
+            None => (true, false),
+        };
+        if lost && self.phase != SafetyPhase::WaitingForSmallForce {
+            self.disengage();
+        }
+        self.outside = !inside && (lost || self.phase == SafetyPhase::WaitingForSmallForce);
+        if self.outside {
+            self.stats.outside_workspace += 1;
+        }
+
         match self.phase {
             SafetyPhase::WaitingForSmallForce => {
-                if req.force.length() < c.engage_threshold_n {
+                if !inside {
+                    self.small_ticks = 0;
+                } else if req.force.length() < c.engage_threshold_n {
                     self.small_ticks += 1;
                     if self.small_ticks > c.engage_ticks {
                         self.phase = SafetyPhase::RampingIn;
@@ -195,11 +305,15 @@ impl SafetyLayer {
         }
 
         let gain = self.engage_gain * self.watchdog_gain;
+        let limit = self.force_limit_n();
+        if limit < c.max_force_n {
+            self.stats.heat_limited += 1;
+        }
         let mut target = ForceTorque { force: req.force * gain, torque: req.torque * gain };
-        if target.force.length() > c.max_force_n || target.torque.length() > c.max_torque_nm {
+        if target.force.length() > limit || target.torque.length() > c.max_torque_nm {
             self.stats.clamped += 1;
         }
-        target.force = target.force.clamp_length_max(c.max_force_n);
+        target.force = target.force.clamp_length_max(limit);
         target.torque = target.torque.clamp_length_max(c.max_torque_nm);
 
         let df = (target.force - self.last.force).clamp_length_max(c.max_force_rate_n_per_s * dt);
@@ -214,6 +328,8 @@ impl SafetyLayer {
         if !out.is_finite() {
             out = ForceTorque::ZERO;
         }
+        let heat = out.force.length_squared() - self.heat_n2;
+        self.heat_n2 = (self.heat_n2 + heat * (dt / c.heat_time_s).min(1.0)).max(0.0);
         self.last = out;
         out
     }
@@ -320,16 +436,124 @@ mod tests {
         assert_eq!(s.stats().non_finite, 2);
     }
 
+    fn ball() -> Workspace {
+        Workspace { centre: Vec3::new(0.0, 0.0, 0.11), radius_m: 0.04 }
+    }
+
+    #[test]
+    fn with_a_workspace_forces_engage_only_with_the_grip_inside_and_stop_when_it_goes_far_out() {
+        let cfg = SafetyConfig { ramp_in_s: 0.01, ..SafetyConfig::for_limits(8.0, 0.0).with_workspace(ball()) };
+        let mut s = SafetyLayer::new(cfg);
+        let outside = Vec3::new(0.0, 0.0, 0.2);
+        for _ in 0..100 {
+            assert_eq!(s.apply_at(ForceTorque::ZERO, DT, 0.0, outside), ForceTorque::ZERO);
+        }
+        assert_eq!(s.phase(), SafetyPhase::WaitingForSmallForce, "a grip read out of reach never engages");
+        assert!(s.outside_workspace() && s.stats().outside_workspace == 100);
+        // No position at all (NaN) is not inside either.
+        s.apply(ForceTorque::ZERO, DT, 0.0);
+        assert_eq!(s.phase(), SafetyPhase::WaitingForSmallForce);
+        // Inside: engages as usual.
+        let inside = Vec3::new(0.03, 0.0, 0.11);
+        for _ in 0..4 {
+            s.apply_at(ft(0.1), DT, 0.0, inside);
+        }
+        for _ in 0..100 {
+            s.apply_at(ft(2.0), DT, 0.0, inside);
+        }
+        assert_eq!(s.phase(), SafetyPhase::Engaged);
+        assert!(!s.outside_workspace());
+        assert!((s.last_output().force.x - 2.0).abs() < 1e-4);
+        // Pushed a little past the ball (its edge is not a wall): forces stay on.
+        s.apply_at(ft(2.0), DT, 0.0, Vec3::new(0.055, 0.0, 0.11));
+        assert_eq!(s.phase(), SafetyPhase::Engaged);
+        // Read 1.5 radii out: forces go, fall at the rate limit, and wait for the grip to come back.
+        let far = Vec3::new(0.061, 0.0, 0.11);
+        let mut previous = s.last_output().force.x;
+        for _ in 0..10 {
+            let out = s.apply_at(ft(2.0), DT, 0.0, far).force.x;
+            assert!(out <= previous && previous - out <= 0.5 + 1e-5, "down by ≤ 0.5 N a tick: {previous} → {out}");
+            previous = out;
+        }
+        assert_eq!(s.last_output(), ForceTorque::ZERO);
+        assert_eq!(s.phase(), SafetyPhase::WaitingForSmallForce);
+        assert!(s.outside_workspace());
+        // Back inside with a small request: engages again.
+        for _ in 0..4 {
+            s.apply_at(ForceTorque::ZERO, DT, 0.0, inside);
+        }
+        assert_eq!(s.phase(), SafetyPhase::RampingIn);
+    }
+
+    #[test]
+    fn a_long_hard_push_heats_the_limit_down_to_the_continuous_force_and_a_touch_keeps_the_peak() {
+        // The Inverse3's figures: 10 N peak, 4 N for long.
+        let mut s = engaged(SafetyConfig::for_limits(10.0, 0.0).with_continuous_force(4.0));
+        assert_eq!(s.config().heat_time_s, 30.0);
+        // A one-second 10 N press, then rest: the peak is there, and the limit never moves.
+        for _ in 0..1000 {
+            s.apply(ft(10.0), DT, 0.0);
+        }
+        assert!((s.last_output().force.x - 10.0).abs() < 1e-4, "{:?}", s.last_output());
+        assert_eq!(s.stats().heat_limited, 0);
+        for _ in 0..60_000 {
+            s.apply(ForceTorque::ZERO, DT, 0.0);
+        }
+        // A two-minute push at the peak: the limit slides down to about the continuous force and stays.
+        let mut least = f32::MAX;
+        let mut at = Vec::new();
+        for i in 0..120_000 {
+            let out = s.apply(ft(10.0), DT, 0.0).force.x;
+            if i >= 20 {
+                least = least.min(out); // after the 20 ticks the rate limit takes to reach 10 N
+            }
+            if i == 2_000 {
+                assert!((out - 10.0).abs() < 1e-4, "the peak is there for the first two seconds: {out}");
+            }
+            if i % 10_000 == 9_999 {
+                at.push(out);
+            }
+        }
+        assert!(s.stats().heat_limited > 0);
+        let end = *at.last().expect("sampled");
+        assert!((4.0..=4.05).contains(&end), "held at {end} N after two minutes: {at:?}");
+        assert!(least >= 4.0 - 1e-4, "never below the continuous force: {least}");
+        assert!(at.windows(2).all(|w| w[1] <= w[0] + 1e-3), "falls, never climbs back while pushed: {at:?}");
+        // With no continuous figure there is no heating limit.
+        let mut cold = engaged(SafetyConfig::for_limits(10.0, 0.0));
+        for _ in 0..60_000 {
+            cold.apply(ft(10.0), DT, 0.0);
+        }
+        assert_eq!(cold.stats().heat_limited, 0);
+        assert!((cold.last_output().force.x - 10.0).abs() < 1e-4);
+    }
+
+    #[test]
+    fn a_workspace_or_heat_figure_that_cannot_work_is_refused_by_name() {
+        let bad = |cfg: SafetyConfig| cfg.validate().expect_err("refused").to_string();
+        let base = SafetyConfig::for_limits(8.0, 0.0);
+        assert!(bad(base.with_workspace(Workspace { radius_m: 0.0, ..ball() })).contains("workspace.radius_m"));
+        let nan = Workspace { centre: Vec3::new(0.0, f32::NAN, 0.0), ..ball() };
+        assert!(bad(base.with_workspace(nan)).contains("workspace.centre.y"));
+        assert!(bad(SafetyConfig { heat_time_s: 0.0, ..base }).contains("heat_time_s"));
+        assert!(bad(SafetyConfig { continuous_force_n: -1.0, ..base }).contains("continuous_force_n"));
+        assert_eq!(base.with_continuous_force(20.0).continuous_force_n, 8.0, "never above the peak");
+        assert!(base.with_workspace(ball()).with_continuous_force(3.0).validate().is_ok());
+    }
+
     proptest! {
         #[test]
         fn any_request_sequence_stays_within_limits_and_rate(
-            requests in prop::collection::vec((-1e6f32..1e6, -1e6f32..1e6, -1e3f32..1e3, 0.0f32..0.002, 0.0f32..0.05), 1..300)
+            requests in prop::collection::vec((-1e6f32..1e6, -1e6f32..1e6, -1e3f32..1e3, 0.0f32..0.002, 0.0f32..0.05, -0.1f32..0.1), 1..300)
         ) {
-            let cfg = SafetyConfig { ramp_in_s: 0.01, ..SafetyConfig::for_limits(8.5, 0.188) };
+            let cfg = SafetyConfig { ramp_in_s: 0.01, heat_time_s: 0.05, ..SafetyConfig::for_limits(8.5, 0.188) }
+                .with_continuous_force(2.0)
+                .with_workspace(Workspace { centre: Vec3::ZERO, radius_m: 0.05 });
             let mut s = SafetyLayer::new(cfg);
             let mut last = ForceTorque::ZERO;
-            for (fx, fy, tz, dt, age) in requests {
-                let out = s.apply(ForceTorque { force: Vec3::new(fx, fy, 0.0), torque: Vec3::new(0.0, 0.0, tz) }, dt, age);
+            for (fx, fy, tz, dt, age, x) in requests {
+                let request = ForceTorque { force: Vec3::new(fx, fy, 0.0), torque: Vec3::new(0.0, 0.0, tz) };
+                let out = s.apply_at(request, dt, age, Vec3::new(x, 0.0, 0.0));
                 prop_assert!(out.is_finite());
                 prop_assert!(out.force.length() <= 8.5 + 1e-4);
                 prop_assert!(out.torque.length() <= 0.188 + 1e-5);

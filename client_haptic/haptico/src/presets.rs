@@ -75,20 +75,21 @@ pub fn falcon() -> DeviceSpecs {
     }
 }
 
-/// Haply Inverse3: 3-DOF (the VerseGrip's orientation is not read). Haply's data sheet could not be read
-/// from where this was written: every figure is assumed and conservative (the Touch's force, a workspace
-/// well inside the arm's reach) until checked against the device.
+/// Haply Inverse3: 10 N peak, 4 N held (Haply's "maximum force over 80 % of the workspace"), 1 N/mm,
+/// a 510 × 460 × 230 mm workspace (the ball inside it: 115 mm), refreshed at up to 4 kHz; 3-DOF (the
+/// VerseGrip's orientation is not read). Figures from Haply's published specification, read from a public
+/// copy of the product page (Haply's own site was not reachable from here); damping is assumed.
 pub fn inverse3() -> DeviceSpecs {
     DeviceSpecs {
         name: "Haply Inverse3",
         sensed_dof: 3,
         actuated_dof: 3,
-        peak_force_n: 3.3,       // assumed
-        continuous_force_n: 1.5, // assumed
+        peak_force_n: 10.0,
+        continuous_force_n: 4.0,
         max_torque_nm: 0.0,
-        max_stiffness_n_per_m: 800.0, // assumed
-        max_damping_ns_per_m: 4.0,    // assumed
-        workspace_radius_m: 0.1,      // assumed
+        max_stiffness_n_per_m: 1000.0,
+        max_damping_ns_per_m: 5.0, // assumed, as the Phantom Desktop's
+        workspace_radius_m: 0.115,
     }
 }
 

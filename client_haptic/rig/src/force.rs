@@ -58,6 +58,8 @@ pub struct RigTelemetry {
     pub safety_phase: SafetyPhase,
     /// Safety gain (engagement × watchdog).
     pub safety_gain: f32,
+    /// The grip was read outside the workspace, so forces are off (see [`forcecomp::Workspace`]).
+    pub outside_workspace: bool,
     /// Safety counters.
     pub safety: SafetyStats,
 }
@@ -73,6 +75,7 @@ impl Default for RigTelemetry {
             data_age_us: 0,
             safety_phase: SafetyPhase::WaitingForSmallForce,
             safety_gain: 0.0,
+            outside_workspace: false,
             safety: SafetyStats::default(),
         }
     }
@@ -213,7 +216,7 @@ impl ForceStage {
         };
         let before = tick.total();
         let requested = ForceTorque { force: before.force + wanted.force, torque: before.torque + wanted.torque };
-        let out = self.safety.apply(requested, dt, used.age_s());
+        let out = self.safety.apply_at(requested, dt, used.age_s(), device.pose.translation);
         tick.set(out);
 
         let tool_now = match self.rendering {
@@ -315,7 +318,7 @@ impl ForceStage {
         let used = freshness.used(device.timestamp_us);
         let before = tick.total();
         let requested = ForceTorque { force: before.force + contact_device.force, torque: before.torque };
-        let out = self.safety.apply(requested, tick.dt_s, used.age_s());
+        let out = self.safety.apply_at(requested, tick.dt_s, used.age_s(), device.pose.translation);
         tick.set(out);
         let proxy_pose = Pose::new(self.god.proxy(), tip.rotation);
         let reach = self.god.proxy().distance(tip.translation) + self.proxy.margin + self.proxy.tip_radius;
@@ -353,6 +356,7 @@ impl ForceStage {
             data_age_us: age_us,
             safety_phase: self.safety.phase(),
             safety_gain: self.safety.gain(),
+            outside_workspace: self.safety.outside_workspace(),
             safety: self.safety.stats(),
         });
     }

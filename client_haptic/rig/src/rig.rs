@@ -6,7 +6,7 @@
 use std::sync::Mutex;
 
 use collette::pipeline::{CollisionHandle, CollisionThread};
-use forcecomp::{CouplingConfig, GodObject, SafetyConfig, SafetyLayer, VirtualCoupling};
+use forcecomp::{CouplingConfig, GodObject, SafetyConfig, SafetyLayer, VirtualCoupling, Workspace};
 use haptic_common::{Delegator, OnCollision, Pose};
 use haptico::{Device, HapticClock, HapticConfig, HapticEvents, HapticHandle, HapticTelemetry, TickTiming};
 
@@ -27,8 +27,12 @@ pub struct RigConfig {
     pub map: WorkspaceMap,
     /// Coupling (None: derived from the device's limits and a 4 N·s/m hand).
     pub coupling: Option<CouplingConfig>,
-    /// Safety limits (None: the device's peak force and torque with the default habits).
+    /// Safety limits (None: the device's peak force and torque, heating down to its continuous force,
+    /// with the default habits).
     pub safety: Option<SafetyConfig>,
+    /// Where the grip must be read for forces to engage (device frame; see [`Workspace`]), whatever
+    /// `safety` says; None: anywhere. A real device's client sets it from the device's workspace.
+    pub workspace: Option<Workspace>,
     /// Coupled, direct or 3-DOF proxy rendering (default coupled).
     pub rendering: Rendering,
     /// How the 3-DOF proxy feels materials (with `Rendering::Proxy`).
@@ -45,6 +49,7 @@ impl Default for RigConfig {
             map: WorkspaceMap::default(),
             coupling: None,
             safety: None,
+            workspace: None,
             rendering: Rendering::Coupled,
             proxy: ProxyRendering::default(),
             force_sample_capacity: 1 << 16,
@@ -79,7 +84,11 @@ impl Parts {
             CouplingConfig::for_device(specs.max_stiffness_n_per_m, specs.max_damping_ns_per_m, 4.0, period_s)
         });
         coupling.validate()?;
-        let safety = config.safety.unwrap_or_else(|| SafetyConfig::for_limits(specs.peak_force_n, specs.max_torque_nm));
+        let mut safety = config.safety.unwrap_or_else(|| {
+            SafetyConfig::for_limits(specs.peak_force_n, specs.max_torque_nm)
+                .with_continuous_force(specs.continuous_force_n)
+        });
+        safety.workspace = config.workspace.or(safety.workspace);
         safety.validate()?;
         let tool_pose = collision.add_object(tool.tree, Pose::IDENTITY).ok_or(RigError::QueueFull("collision"))?;
         let (telemetry_in, telemetry_out) = triple_buffer::triple_buffer(&RigTelemetry::default());
