@@ -133,7 +133,8 @@ pub struct ViveArgs {
     /// Time and level differences instead of HRTF.
     #[arg(long)]
     pub no_hrtf: bool,
-    /// Save a screenshot here once the museum is shown, then quit.
+    /// Save a screenshot (PNG) here once the museum is shown, then quit; in XR mode the left eye's
+    /// image, as the headset showed it.
     #[arg(long)]
     pub screenshot: Option<PathBuf>,
     /// Frames to wait before the screenshot (lavapipe needs ~120).
