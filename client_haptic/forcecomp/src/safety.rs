@@ -72,9 +72,10 @@ impl Workspace {
         p.distance(self.centre) <= self.radius_m
     }
 
-    /// True when `p` is so far out that forces must stop.
+    /// True when `p` is so far out that forces must stop (or is no position at all: NaN).
     pub fn lost(&self, p: Vec3) -> bool {
-        !(p.distance(self.centre) <= Self::LEAVE * self.radius_m)
+        let d = p.distance(self.centre);
+        d.is_nan() || d > Self::LEAVE * self.radius_m
     }
 }
 
