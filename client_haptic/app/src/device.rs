@@ -257,7 +257,7 @@ pub const BACK_IN_REACH: &str = "The grip is back in reach: you will feel the co
 impl DeviceHealth {
     /// Where a real device's grip must be read for forces to engage: the ball of its published workspace
     /// around the device frame's origin (the Falcon's centre of travel; with the Inverse3, the point the
-    /// copy is felt at, a little below and behind where the grip was held still to centre it). `None` for
+    /// copy is felt at, [`START`]'s 9 cm from where the grip was held still to centre it). `None` for
     /// simulated, recorded and HID devices, whose grip goes where the program puts it.
     pub fn workspace(&self, specs: &DeviceSpecs) -> Option<forcecomp::Workspace> {
         let real = matches!(self, Self::Falcon(_) | Self::Haply(_));

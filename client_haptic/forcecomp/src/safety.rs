@@ -269,7 +269,8 @@ impl SafetyLayer {
         if lost && self.phase != SafetyPhase::WaitingForSmallForce {
             self.disengage();
         }
-        self.outside = !inside && (lost || self.phase == SafetyPhase::WaitingForSmallForce);
+        // Lost means disengaged by now: outside with forces off either way.
+        self.outside = !inside && self.phase == SafetyPhase::WaitingForSmallForce;
         if self.outside {
             self.stats.outside_workspace += 1;
         }
