@@ -104,7 +104,7 @@ impl InnerSphereTree {
         let v3 = |at: usize| Vec3::new(f(at), f(at + 4), f(at + 8));
         let sphere_at = |at: usize| Sphere::new(v3(at), f(at + 12));
         let weighted = version >= 2;
-        let tree = InnerSphereTree {
+        let mut tree = InnerSphereTree {
             spheres: (0..spheres).map(|i| sphere_at(HEADER_SIZE + sphere_size * i)).collect(),
             weights: (0..spheres).map(|i| if weighted { f(HEADER_SIZE + sphere_size * i + 16) } else { 1.0 }).collect(),
             nodes: (0..nodes)
@@ -123,8 +123,11 @@ impl InnerSphereTree {
                 })
                 .collect(),
             mesh_volume: f(24),
+            blocks: Vec::new(),
+            block_of: Vec::new(),
         };
         tree.validate().map_err(IstFileError::Invalid)?;
+        tree.rebuild_blocks();
         Ok(tree)
     }
 

@@ -14,14 +14,21 @@ impl InnerSphereTree {
     /// spread (the split index kept within the middle half so the tree stays balanced), twice per level,
     /// giving up to four children. Inner nodes store the sphere wrapping their leaves and their leaves'
     /// summed volume. Every sphere weighs 1 ([`InnerSphereTree::weights`]): `build` weighs them.
-    pub fn from_spheres(mut spheres: Vec<Sphere>, mesh_volume: f32) -> Self {
+    pub fn from_spheres(spheres: Vec<Sphere>, mesh_volume: f32) -> Self {
+        Self::from_spheres_in_leaves(spheres, mesh_volume, LEAF_SIZE)
+    }
+
+    /// [`InnerSphereTree::from_spheres`] with up to `leaf_size` spheres per leaf (trees from other
+    /// builders, and tests of the queries' paths for them).
+    pub(crate) fn from_spheres_in_leaves(mut spheres: Vec<Sphere>, mesh_volume: f32, leaf_size: usize) -> Self {
+        let leaf_size = leaf_size.max(1);
         let mut nodes = vec![Node::default()];
         let mut work = vec![(0usize, 0usize, spheres.len())];
         while let Some((node, lo, hi)) = work.pop() {
             let slice = &spheres[lo..hi];
             let volume = slice.iter().map(|s| s.volume() as f64).sum::<f64>() as f32;
             let bound = enclosing_sphere(slice);
-            if hi - lo <= LEAF_SIZE {
+            if hi - lo <= leaf_size {
                 nodes[node] =
                     Node { bound, volume, mesh_share: volume, first: lo as u32, count: (hi - lo) as u32, leaf: true };
                 continue;
@@ -29,7 +36,7 @@ impl InnerSphereTree {
             let mid = split(&mut spheres[lo..hi]) + lo;
             let mut parts = Vec::with_capacity(4);
             for (a, b) in [(lo, mid), (mid, hi)] {
-                if b - a > 2 * LEAF_SIZE {
+                if b - a > 2 * leaf_size {
                     let m = split(&mut spheres[a..b]) + a;
                     parts.push((a, m));
                     parts.push((m, b));
@@ -46,7 +53,9 @@ impl InnerSphereTree {
             }
         }
         let weights = vec![1.0; spheres.len()];
-        Self { spheres, weights, nodes, mesh_volume }
+        let mut tree = Self { spheres, weights, nodes, mesh_volume, blocks: Vec::new(), block_of: Vec::new() };
+        tree.rebuild_blocks();
+        tree
     }
 }
 

@@ -7,9 +7,11 @@
 mod build;
 mod traverse;
 mod validate;
+mod wide;
 
 pub use build::LEAF_SIZE;
 pub use traverse::for_each_leaf_in_sphere;
+pub(crate) use wide::ChildBlock;
 
 use crate::shape::Sphere;
 
@@ -41,12 +43,39 @@ impl Node {
 }
 
 /// An Inner Sphere Tree: non-overlapping spheres inside one object, in the object's local frame.
-#[derive(Clone, Debug, PartialEq)]
+///
+/// Two trees are equal when their spheres, weights, nodes and mesh volume are (the child blocks are
+/// derived from them).
+#[derive(Clone)]
 pub struct InnerSphereTree {
     pub(crate) spheres: Vec<Sphere>,
     pub(crate) weights: Vec<f32>,
     pub(crate) nodes: Vec<Node>,
     pub(crate) mesh_volume: f32,
+    /// Each inner node's children side by side ([`wide`]), derived from `nodes`.
+    pub(crate) blocks: Vec<ChildBlock>,
+    /// Per node, its index in `blocks` (`u32::MAX` for leaves).
+    pub(crate) block_of: Vec<u32>,
+}
+
+impl PartialEq for InnerSphereTree {
+    fn eq(&self, other: &Self) -> bool {
+        self.spheres == other.spheres
+            && self.weights == other.weights
+            && self.nodes == other.nodes
+            && self.mesh_volume == other.mesh_volume
+    }
+}
+
+impl std::fmt::Debug for InnerSphereTree {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("InnerSphereTree")
+            .field("spheres", &self.spheres)
+            .field("weights", &self.weights)
+            .field("nodes", &self.nodes)
+            .field("mesh_volume", &self.mesh_volume)
+            .finish_non_exhaustive()
+    }
 }
 
 impl InnerSphereTree {
@@ -108,7 +137,7 @@ impl InnerSphereTree {
     pub fn scaled(&self, factor: f32) -> Self {
         let s = |x: Sphere| Sphere::new(x.center * factor, x.radius * factor);
         let v = factor * factor * factor;
-        Self {
+        let mut scaled = Self {
             spheres: self.spheres.iter().map(|&x| s(x)).collect(),
             weights: self.weights.clone(),
             nodes: self
@@ -117,7 +146,11 @@ impl InnerSphereTree {
                 .map(|n| Node { bound: s(n.bound), volume: n.volume * v, mesh_share: n.mesh_share * v, ..*n })
                 .collect(),
             mesh_volume: self.mesh_volume * v,
-        }
+            blocks: Vec::new(),
+            block_of: Vec::new(),
+        };
+        scaled.rebuild_blocks();
+        scaled
     }
 
     /// A copy whose spheres all weigh 1: its queries give the packing's own overlap volume.
@@ -127,6 +160,7 @@ impl InnerSphereTree {
         for n in &mut t.nodes {
             n.mesh_share = n.volume;
         }
+        t.rebuild_blocks();
         t
     }
 
@@ -144,5 +178,6 @@ impl InnerSphereTree {
             };
             self.nodes[i].mesh_share = share as f32;
         }
+        self.rebuild_blocks();
     }
 }

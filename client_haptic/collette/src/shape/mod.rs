@@ -9,3 +9,4 @@ mod sphere;
 pub use mesh::TriMesh;
 pub use primitives::{box_buffers, torus_buffers, uv_sphere_buffers};
 pub use sphere::{Lens, Sphere, lens, lens_volume, sphere_volume};
+pub(crate) use sphere::{Lens4, lens_x4};

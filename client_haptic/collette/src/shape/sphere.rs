@@ -1,6 +1,6 @@
 //! Spheres and the exact geometry of two overlapping spheres (the lens).
 
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 use std::f32::consts::PI;
 
 /// A ball: centre and radius, in the units of its tree (metres for the scene helpers).
@@ -58,20 +58,17 @@ pub fn lens_volume(r1: f32, r2: f32, d: f32) -> f32 {
 }
 
 /// Volume of a spherical cap of height `h` (0..=2r) cut from a ball of radius `r`.
-#[inline]
+#[inline(always)]
 fn cap_volume(r: f32, h: f32) -> f32 {
     PI * h * h * (3.0 * r - h) / 3.0
 }
 
-/// Distance from the ball's centre to the centroid of a cap of height `h` (0 < h <= 2r).
-#[inline]
-fn cap_centroid_offset(r: f32, h: f32) -> f32 {
-    let denom = 3.0 * r - h;
-    if denom <= 0.0 {
-        return 0.0;
-    }
-    let a = 2.0 * r - h;
-    3.0 * a * a / (4.0 * denom)
+/// A cap's volume times the distance from the ball's centre to the cap's centroid (its first moment
+/// along the axis): `π h² (2r − h)² / 4` for a cap of height `h` cut from a ball of radius `r`.
+#[inline(always)]
+fn cap_moment(r: f32, h: f32) -> f32 {
+    let a = h * (2.0 * r - h);
+    PI * 0.25 * a * a
 }
 
 /// Geometry of the overlap of two balls.
@@ -87,7 +84,9 @@ pub struct Lens {
 
 /// The lens of two balls, or `None` when they do not overlap. The centroid lies on the centre line; when
 /// one ball contains the other it is the smaller ball's centre.
-#[inline]
+///
+/// Two divisions and one square root: the caps' centroids enter through their first moments.
+#[inline(always)]
 pub fn lens(c1: Vec3, r1: f32, c2: Vec3, r2: f32) -> Option<Lens> {
     let delta = c2 - c1;
     let d2 = delta.length_squared();
@@ -101,9 +100,10 @@ pub fn lens(c1: Vec3, r1: f32, c2: Vec3, r2: f32) -> Option<Lens> {
         let (c, r) = if r1 <= r2 { (c1, r1) } else { (c2, r2) };
         return Some(Lens { volume: sphere_volume(r), centroid: c, depth });
     }
-    let u = delta / d;
+    let inv_d = 1.0 / d;
+    let u = delta * inv_d;
     // Distance from c1 to the radical plane; the lens is cap 1 (beyond the plane) plus cap 2.
-    let x1 = (d2 + r1 * r1 - r2 * r2) / (2.0 * d);
+    let x1 = (d2 + r1 * r1 - r2 * r2) * 0.5 * inv_d;
     let h1 = (r1 - x1).clamp(0.0, 2.0 * r1);
     let h2 = (r2 - (d - x1)).clamp(0.0, 2.0 * r2);
     let v1 = cap_volume(r1, h1);
@@ -112,9 +112,53 @@ pub fn lens(c1: Vec3, r1: f32, c2: Vec3, r2: f32) -> Option<Lens> {
     if volume <= 0.0 {
         return Some(Lens { volume: 0.0, centroid: c1 + u * x1, depth });
     }
-    let p1 = c1 + u * cap_centroid_offset(r1, h1);
-    let p2 = c2 - u * cap_centroid_offset(r2, h2);
-    Some(Lens { volume, centroid: (p1 * v1 + p2 * v2) / volume, depth })
+    // Cap 1's centroid lies beyond c1 along u, cap 2's before c2.
+    let moment = c1 * v1 + c2 * v2 + u * (cap_moment(r1, h1) - cap_moment(r2, h2));
+    Some(Lens { volume, centroid: moment * (1.0 / volume), depth })
+}
+
+/// Four lenses at once ([`lens`] lane by lane, structure of arrays): centres `c1`, `c2` as x, y, z
+/// lanes. Lanes whose balls do not overlap get volume 0.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Lens4 {
+    pub volume: Vec4,
+    pub centroid: [Vec4; 3],
+    pub depth: Vec4,
+}
+
+/// [`lens`] for four pairs of balls at once.
+#[inline(always)]
+pub(crate) fn lens_x4(c1: [Vec4; 3], r1: Vec4, c2: [Vec4; 3], r2: Vec4) -> Lens4 {
+    let delta = [c2[0] - c1[0], c2[1] - c1[1], c2[2] - c1[2]];
+    let d2 = delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2];
+    let s = r1 + r2;
+    let apart = d2.cmpge(s * s);
+    let d = d2.sqrt();
+    let depth = s - d;
+    let inside = d.cmple((r1 - r2).abs());
+    let inv_d = d.recip();
+    let x1 = (d2 + r1 * r1 - r2 * r2) * Vec4::splat(0.5) * inv_d;
+    let h1 = (r1 - x1).clamp(Vec4::ZERO, r1 * 2.0);
+    let h2 = (r2 - (d - x1)).clamp(Vec4::ZERO, r2 * 2.0);
+    let third = Vec4::splat(PI / 3.0);
+    let v1 = third * h1 * h1 * (r1 * 3.0 - h1);
+    let v2 = third * h2 * h2 * (r2 * 3.0 - h2);
+    let (a1, a2) = (h1 * (r1 * 2.0 - h1), h2 * (r2 * 2.0 - h2));
+    let moment = Vec4::splat(PI * 0.25) * (a1 * a1 - a2 * a2) * inv_d;
+    let lens_volume = v1 + v2;
+    let inv_v = lens_volume.recip();
+    // The smaller ball when one contains the other.
+    let first_smaller = r1.cmple(r2);
+    let small_r = r1.min(r2);
+    let small_volume = Vec4::splat(4.0 / 3.0 * PI) * small_r * small_r * small_r;
+    let mut centroid = [Vec4::ZERO; 3];
+    for k in 0..3 {
+        let lens_c = (c1[k] * v1 + c2[k] * v2 + delta[k] * moment) * inv_v;
+        let small_c = Vec4::select(first_smaller, c1[k], c2[k]);
+        centroid[k] = Vec4::select(inside, small_c, lens_c);
+    }
+    let volume = Vec4::select(inside, small_volume, lens_volume.max(Vec4::ZERO));
+    Lens4 { volume: Vec4::select(apart, Vec4::ZERO, volume), centroid, depth }
 }
 
 #[cfg(test)]
@@ -166,6 +210,45 @@ mod tests {
         assert_eq!(lens_volume(1.0, 1.0, 3.0), 0.0);
         assert!((lens_volume(2.0, 0.5, 0.5) - sphere_volume(0.5)).abs() < 1e-6);
         assert!(lens(Vec3::ZERO, 1.0, Vec3::X * 2.5, 1.0).is_none());
+    }
+
+    #[test]
+    fn four_lenses_at_once_match_one_at_a_time() {
+        let mut seed = 7u32;
+        let mut next = || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) as f32 / (1 << 24) as f32
+        };
+        for _ in 0..2_000 {
+            let mut c1 = [Vec4::ZERO; 3];
+            let mut c2 = [Vec4::ZERO; 3];
+            let (mut r1, mut r2) = (Vec4::ZERO, Vec4::ZERO);
+            for lane in 0..4 {
+                for k in 0..3 {
+                    c1[k][lane] = next() * 2.0 - 1.0;
+                    c2[k][lane] = next() * 2.0 - 1.0;
+                }
+                r1[lane] = 0.05 + next();
+                r2[lane] = 0.05 + next() * 0.5;
+            }
+            // One lane with the balls concentric.
+            for k in 0..3 {
+                c2[k][3] = c1[k][3];
+            }
+            let four = lens_x4(c1, r1, c2, r2);
+            for lane in 0..4 {
+                let p = |c: [Vec4; 3]| Vec3::new(c[0][lane], c[1][lane], c[2][lane]);
+                let one = lens(p(c1), r1[lane], p(c2), r2[lane]);
+                let (v, c) = one.map_or((0.0, Vec3::ZERO), |l| (l.volume, l.centroid));
+                let scale = (r1[lane] + r2[lane]).powi(3);
+                assert!((four.volume[lane] - v).abs() <= 1e-5 * scale, "lane {lane}: {} vs {v}", four.volume[lane]);
+                if v > 1e-4 * scale {
+                    assert!(p(four.centroid).distance(c) <= 1e-4, "lane {lane}: {} vs {c}", p(four.centroid));
+                    let depth = one.map_or(0.0, |l| l.depth);
+                    assert!((four.depth[lane] - depth).abs() <= 1e-5, "lane {lane} depth");
+                }
+            }
+        }
     }
 
     #[test]

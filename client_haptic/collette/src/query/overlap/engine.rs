@@ -1,29 +1,41 @@
 //! The simultaneous descent of two trees shared by the exact and budgeted overlap queries.
 
+use super::affine::WideAffine;
+use super::batch::{Lanes, PAIR_BATCH, PairBatch};
+use super::sink::Sink;
 use super::{Budget, OverlapResult};
 use crate::partitioning::{InnerSphereTree, Node};
 use crate::query::QueryWorkspace;
-use crate::shape::{Lens, lens, sphere_volume};
-use glam::{Affine3A, Vec3};
+use crate::shape::{Lens, lens, lens_x4, sphere_volume};
+use glam::{Affine3A, Vec3, Vec4};
 use haptic_common::Pose;
 use std::time::Instant;
 
 /// How many node pairs are tested between two clock reads.
 const CLOCK_STRIDE: u32 = 8;
 
+/// Room on [`Engine::subtree_in_sphere`]'s stack: a valid tree is at most 64 levels deep and leaves at
+/// most three siblings per level waiting, so it never overflows (and spills onto the pair stack if it did).
+const LOCAL_DEPTH: usize = 200;
+
 pub(super) struct Engine<'a, S> {
     a: &'a InnerSphereTree,
     b: &'a InnerSphereTree,
     pos12: Affine3A,
+    /// `pos12`'s entries, each in all four lanes (moving four of B's centres at once).
+    wide: WideAffine,
     budget: Budget,
     aggregate: bool,
     sink: S,
+    pairs: PairBatch,
+    /// Stack of A's blocks for [`Engine::subtree_in_sphere`].
+    local: [u32; LOCAL_DEPTH],
     until_clock: u32,
     exhausted: bool,
     pub(super) result: OverlapResult,
 }
 
-impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
+impl<'a, S: Sink> Engine<'a, S> {
     /// `aggregate`: a node lying wholly inside one leaf sphere of the other tree contributes its summed
     /// volume as one contact (exact volume, far fewer pairs) instead of one contact per leaf pair.
     /// Every volume is weighted by both spheres' weights ([`InnerSphereTree::weights`]).
@@ -36,13 +48,17 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
         sink: S,
     ) -> Self {
         let result = OverlapResult { complete: true, ..OverlapResult::default() };
+        let pos12 = Affine3A::from_rotation_translation(pos12.rotation, pos12.translation);
         Self {
             a,
             b,
-            pos12: Affine3A::from_rotation_translation(pos12.rotation, pos12.translation),
+            pos12,
+            wide: WideAffine::new(&pos12),
             budget,
             aggregate,
             sink,
+            pairs: PairBatch::new(),
+            local: [0; LOCAL_DEPTH],
             until_clock: 0,
             exhausted: false,
             result,
@@ -58,16 +74,26 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
     /// Exact depth-first descent.
     pub(super) fn run_depth_first(&mut self, ws: &mut QueryWorkspace) {
         ws.stack.clear();
-        ws.stack.push((0, 0));
+        if self.root_needs_visit() {
+            ws.stack.push((0, 0));
+        }
         self.drain_stack(ws);
+        self.flush_pairs();
     }
 
     /// Breadth-first descent in a fixed ring; overflow is refined depth-first; stops on the budget.
     pub(super) fn run_breadth_first(&mut self, ws: &mut QueryWorkspace) {
+        ws.stack.clear();
+        if self.root_needs_visit() {
+            self.breadth_first(ws);
+        }
+        self.flush_pairs();
+    }
+
+    fn breadth_first(&mut self, ws: &mut QueryWorkspace) {
         let cap = ws.ring.len();
         let (mut head, mut len) = (0usize, 1usize);
         ws.ring[0] = (0, 0);
-        ws.stack.clear();
         while len > 0 {
             if self.out_of_budget(len as f32 * ws.estimate_ns) {
                 break;
@@ -75,15 +101,15 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
             let (ia, ib) = ws.ring[head];
             head = (head + 1) % cap;
             len -= 1;
-            let (children, n) = self.visit(ia, ib);
-            for &pair in &children[..n] {
-                if len < cap {
-                    ws.ring[(head + len) % cap] = pair;
-                    len += 1;
-                } else {
-                    ws.stack.push(pair);
-                }
+            // The stack is empty here: the children land on it, then move to the ring while it has room.
+            self.visit(ia, ib, &mut ws.stack);
+            let mut moved = 0;
+            while moved < ws.stack.len() && len < cap {
+                ws.ring[(head + len) % cap] = ws.stack[moved];
+                len += 1;
+                moved += 1;
             }
+            ws.stack.drain(..moved);
             if !ws.stack.is_empty() {
                 self.drain_stack(ws);
             }
@@ -103,6 +129,22 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
         }
     }
 
+    /// Tests the two roots; handles them when the answer ends there (two leaves, one inside a leaf
+    /// sphere); true when their children must be visited.
+    fn root_needs_visit(&mut self) -> bool {
+        let (na, nb) = (self.a.nodes[0], self.b.nodes[0]);
+        let cb = self.tp(nb.bound.center);
+        let r = na.bound.radius + nb.bound.radius;
+        if na.bound.center.distance_squared(cb) >= r * r {
+            return false;
+        }
+        if na.leaf && nb.leaf {
+            self.leaf_pairs(&na, &nb);
+            return false;
+        }
+        !(self.aggregate && self.contained(&na, &nb, cb))
+    }
+
     fn drain_stack(&mut self, ws: &mut QueryWorkspace) {
         while let Some((ia, ib)) = ws.stack.pop() {
             if self.out_of_budget(0.0) {
@@ -112,8 +154,7 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
                 }
                 return;
             }
-            let (children, n) = self.visit(ia, ib);
-            ws.stack.extend_from_slice(&children[..n]);
+            self.visit(ia, ib, &mut ws.stack);
         }
     }
 
@@ -141,48 +182,204 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
         self.exhausted
     }
 
-    /// Tests a node pair; refines leaf pairs exactly; returns the child pairs to visit.
+    /// Visits an overlapping node pair that does not end the descent: tests the larger node's children
+    /// (four at once, from its [`crate::partitioning::ChildBlock`]) against the other node, settles the
+    /// child pairs that end here (two leaves: their sphere pairs; with `aggregate`, a node inside one
+    /// leaf sphere: one contact) and pushes the others, which overlap and must be visited in turn, on
+    /// `next`. A subtree of A against one sphere of B (most of an exact query's work) goes to
+    /// [`Engine::subtree_in_sphere`].
     #[inline]
-    fn visit(&mut self, ia: u32, ib: u32) -> ([(u32, u32); 4], usize) {
-        let mut children = [(0u32, 0u32); 4];
+    fn visit(&mut self, ia: u32, ib: u32, next: &mut Vec<(u32, u32)>) {
         self.result.node_pairs += 1;
-        let na = &self.a.nodes[ia as usize];
-        let nb = &self.b.nodes[ib as usize];
-        let cb = self.tp(nb.bound.center);
-        let r = na.bound.radius + nb.bound.radius;
-        if na.bound.center.distance_squared(cb) >= r * r {
-            return (children, 0);
-        }
-        if na.leaf && nb.leaf {
-            self.leaf_pairs(na, nb);
-            return (children, 0);
-        }
-        if self.aggregate && self.contained(na, nb, cb) {
-            return (children, 0);
-        }
-        // Children are tested here, so pairs that cannot overlap are never queued.
-        let descend_a = nb.leaf || (!na.leaf && na.bound.radius >= nb.bound.radius);
-        let mut n = 0;
-        if descend_a {
-            for c in na.range() {
-                let child = &self.a.nodes[c].bound;
-                let r = child.radius + nb.bound.radius;
-                if child.center.distance_squared(cb) < r * r {
-                    children[n] = (c as u32, ib);
-                    n += 1;
+        let (a, b) = (self.a, self.b);
+        let na = &a.nodes[ia as usize];
+        let nb = &b.nodes[ib as usize];
+        if nb.leaf && nb.count == 1 && !na.leaf && self.budget == Budget::Unlimited {
+            // The common case deep in the descent: a subtree of A against one sphere of B.
+            let s = &b.spheres[nb.first as usize];
+            self.subtree_in_sphere(ia, self.tp(s.center), s.radius, nb.first, ib, next);
+        } else if nb.leaf || (!na.leaf && na.bound.radius >= nb.bound.radius) {
+            // A's children against B (in A's frame).
+            let (cb, rb) = Self::bound_of(b, nb);
+            let cb = self.tp(cb);
+            let blk = a.block(ia);
+            let (dx, dy, dz) = (blk.x - Vec4::splat(cb.x), blk.y - Vec4::splat(cb.y), blk.z - Vec4::splat(cb.z));
+            let d2 = dx * dx + dy * dy + dz * dz;
+            let (reach, gap) = (blk.r + Vec4::splat(rb), blk.r - Vec4::splat(rb));
+            let mut hits = d2.cmplt(reach * reach).bitmask();
+            // Containment is possible only for a leaf at least as large as the other node.
+            let (b_holds, a_holds) = (gap.cmple(Vec4::ZERO).bitmask(), gap.cmpge(Vec4::ZERO).bitmask());
+            let leafy = if nb.leaf { b_holds } else { 0 } | (blk.leaf & a_holds);
+            let nested = d2.cmple(gap * gap).bitmask() & leafy;
+            while hits != 0 {
+                let lane = hits.trailing_zeros() as usize;
+                hits &= hits - 1;
+                let child = blk.node[lane];
+                if nb.leaf && blk.leaf >> lane & 1 != 0 {
+                    if blk.single >> lane & 1 != 0 && nb.count == 1 {
+                        let ca = Vec3::new(blk.x[lane], blk.y[lane], blk.z[lane]);
+                        self.sphere_pair(ca, blk.r[lane], blk.link[lane], cb, rb, nb.first);
+                    } else {
+                        self.leaf_pairs(&a.nodes[child as usize], nb);
+                    }
+                } else if !(self.aggregate
+                    && nested >> lane & 1 != 0
+                    && self.nest(
+                        child,
+                        Vec3::new(blk.x[lane], blk.y[lane], blk.z[lane]),
+                        blk.r[lane],
+                        ib,
+                        cb,
+                        rb,
+                        d2[lane],
+                    ))
+                {
+                    next.push((child, ib));
                 }
             }
         } else {
-            for c in nb.range() {
-                let child = &self.b.nodes[c].bound;
-                let r = na.bound.radius + child.radius;
-                if na.bound.center.distance_squared(self.tp(child.center)) < r * r {
-                    children[n] = (ia, c as u32);
-                    n += 1;
+            // B's children, moved into A's frame four at once, against A.
+            let (ca, ra) = Self::bound_of(a, na);
+            let blk = b.block(ib);
+            let [x, y, z] = self.wide.point(blk.x, blk.y, blk.z);
+            let (dx, dy, dz) = (x - Vec4::splat(ca.x), y - Vec4::splat(ca.y), z - Vec4::splat(ca.z));
+            let d2 = dx * dx + dy * dy + dz * dz;
+            let (reach, gap) = (blk.r + Vec4::splat(ra), blk.r - Vec4::splat(ra));
+            let mut hits = d2.cmplt(reach * reach).bitmask();
+            // Containment is possible only for a leaf at least as large as the other node.
+            let (b_holds, a_holds) = (gap.cmpge(Vec4::ZERO).bitmask(), gap.cmple(Vec4::ZERO).bitmask());
+            let leafy = if na.leaf { a_holds } else { 0 } | (blk.leaf & b_holds);
+            let nested = d2.cmple(gap * gap).bitmask() & leafy;
+            while hits != 0 {
+                let lane = hits.trailing_zeros() as usize;
+                hits &= hits - 1;
+                let child = blk.node[lane];
+                if na.leaf && blk.leaf >> lane & 1 != 0 {
+                    if blk.single >> lane & 1 != 0 && na.count == 1 {
+                        let cb = Vec3::new(x[lane], y[lane], z[lane]);
+                        self.sphere_pair(ca, ra, na.first, cb, blk.r[lane], blk.link[lane]);
+                    } else {
+                        self.leaf_pairs(na, &b.nodes[child as usize]);
+                    }
+                } else if !(self.aggregate
+                    && nested >> lane & 1 != 0
+                    && self.nest(ia, ca, ra, child, Vec3::new(x[lane], y[lane], z[lane]), blk.r[lane], d2[lane]))
+                {
+                    next.push((ia, child));
                 }
             }
         }
-        (children, n)
+    }
+
+    /// Descends A's subtree under inner node `ia` against B's sphere `sb` (centre `cb` in A's frame,
+    /// radius `rb`, in leaf `ib`) on a small local stack: the same answer as visiting each pair, without
+    /// reloading B's side or transforming it again. Exact queries only (no budget is checked).
+    fn subtree_in_sphere(&mut self, ia: u32, cb: Vec3, rb: f32, sb: u32, ib: u32, next: &mut Vec<(u32, u32)>) {
+        let a = self.a;
+        let wb = self.b.weights[sb as usize];
+        let (x0, y0, z0, r0) = (Vec4::splat(cb.x), Vec4::splat(cb.y), Vec4::splat(cb.z), Vec4::splat(rb));
+        let mut len = 1;
+        self.local[0] = a.block_of[ia as usize];
+        while len > 0 {
+            len -= 1;
+            self.result.node_pairs += 1;
+            let blk = a.block_at(self.local[len]);
+            let (dx, dy, dz) = (blk.x - x0, blk.y - y0, blk.z - z0);
+            let d2 = dx * dx + dy * dy + dz * dz;
+            let (reach, gap) = (blk.r + r0, r0 - blk.r);
+            let hits = d2.cmplt(reach * reach).bitmask();
+            let leaves = hits & blk.leaf;
+            for lane in Lanes(leaves & blk.single) {
+                let ca = Vec3::new(blk.x[lane], blk.y[lane], blk.z[lane]);
+                self.sphere_pair(ca, blk.r[lane], blk.link[lane], cb, rb, sb);
+            }
+            for lane in Lanes(leaves & !blk.single) {
+                self.leaf_pairs(&a.nodes[blk.node[lane] as usize], &self.b.nodes[ib as usize]);
+            }
+            let inner = hits & !blk.leaf;
+            // Inside the sphere: |c - cb| + r <= rb.
+            let inside =
+                if self.aggregate { inner & (d2.cmple(gap * gap) & gap.cmpge(Vec4::ZERO)).bitmask() } else { 0 };
+            for lane in Lanes(inside) {
+                let ca = Vec3::new(blk.x[lane], blk.y[lane], blk.z[lane]);
+                let l = Lens { volume: blk.share[lane] * wb, centroid: ca, depth: blk.r[lane] + rb - d2[lane].sqrt() };
+                self.emit_aggregate(&l, ca, cb);
+            }
+            for lane in Lanes(inner & !inside) {
+                if len < LOCAL_DEPTH {
+                    self.local[len] = blk.link[lane];
+                    len += 1;
+                } else {
+                    next.push((blk.node[lane], ib));
+                }
+            }
+        }
+    }
+
+    /// A pair of nodes whose bounds nest (one inside the other; bounds in A's frame, `d2` apart
+    /// squared), not two leaves: true when one node lies inside a leaf sphere of the other tree, which
+    /// then gives one contact carrying the node's volume.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(never)]
+    fn nest(&mut self, ia: u32, ca: Vec3, ra: f32, ib: u32, cb: Vec3, rb: f32, d2: f32) -> bool {
+        let (a, b) = (self.a, self.b);
+        let (na, nb) = (&a.nodes[ia as usize], &b.nodes[ib as usize]);
+        if nb.leaf && nb.count == 1 && rb >= ra {
+            // A's node inside B's sphere.
+            let volume = na.mesh_share * b.weights[nb.first as usize];
+            self.emit_aggregate(&Lens { volume, centroid: ca, depth: ra + rb - d2.sqrt() }, ca, cb);
+            return true;
+        }
+        if na.leaf && na.count == 1 && ra >= rb {
+            // B's node inside A's sphere.
+            let volume = nb.mesh_share * a.weights[na.first as usize];
+            self.emit_aggregate(&Lens { volume, centroid: cb, depth: ra + rb - d2.sqrt() }, ca, cb);
+            return true;
+        }
+        // A leaf of several spheres (a tree from another builder): test each sphere.
+        ((na.leaf && na.count != 1) || (nb.leaf && nb.count != 1)) && self.contained(na, nb, self.tp(nb.bound.center))
+    }
+
+    /// A node's bound in its own frame: the sphere itself for a one-sphere leaf (what its parent's
+    /// block holds), else the node's bound.
+    #[inline(always)]
+    fn bound_of(tree: &InnerSphereTree, node: &Node) -> (Vec3, f32) {
+        if node.leaf && node.count == 1 {
+            let s = &tree.spheres[node.first as usize];
+            (s.center, s.radius)
+        } else {
+            (node.bound.center, node.bound.radius)
+        }
+    }
+
+    /// One pair of leaf spheres (A's sphere `sa` at `ca`, B's sphere `sb` at `cb`, both in A's frame).
+    #[inline(always)]
+    fn sphere_pair(&mut self, ca: Vec3, ra: f32, sa: u32, cb: Vec3, rb: f32, sb: u32) {
+        let weight = self.a.weights[sa as usize] * self.b.weights[sb as usize];
+        if self.pairs.push(ca, ra, cb, rb, weight) {
+            self.flush_pairs();
+        }
+    }
+
+    /// Computes the queued sphere pairs' lenses four at once and reports them.
+    fn flush_pairs(&mut self) {
+        let n = self.pairs.len;
+        self.pairs.len = 0;
+        let p = &self.pairs;
+        for at in (0..n).step_by(4) {
+            let v = |x: &[f32; PAIR_BATCH]| Vec4::from_slice(&x[at..at + 4]);
+            let (ca, cb) = ([v(&p.ax), v(&p.ay), v(&p.az)], [v(&p.bx), v(&p.by), v(&p.bz)]);
+            let mut lenses = lens_x4(ca, v(&p.ar), cb, v(&p.br));
+            lenses.volume *= v(&p.w);
+            let lanes = lenses.volume.cmpgt(Vec4::ZERO).bitmask() & ((1u32 << (n - at).min(4)) - 1);
+            let mut left = lanes;
+            while left != 0 {
+                self.result.total_volume += lenses.volume[left.trailing_zeros() as usize];
+                self.result.leaf_pairs += 1;
+                left &= left - 1;
+            }
+            self.sink.four(&lenses, ca, cb, lanes);
+        }
     }
 
     #[inline]
@@ -198,7 +395,7 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
                     l.volume *= wa * wb;
                     self.result.total_volume += l.volume;
                     self.result.leaf_pairs += 1;
-                    (self.sink)(&l, sa.center, cb);
+                    self.sink.one(&l, sa.center, cb);
                 }
             }
         }
@@ -241,7 +438,7 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
         if l.volume > 0.0 {
             self.result.total_volume += l.volume;
             self.result.aggregated_pairs += 1;
-            (self.sink)(l, ca, cb);
+            self.sink.one(l, ca, cb);
         }
     }
 
@@ -260,6 +457,6 @@ impl<'a, S: FnMut(&Lens, Vec3, Vec3)> Engine<'a, S> {
         self.result.total_volume += l.volume;
         self.result.estimated_volume += l.volume;
         self.result.estimated_pairs += 1;
-        (self.sink)(&l, na.bound.center, cb);
+        self.sink.one(&l, na.bound.center, cb);
     }
 }

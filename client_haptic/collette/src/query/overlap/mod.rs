@@ -3,14 +3,17 @@
 //! Inner spheres of one object never overlap each other, so the summed lens volumes are exactly the
 //! overlap volume of the two packings (a lower bound of the objects' intersection volume).
 
+mod affine;
+mod batch;
 mod engine;
+mod sink;
 
 use crate::partitioning::InnerSphereTree;
 use crate::query::QueryWorkspace;
-use crate::shape::Lens;
 use engine::Engine;
-use glam::Vec3;
-use haptic_common::{Contact, ContactSet, Pose};
+use glam::{Affine3A, Vec3};
+use haptic_common::{ContactSet, Pose};
+use sink::{Contacts, VolumeOnly};
 use std::time::Instant;
 
 /// How much work a budgeted query may do before estimating the rest.
@@ -51,8 +54,7 @@ pub fn overlap_volume(
     pose_b: &Pose,
     ws: &mut QueryWorkspace,
 ) -> OverlapResult {
-    let mut engine =
-        Engine::new(a, b, pose_a.relative_to(pose_b), Budget::Unlimited, true, |_: &Lens, _: Vec3, _: Vec3| {});
+    let mut engine = Engine::new(a, b, pose_a.relative_to(pose_b), Budget::Unlimited, true, VolumeOnly);
     engine.run_depth_first(ws);
     engine.result
 }
@@ -103,19 +105,8 @@ fn run(
     out: &mut ContactSet,
 ) -> OverlapResult {
     out.clear();
-    let rot = pose_a.rotation;
-    let fallback = fallback_normal(a, b, pose_a, pose_b);
-    let sink = |lens: &Lens, ca: Vec3, cb: Vec3| {
-        let delta = ca - cb;
-        let len = delta.length();
-        let normal = if len > 1e-12 { rot * (delta / len) } else { fallback };
-        out.push(Contact {
-            point: pose_a.transform_point(lens.centroid),
-            normal,
-            volume: lens.volume,
-            depth: lens.depth,
-        });
-    };
+    let to_world = Affine3A::from_rotation_translation(pose_a.rotation, pose_a.translation);
+    let sink = Contacts::new(to_world, fallback_normal(a, b, pose_a, pose_b), out);
     let mut engine = Engine::new(a, b, pose_a.relative_to(pose_b), budget, aggregate, sink);
     match budget {
         Budget::Unlimited => engine.run_depth_first(ws),

@@ -1,5 +1,5 @@
 use super::*;
-use crate::shape::{box_buffers, lens_volume, uv_sphere_buffers};
+use crate::shape::{box_buffers, lens_volume, torus_buffers, uv_sphere_buffers};
 use crate::{BuildOptions, TriMesh, build};
 use glam::Quat;
 use std::sync::OnceLock;
@@ -14,9 +14,16 @@ fn ball(spheres: usize) -> InnerSphereTree {
     tree_of(v, t, spheres)
 }
 
-fn small_ball() -> &'static InnerSphereTree {
+/// A torus (R 0.7, r 0.3) of 300 spheres: many spheres of many sizes (a ball's packing is nearly one
+/// sphere, too simple to exercise a descent).
+fn torus(spheres: usize) -> InnerSphereTree {
+    let (v, t) = torus_buffers(0.7, 0.3, 48, 24);
+    tree_of(v, t, spheres)
+}
+
+fn small_tree() -> &'static InnerSphereTree {
     static T: OnceLock<InnerSphereTree> = OnceLock::new();
-    T.get_or_init(|| ball(300))
+    T.get_or_init(|| torus(300))
 }
 
 fn unit_box(spheres: usize) -> InnerSphereTree {
@@ -43,7 +50,8 @@ fn volume(a: &InnerSphereTree, pa: &Pose, b: &InnerSphereTree, pb: &Pose) -> f32
 
 #[test]
 fn the_tree_traversal_finds_every_overlapping_pair() {
-    let t = small_ball();
+    let t = small_tree();
+    assert!(t.spheres().len() > 200, "a tree worth descending");
     let pb = Pose::new(Vec3::new(0.9, 0.3, -0.2), Quat::from_rotation_y(0.4));
     let exact = brute_force(t, &Pose::IDENTITY, t, &pb);
     let got = volume(t, &Pose::IDENTITY, t, &pb) as f64;
@@ -89,7 +97,7 @@ fn the_overlap_of_two_boxes_converges_to_the_exact_value_and_the_weights_close_t
 
 #[test]
 fn overlap_is_symmetric_in_its_two_objects() {
-    let (a, b) = (small_ball(), unit_box(200));
+    let (a, b) = (small_tree(), unit_box(200));
     let pa = Pose::new(Vec3::new(0.1, 0.2, 0.3), Quat::from_rotation_x(0.3));
     let pb = Pose::new(Vec3::new(0.8, 0.1, 0.2), Quat::from_rotation_z(1.1));
     let mut ws = QueryWorkspace::new();
@@ -105,7 +113,7 @@ fn overlap_is_symmetric_in_its_two_objects() {
 
 #[test]
 fn a_rigid_motion_of_both_objects_changes_nothing() {
-    let t = small_ball();
+    let t = small_tree();
     let (pa, pb) = (Pose::IDENTITY, Pose::new(Vec3::new(0.7, 0.5, 0.0), Quat::from_rotation_y(0.9)));
     let m = Pose::new(Vec3::new(10.0, -3.0, 2.0), Quat::from_euler(glam::EulerRot::XYZ, 0.4, -1.2, 2.0));
     let before = volume(t, &pa, t, &pb);
@@ -115,7 +123,7 @@ fn a_rigid_motion_of_both_objects_changes_nothing() {
 
 #[test]
 fn small_motions_give_small_volume_changes() {
-    let t = small_ball();
+    let t = small_tree();
     let step = 1e-3;
     let mut last = volume(t, &Pose::IDENTITY, t, &Pose::from_translation(Vec3::X * 1.0));
     for k in 1..200 {
@@ -165,6 +173,78 @@ fn a_time_budget_is_held_within_a_small_margin() {
     assert!(overshoots[25] < std::time::Duration::from_micros(150), "median overshoot {:?}", overshoots[25]);
 }
 
+/// Checks every query kind against brute force at `pose` and that the contacts carry the volume;
+/// returns how many contacts the every-pair and the aggregated query gave.
+fn check_every_query(a: &InnerSphereTree, pa: &Pose, b: &InnerSphereTree, pb: &Pose) -> (usize, usize) {
+    let reference = brute_force(a, pa, b, pb);
+    let mut ws = QueryWorkspace::new();
+    let mut set = ContactSet::new();
+    let close = |v: f32| (v as f64 - reference).abs() <= 1e-4 * reference + 1e-9;
+    let every = overlap(a, pa, b, pb, &mut ws, &mut set);
+    assert!(close(every.total_volume), "every-pair {} vs brute force {reference}", every.total_volume);
+    assert_eq!(set.len() as u32, every.leaf_pairs, "one contact per overlapping sphere pair");
+    let carried: f64 = set.as_slice().iter().map(|c| c.volume as f64).sum();
+    assert!((carried - every.total_volume as f64).abs() <= 1e-4 * reference + 1e-9, "contacts carry the volume");
+    let aggregated = overlap_budgeted(a, pa, b, pb, Budget::Unlimited, &mut ws, &mut set);
+    assert!(close(aggregated.total_volume), "aggregated {} vs brute force {reference}", aggregated.total_volume);
+    assert!(aggregated.complete && aggregated.estimated_volume == 0.0);
+    let carried: f64 = set.as_slice().iter().map(|c| c.volume as f64).sum();
+    assert!((carried - aggregated.total_volume as f64).abs() <= 1e-4 * reference + 1e-9, "contacts carry the volume");
+    assert_eq!(set.len() as u32, aggregated.leaf_pairs + aggregated.aggregated_pairs);
+    for c in set.as_slice() {
+        assert!((c.normal.length() - 1.0).abs() < 1e-4 && c.volume > 0.0 && c.point.is_finite(), "{c:?}");
+    }
+    let contacts = (every.leaf_pairs as usize, set.len());
+    assert!(close(overlap_volume(a, pa, b, pb, &mut ws).total_volume));
+    let ample = overlap_budgeted(a, pa, b, pb, Budget::NodePairs(u32::MAX), &mut ws, &mut set);
+    assert!(close(ample.total_volume), "budgeted with an ample budget {}", ample.total_volume);
+    contacts
+}
+
+#[test]
+fn every_query_matches_brute_force_for_trees_of_different_scales() {
+    // A small dense torus against a larger box: deep in the descent a subtree of one meets a single
+    // sphere of the other (the exact query's shortcut), and whole subtrees lie inside single spheres.
+    let small = torus(600).scaled(0.15);
+    assert!(small.spheres().len() >= 500);
+    let large = unit_box(300);
+    for (k, offset) in [Vec3::new(0.42, 0.1, 0.05), Vec3::new(0.3, 0.3, 0.3), Vec3::ZERO, Vec3::new(0.55, 0.0, 0.2)]
+        .into_iter()
+        .enumerate()
+    {
+        let pa = Pose::new(offset, Quat::from_rotation_y(0.3 * k as f32));
+        let pb = Pose::new(Vec3::new(0.02, -0.01, 0.0), Quat::from_rotation_x(0.2));
+        let small_first = check_every_query(&small, &pa, &large, &pb);
+        let large_first = check_every_query(&large, &pb, &small, &pa);
+        if offset == Vec3::ZERO {
+            // The torus lies deep inside the box: whichever tree is A, most of its nodes lie inside
+            // single spheres of the box and give one contact each.
+            for (every, aggregated) in [small_first, large_first] {
+                assert!(aggregated * 3 < every, "{aggregated} aggregated contacts against {every} pairs");
+            }
+        }
+    }
+}
+
+#[test]
+fn leaves_of_several_spheres_give_the_same_answer() {
+    // Trees from other builders may hold several spheres per leaf: every path must handle them.
+    let one = unit_box(400);
+    let several = InnerSphereTree::from_spheres_in_leaves(one.spheres().to_vec(), one.mesh_volume(), 3);
+    several.validate().expect("a valid tree");
+    let counts: Vec<u32> = several.nodes().iter().filter(|n| n.leaf).map(|n| n.count).collect();
+    assert!(counts.iter().any(|&c| c > 1), "{} spheres, leaf sizes {counts:?}", several.spheres().len());
+    let small = InnerSphereTree::from_spheres_in_leaves(unit_box(300).scaled(0.2).spheres().to_vec(), 0.008, 4);
+    for offset in [Vec3::new(0.45, 0.2, 0.0), Vec3::new(0.2, 0.1, 0.0), Vec3::new(0.6, 0.0, 0.3)] {
+        let pb = Pose::new(offset, Quat::from_rotation_z(0.7));
+        check_every_query(&several, &Pose::IDENTITY, &several, &pb);
+        check_every_query(&several, &Pose::IDENTITY, &one, &pb);
+        check_every_query(&one, &Pose::IDENTITY, &several, &pb);
+        check_every_query(&small, &pb, &several, &Pose::IDENTITY);
+        check_every_query(&several, &Pose::IDENTITY, &small, &pb);
+    }
+}
+
 mod properties {
     use super::*;
     use proptest::prelude::*;
@@ -179,13 +259,20 @@ mod properties {
         #![proptest_config(ProptestConfig::with_cases(48))]
         #[test]
         fn random_poses_match_brute_force_and_are_symmetric(pa in pose(), pb in pose()) {
-            let t = small_ball();
+            let t = small_tree();
             let reference = brute_force(t, &pa, t, &pb);
             let ab = volume(t, &pa, t, &pb) as f64;
             let ba = volume(t, &pb, t, &pa) as f64;
             prop_assert!((ab - reference).abs() <= 1e-3 * reference + 1e-6);
             prop_assert!((ab - ba).abs() <= 1e-3 * ab + 1e-6);
             prop_assert!(ab <= t.mesh_share() as f64 * 1.001);
+        }
+
+        #[test]
+        fn random_poses_of_unequal_trees_agree_in_every_query(pa in pose(), pb in pose()) {
+            static SMALL: OnceLock<InnerSphereTree> = OnceLock::new();
+            let small = SMALL.get_or_init(|| unit_box(400).scaled(0.3));
+            check_every_query(small, &pa, small_tree(), &pb);
         }
     }
 }

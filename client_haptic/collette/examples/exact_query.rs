@@ -1,0 +1,110 @@
+//! Times the exact (aggregated) overlap query alone over the benchmark scene's 35,000 poses: a quick
+//! loop for working on the query, where the full `bunny_scene` bench also runs every other query.
+//!
+//! ```text
+//! cargo run --release -p collette --example exact_query -- --spheres 10000
+//! ```
+//!
+//! Prints the query time's p50 / p99 / p99.9 / max (least of `--runs` runs per pose, which filters out
+//! the machine taking the core away), the work at the slowest pose, and a checksum of every pose's
+//! volume and contact count; `--dump FILE` writes one line per pose (volume, contacts) to compare two
+//! versions of the query.
+
+use clap::Parser;
+use collette::scene::{brilliant_cut, default_bunny_path, load_bunny, trajectory};
+use collette::{
+    Budget, BuildOptions, ContactSet, InnerSphereTree, Pose, QueryWorkspace, TriMesh, build, overlap_budgeted,
+};
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(Parser)]
+#[command(about = "time the exact aggregated overlap query over the bunny scene's trajectory")]
+struct Args {
+    /// Spheres per tree (tool and bunny), or TOOL:BUNNY.
+    #[arg(long, default_value = "10000")]
+    spheres: String,
+    /// Runs of each pose; the least time counts.
+    #[arg(long, default_value_t = 3)]
+    runs: usize,
+    /// Writes each pose's volume and contact count to this file.
+    #[arg(long)]
+    dump: Option<PathBuf>,
+}
+
+fn tree(mesh: &TriMesh, n: usize, name: &str) -> InnerSphereTree {
+    let cache = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../../target/collette-bench/{name}-{n}.ist"));
+    if let Ok(t) = InnerSphereTree::load(&cache) {
+        return t;
+    }
+    let (t, _) = build(mesh, &BuildOptions::spheres(n), &mut |_| {}).expect("the scene meshes are valid");
+    let _ = std::fs::create_dir_all(cache.parent().expect("cache has a folder"));
+    let _ = t.save(&cache);
+    t
+}
+
+fn main() {
+    let args = Args::parse();
+    let (nt, nb) = match args.spheres.split_once(':') {
+        Some((a, b)) => (a.parse().expect("tool count"), b.parse().expect("bunny count")),
+        None => {
+            let n: usize = args.spheres.parse().expect("sphere count");
+            (n, n)
+        }
+    };
+    let bunny_mesh = load_bunny(default_bunny_path()).expect("bunny loads");
+    let tool = tree(&brilliant_cut(collette::scene::TOOL_DIAMETER), nt, "gem");
+    let bunny = tree(&bunny_mesh, nb, "bunny");
+    let path = trajectory(&bunny_mesh);
+
+    let mut ws = QueryWorkspace::new();
+    let mut set = ContactSet::new();
+    let mut times = Vec::with_capacity(path.len());
+    let mut dump = String::new();
+    let (mut checksum, mut worst) = (0.0f64, (0.0f64, 0usize, Default::default()));
+    for (i, s) in path.iter().enumerate() {
+        let mut best = f64::MAX;
+        let mut result = Default::default();
+        for _ in 0..args.runs.max(1) {
+            let t0 = Instant::now();
+            result = overlap_budgeted(&tool, &s.tool, &bunny, &Pose::IDENTITY, Budget::Unlimited, &mut ws, &mut set);
+            best = best.min(t0.elapsed().as_secs_f64() * 1e6);
+        }
+        times.push(best);
+        checksum += result.total_volume as f64 * 1e6 + set.len() as f64;
+        if best > worst.0 {
+            worst = (best, i, result);
+        }
+        if args.dump.is_some() {
+            let _ = writeln!(dump, "{i} {:e} {}", result.total_volume, set.len());
+        }
+    }
+    if let Some(p) = args.dump {
+        std::fs::write(&p, dump).expect("dump written");
+    }
+    let mut sorted = times.clone();
+    sorted.sort_by(f64::total_cmp);
+    let at = |q: f64| sorted[((sorted.len() - 1) as f64 * q).round() as usize];
+    let total: f64 = times.iter().sum();
+    println!(
+        "{} poses, {nt}:{nb} spheres, least of {} runs: p50 {:.1} us, p99 {:.1} us, p99.9 {:.1} us, max {:.1} us, \
+         mean {:.1} us",
+        path.len(),
+        args.runs,
+        at(0.5),
+        at(0.99),
+        at(0.999),
+        at(1.0),
+        total / times.len() as f64
+    );
+    let (t, i, r): (f64, usize, collette::OverlapResult) = worst;
+    println!(
+        "slowest pose {i} (t = {:.3} s): {t:.1} us, {} node pairs, {} leaf pairs, {} aggregated",
+        i as f64 / 1000.0,
+        r.node_pairs,
+        r.leaf_pairs,
+        r.aggregated_pairs
+    );
+    println!("checksum {checksum:.6}");
+}

@@ -1,0 +1,88 @@
+//! Where a query's overlapping pairs go: nowhere (volume only) or into a [`ContactSet`].
+
+use super::affine::WideAffine;
+use crate::shape::{Lens, Lens4};
+use glam::{Affine3A, Vec3, Vec4};
+use haptic_common::{Contact, ContactSet};
+
+/// Receives the overlapping pairs a query finds, in A's frame: the lens (volume already weighted)
+/// and the two centres its normal runs between (from B's towards A's).
+pub(super) trait Sink {
+    /// One pair.
+    fn one(&mut self, lens: &Lens, ca: Vec3, cb: Vec3);
+    /// Four sphere pairs at once; only the lanes whose bit is set in `lanes` count.
+    fn four(&mut self, lenses: &Lens4, ca: [Vec4; 3], cb: [Vec4; 3], lanes: u32);
+}
+
+/// Keeps nothing: the query's result carries the volume.
+pub(super) struct VolumeOnly;
+
+impl Sink for VolumeOnly {
+    #[inline(always)]
+    fn one(&mut self, _: &Lens, _: Vec3, _: Vec3) {}
+    #[inline(always)]
+    fn four(&mut self, _: &Lens4, _: [Vec4; 3], _: [Vec4; 3], _: u32) {}
+}
+
+/// Writes each pair as a world-frame contact.
+pub(super) struct Contacts<'o> {
+    to_world: Affine3A,
+    wide: WideAffine,
+    /// Normal used when two centres coincide.
+    fallback: Vec3,
+    out: &'o mut ContactSet,
+}
+
+/// Centres closer than this (squared) give no direction: the fallback normal is used.
+const COINCIDENT: f32 = 1e-24;
+
+impl<'o> Contacts<'o> {
+    /// `to_world` maps A's frame to the world.
+    pub(super) fn new(to_world: Affine3A, fallback: Vec3, out: &'o mut ContactSet) -> Self {
+        Self { to_world, wide: WideAffine::new(&to_world), fallback, out }
+    }
+}
+
+impl Sink for Contacts<'_> {
+    #[inline]
+    fn one(&mut self, lens: &Lens, ca: Vec3, cb: Vec3) {
+        let delta = ca - cb;
+        let len2 = delta.length_squared();
+        let normal = if len2 > COINCIDENT {
+            self.to_world.transform_vector3(delta * len2.sqrt().recip())
+        } else {
+            self.fallback
+        };
+        self.out.push(Contact {
+            point: self.to_world.transform_point3(lens.centroid),
+            normal,
+            volume: lens.volume,
+            depth: lens.depth,
+        });
+    }
+
+    #[inline]
+    fn four(&mut self, lenses: &Lens4, ca: [Vec4; 3], cb: [Vec4; 3], mut lanes: u32) {
+        let delta = [ca[0] - cb[0], ca[1] - cb[1], ca[2] - cb[2]];
+        let len2 = delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2];
+        let inv = len2.sqrt().recip();
+        let normal = self.wide.vector(delta[0] * inv, delta[1] * inv, delta[2] * inv);
+        let point = self.wide.point(lenses.centroid[0], lenses.centroid[1], lenses.centroid[2]);
+        let coincident = len2.cmple(Vec4::splat(COINCIDENT)).bitmask();
+        while lanes != 0 {
+            let lane = lanes.trailing_zeros() as usize;
+            lanes &= lanes - 1;
+            let normal = if coincident >> lane & 1 != 0 {
+                self.fallback
+            } else {
+                Vec3::new(normal[0][lane], normal[1][lane], normal[2][lane])
+            };
+            self.out.push(Contact {
+                point: Vec3::new(point[0][lane], point[1][lane], point[2][lane]),
+                normal,
+                volume: lenses.volume[lane],
+                depth: lenses.depth[lane],
+            });
+        }
+    }
+}
