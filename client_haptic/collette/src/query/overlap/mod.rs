@@ -21,7 +21,7 @@ use std::time::Instant;
 pub enum Budget {
     /// No limit: the exact answer.
     Unlimited,
-    /// Stop after testing this many node pairs (deterministic, for tests and replays).
+    /// Stop after visiting this many node pairs (deterministic, for tests and replays).
     NodePairs(u32),
     /// Stop at this instant (checked every few node pairs).
     Deadline(Instant),
@@ -40,7 +40,8 @@ pub struct OverlapResult {
     pub aggregated_pairs: u32,
     /// Node pairs estimated instead of refined.
     pub estimated_pairs: u32,
-    /// Node pairs tested.
+    /// Node pairs visited: each tests the children of one node against the other node (four at once)
+    /// and settles the child pairs that end the descent there.
     pub node_pairs: u32,
     /// False when the budget stopped the traversal.
     pub complete: bool,
