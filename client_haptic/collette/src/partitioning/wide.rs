@@ -13,7 +13,7 @@ use glam::Vec4;
 pub(crate) const NO_BLOCK: u32 = u32::MAX;
 
 /// Up to four children of one inner node. Unused lanes have NaN centres, so no test ever hits them.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug)]
 #[repr(C, align(16))]
 pub(crate) struct ChildBlock {
     /// Centres' x, y, z and radii of the children's bounds (the sphere itself for a one-sphere leaf).

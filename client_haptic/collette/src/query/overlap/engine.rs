@@ -18,6 +18,21 @@ const CLOCK_STRIDE: u32 = 8;
 /// most three siblings per level waiting, so it never overflows (and spills onto the pair stack if it did).
 const LOCAL_DEPTH: usize = 200;
 
+/// Four children (centres and radii, in A's frame; `leaves` has the bits of those that are leaves)
+/// against one node's bound (`c`, `r`; `leaf` when it is a leaf): the squared distances, the lanes that
+/// overlap it, and the lanes that containment may settle (one bound inside the other, the outer one a
+/// leaf's, as a node inside a leaf sphere needs).
+#[inline(always)]
+fn four_against(centres: [Vec4; 3], radii: Vec4, leaves: u32, c: Vec3, r: f32, leaf: bool) -> (Vec4, u32, u32) {
+    let (dx, dy, dz) = (centres[0] - Vec4::splat(c.x), centres[1] - Vec4::splat(c.y), centres[2] - Vec4::splat(c.z));
+    let d2 = dx * dx + dy * dy + dz * dz;
+    let (reach, gap) = (radii + Vec4::splat(r), radii - Vec4::splat(r));
+    let hits = d2.cmplt(reach * reach).bitmask();
+    let outer_is_leaf =
+        if leaf { gap.cmple(Vec4::ZERO).bitmask() } else { 0 } | (leaves & gap.cmpge(Vec4::ZERO).bitmask());
+    (d2, hits, d2.cmple(gap * gap).bitmask() & outer_is_leaf)
+}
+
 pub(super) struct Engine<'a, S> {
     a: &'a InnerSphereTree,
     b: &'a InnerSphereTree,
@@ -203,14 +218,7 @@ impl<'a, S: Sink> Engine<'a, S> {
             let (cb, rb) = Self::bound_of(b, nb);
             let cb = self.tp(cb);
             let blk = a.block(ia);
-            let (dx, dy, dz) = (blk.x - Vec4::splat(cb.x), blk.y - Vec4::splat(cb.y), blk.z - Vec4::splat(cb.z));
-            let d2 = dx * dx + dy * dy + dz * dz;
-            let (reach, gap) = (blk.r + Vec4::splat(rb), blk.r - Vec4::splat(rb));
-            let mut hits = d2.cmplt(reach * reach).bitmask();
-            // Containment is possible only for a leaf at least as large as the other node.
-            let (b_holds, a_holds) = (gap.cmple(Vec4::ZERO).bitmask(), gap.cmpge(Vec4::ZERO).bitmask());
-            let leafy = if nb.leaf { b_holds } else { 0 } | (blk.leaf & a_holds);
-            let nested = d2.cmple(gap * gap).bitmask() & leafy;
+            let (d2, mut hits, nested) = four_against([blk.x, blk.y, blk.z], blk.r, blk.leaf, cb, rb, nb.leaf);
             while hits != 0 {
                 let lane = hits.trailing_zeros() as usize;
                 hits &= hits - 1;
@@ -242,14 +250,7 @@ impl<'a, S: Sink> Engine<'a, S> {
             let (ca, ra) = Self::bound_of(a, na);
             let blk = b.block(ib);
             let [x, y, z] = self.wide.point(blk.x, blk.y, blk.z);
-            let (dx, dy, dz) = (x - Vec4::splat(ca.x), y - Vec4::splat(ca.y), z - Vec4::splat(ca.z));
-            let d2 = dx * dx + dy * dy + dz * dz;
-            let (reach, gap) = (blk.r + Vec4::splat(ra), blk.r - Vec4::splat(ra));
-            let mut hits = d2.cmplt(reach * reach).bitmask();
-            // Containment is possible only for a leaf at least as large as the other node.
-            let (b_holds, a_holds) = (gap.cmpge(Vec4::ZERO).bitmask(), gap.cmple(Vec4::ZERO).bitmask());
-            let leafy = if na.leaf { a_holds } else { 0 } | (blk.leaf & b_holds);
-            let nested = d2.cmple(gap * gap).bitmask() & leafy;
+            let (d2, mut hits, nested) = four_against([x, y, z], blk.r, blk.leaf, ca, ra, na.leaf);
             while hits != 0 {
                 let lane = hits.trailing_zeros() as usize;
                 hits &= hits - 1;
