@@ -225,6 +225,17 @@ mod tests {
         assert!(matches!(InnerSphereTree::from_bytes(&bytes), Err(IstFileError::Invalid(_))));
     }
 
+    #[test]
+    fn a_node_no_parent_points_to_is_refused_not_trusted() {
+        // An extra inner node nothing reaches, its children far past the node array: before the check
+        // it passed validation and deriving the child blocks indexed past the array (a panic).
+        let mut tree = sample();
+        let stray = Node { first: 9_999_999, count: 4, leaf: false, ..tree.nodes[0] };
+        tree.nodes.push(stray);
+        let e = InnerSphereTree::from_bytes(&tree.to_bytes()).expect_err("a stray node");
+        assert!(e.to_string().contains("not reachable"), "{e}");
+    }
+
     mod fuzz {
         use super::*;
         use proptest::prelude::*;

@@ -3,8 +3,8 @@
 use super::InnerSphereTree;
 
 impl InnerSphereTree {
-    /// Checks indices, ranges, finiteness, weights, that bounds wrap their leaves and that volumes and
-    /// mesh shares add up.
+    /// Checks indices, ranges, finiteness, weights, that bounds wrap their leaves, that volumes and
+    /// mesh shares add up and that every node is reachable from the root.
     pub fn validate(&self) -> Result<(), String> {
         if self.nodes.is_empty() {
             return Err("the tree has no root node".into());
@@ -86,6 +86,10 @@ impl InnerSphereTree {
         }
         if let Some(s) = seen.iter().position(|s| !s) {
             return Err(format!("sphere {s} is in no leaf"));
+        }
+        // Every node is read when the child blocks are derived: none may escape the checks above.
+        if let Some(n) = visited.iter().position(|v| !v) {
+            return Err(format!("node {n} is not reachable from the root"));
         }
         Ok(())
     }
