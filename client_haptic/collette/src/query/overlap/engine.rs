@@ -218,7 +218,7 @@ impl<'a, S: Sink> Engine<'a, S> {
             let (cb, rb) = Self::bound_of(b, nb);
             let cb = self.tp(cb);
             let blk = a.block(ia);
-            let (d2, mut hits, nested) = four_against([blk.x, blk.y, blk.z], blk.r, blk.leaf, cb, rb, nb.leaf);
+            let (_, mut hits, nested) = four_against([blk.x, blk.y, blk.z], blk.r, blk.leaf, cb, rb, nb.leaf);
             while hits != 0 {
                 let lane = hits.trailing_zeros() as usize;
                 hits &= hits - 1;
@@ -232,15 +232,7 @@ impl<'a, S: Sink> Engine<'a, S> {
                     }
                 } else if !(self.aggregate
                     && nested >> lane & 1 != 0
-                    && self.nest(
-                        child,
-                        Vec3::new(blk.x[lane], blk.y[lane], blk.z[lane]),
-                        blk.r[lane],
-                        ib,
-                        cb,
-                        rb,
-                        d2[lane],
-                    ))
+                    && self.contained(&a.nodes[child as usize], nb, self.tp(nb.bound.center)))
                 {
                     next.push((child, ib));
                 }
@@ -250,7 +242,7 @@ impl<'a, S: Sink> Engine<'a, S> {
             let (ca, ra) = Self::bound_of(a, na);
             let blk = b.block(ib);
             let [x, y, z] = self.wide.point(blk.x, blk.y, blk.z);
-            let (d2, mut hits, nested) = four_against([x, y, z], blk.r, blk.leaf, ca, ra, na.leaf);
+            let (_, mut hits, nested) = four_against([x, y, z], blk.r, blk.leaf, ca, ra, na.leaf);
             while hits != 0 {
                 let lane = hits.trailing_zeros() as usize;
                 hits &= hits - 1;
@@ -262,10 +254,10 @@ impl<'a, S: Sink> Engine<'a, S> {
                     } else {
                         self.leaf_pairs(na, &b.nodes[child as usize]);
                     }
-                } else if !(self.aggregate
-                    && nested >> lane & 1 != 0
-                    && self.nest(ia, ca, ra, child, Vec3::new(x[lane], y[lane], z[lane]), blk.r[lane], d2[lane]))
-                {
+                } else if !(self.aggregate && nested >> lane & 1 != 0 && {
+                    let nc = &b.nodes[child as usize];
+                    self.contained(na, nc, self.tp(nc.bound.center))
+                }) {
                     next.push((ia, child));
                 }
             }
@@ -278,17 +270,13 @@ impl<'a, S: Sink> Engine<'a, S> {
     fn subtree_in_sphere(&mut self, ia: u32, cb: Vec3, rb: f32, sb: u32, ib: u32, next: &mut Vec<(u32, u32)>) {
         let a = self.a;
         let wb = self.b.weights[sb as usize];
-        let (x0, y0, z0, r0) = (Vec4::splat(cb.x), Vec4::splat(cb.y), Vec4::splat(cb.z), Vec4::splat(rb));
         let mut len = 1;
         self.local[0] = a.block_of[ia as usize];
         while len > 0 {
             len -= 1;
             self.result.node_pairs += 1;
             let blk = a.block_at(self.local[len]);
-            let (dx, dy, dz) = (blk.x - x0, blk.y - y0, blk.z - z0);
-            let d2 = dx * dx + dy * dy + dz * dz;
-            let (reach, gap) = (blk.r + r0, r0 - blk.r);
-            let hits = d2.cmplt(reach * reach).bitmask();
+            let (d2, hits, nested) = four_against([blk.x, blk.y, blk.z], blk.r, blk.leaf, cb, rb, true);
             let leaves = hits & blk.leaf;
             for lane in Lanes(leaves & blk.single) {
                 let ca = Vec3::new(blk.x[lane], blk.y[lane], blk.z[lane]);
@@ -298,9 +286,8 @@ impl<'a, S: Sink> Engine<'a, S> {
                 self.leaf_pairs(&a.nodes[blk.node[lane] as usize], &self.b.nodes[ib as usize]);
             }
             let inner = hits & !blk.leaf;
-            // Inside the sphere: |c - cb| + r <= rb.
-            let inside =
-                if self.aggregate { inner & (d2.cmple(gap * gap) & gap.cmpge(Vec4::ZERO)).bitmask() } else { 0 };
+            // An inner child that nests is inside the sphere: |c - cb| + r <= rb.
+            let inside = if self.aggregate { inner & nested } else { 0 };
             for lane in Lanes(inside) {
                 let ca = Vec3::new(blk.x[lane], blk.y[lane], blk.z[lane]);
                 let l = Lens { volume: blk.share[lane] * wb, centroid: ca, depth: blk.r[lane] + rb - d2[lane].sqrt() };
@@ -315,30 +302,6 @@ impl<'a, S: Sink> Engine<'a, S> {
                 }
             }
         }
-    }
-
-    /// A pair of nodes whose bounds nest (one inside the other; bounds in A's frame, `d2` apart
-    /// squared), not two leaves: true when one node lies inside a leaf sphere of the other tree, which
-    /// then gives one contact carrying the node's volume.
-    #[allow(clippy::too_many_arguments)]
-    #[inline(never)]
-    fn nest(&mut self, ia: u32, ca: Vec3, ra: f32, ib: u32, cb: Vec3, rb: f32, d2: f32) -> bool {
-        let (a, b) = (self.a, self.b);
-        let (na, nb) = (&a.nodes[ia as usize], &b.nodes[ib as usize]);
-        if nb.leaf && nb.count == 1 && rb >= ra {
-            // A's node inside B's sphere.
-            let volume = na.mesh_share * b.weights[nb.first as usize];
-            self.emit_aggregate(&Lens { volume, centroid: ca, depth: ra + rb - d2.sqrt() }, ca, cb);
-            return true;
-        }
-        if na.leaf && na.count == 1 && ra >= rb {
-            // B's node inside A's sphere.
-            let volume = nb.mesh_share * a.weights[na.first as usize];
-            self.emit_aggregate(&Lens { volume, centroid: cb, depth: ra + rb - d2.sqrt() }, ca, cb);
-            return true;
-        }
-        // A leaf of several spheres (a tree from another builder): test each sphere.
-        ((na.leaf && na.count != 1) || (nb.leaf && nb.count != 1)) && self.contained(na, nb, self.tp(nb.bound.center))
     }
 
     /// A node's bound in its own frame: the sphere itself for a one-sphere leaf (what its parent's
@@ -386,18 +349,11 @@ impl<'a, S: Sink> Engine<'a, S> {
     #[inline]
     fn leaf_pairs(&mut self, na: &Node, nb: &Node) {
         for ib in nb.range() {
-            let (sb, wb) = (&self.b.spheres[ib], self.b.weights[ib]);
+            let sb = self.b.spheres[ib];
             let cb = self.tp(sb.center);
             for ia in na.range() {
-                let (sa, wa) = (&self.a.spheres[ia], self.a.weights[ia]);
-                if let Some(mut l) = lens(sa.center, sa.radius, cb, sb.radius)
-                    && l.volume > 0.0
-                {
-                    l.volume *= wa * wb;
-                    self.result.total_volume += l.volume;
-                    self.result.leaf_pairs += 1;
-                    self.sink.one(&l, sa.center, cb);
-                }
+                let sa = self.a.spheres[ia];
+                self.sphere_pair(sa.center, sa.radius, ia as u32, cb, sb.radius, ib as u32);
             }
         }
     }
