@@ -5,10 +5,12 @@
 //! each pose the reference is a Monte Carlo estimate: `--samples` stratified points inside the first
 //! mesh (one jittered point per grid cell), each tested against the second mesh (parry3d's
 //! pseudo-normal point containment, behind a voxel grid that answers the points far from the surface).
-//! collette's exact (aggregated) overlap volume is divided by it, for each sphere count.
+//! collette's exact (aggregated) overlap volume is divided by it, for each sphere count (`N` for both
+//! trees, or `A:B` to pack the two meshes differently and see whose packing the error comes from).
 //!
 //! ```text
 //! cargo run --release -p collette --example volume_accuracy -- --poses 300 --samples 1000000
+//! cargo run --release -p collette --example volume_accuracy -- --pairs gem-bunny --spheres 10000,40000:10000,10000:40000
 //! ```
 //!
 //! Prints, per pair and sphere count, the ratio's p5 / p50 / p95 (and min / max): the packing's own
@@ -36,9 +38,9 @@ struct Args {
     /// Monte Carlo points inside the first mesh of each pair.
     #[arg(long, default_value_t = 1_000_000)]
     samples: usize,
-    /// Sphere counts of the trees.
-    #[arg(long, value_delimiter = ',', default_value = "1000,10000")]
-    spheres: Vec<usize>,
+    /// Sphere counts of the trees: N for both, or A:B (the pair's first mesh gets A, its second B).
+    #[arg(long, value_delimiter = ',', default_value = "1000,10000", value_parser = sphere_counts)]
+    spheres: Vec<(usize, usize)>,
     /// Mesh pairs: torus-bunny, gem-bunny, bunny-bunny, ball-box.
     #[arg(long, value_delimiter = ',', default_value = "torus-bunny,gem-bunny,bunny-bunny,ball-box")]
     pairs: Vec<String>,
@@ -48,6 +50,15 @@ struct Args {
     /// Seed of the poses and the samples.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+}
+
+/// `N` (both trees) or `A:B`.
+fn sphere_counts(s: &str) -> Result<(usize, usize), String> {
+    let count = |t: &str| t.trim().parse::<usize>().map_err(|e| format!("sphere count {t:?}: {e}"));
+    match s.split_once(':') {
+        Some((a, b)) => Ok((count(a)?, count(b)?)),
+        None => count(s).map(|n| (n, n)),
+    }
 }
 
 fn mesh(name: &str) -> Result<TriMesh, String> {
@@ -186,11 +197,12 @@ fn run(args: &Args) -> Result<(), String> {
             pool.len(),
             started.elapsed().as_secs_f64()
         );
-        for &n in &args.spheres {
-            let tree = |m: &TriMesh| -> Result<InnerSphereTree, String> {
+        for &(n_a, n_b) in &args.spheres {
+            let tree = |m: &TriMesh, n: usize| -> Result<InnerSphereTree, String> {
                 build(m, &BuildOptions::spheres(n), &mut |_| {}).map(|(t, _)| t).map_err(|e| e.to_string())
             };
-            let (ta, tb) = (tree(&ma)?, tree(&mb)?);
+            let (ta, tb) = (tree(&ma, n_a)?, tree(&mb, n_b)?);
+            let n = if n_a == n_b { n_a.to_string() } else { format!("{n_a}:{n_b}") };
             let (ua, ub) = (ta.unweighted(), tb.unweighted());
             let mut ws = QueryWorkspace::new();
             let mut ratios = |a: &InnerSphereTree, b: &InnerSphereTree| {
