@@ -9,7 +9,8 @@
 //! `COLLETTE_BENCH_STRIDE` (use every n-th pose, default 1), `COLLETTE_BENCH_TABLE_ONLY` (skip criterion).
 
 use collette::scene::{
-    Phase, TrajectorySample, brilliant_cut, default_bunny_path, load_bunny, trajectory, write_trajectory_csv,
+    Phase, SphereCounts, TrajectorySample, brilliant_cut, default_bunny_path, load_bunny, trajectory,
+    write_trajectory_csv,
 };
 use collette::{
     Budget, BuildOptions, ContactSet, InnerSphereTree, Pose, QueryWorkspace, TriMesh, build, overlap, overlap_budgeted,
@@ -40,14 +41,6 @@ fn stats(us: Vec<f64>) -> [f64; 3] {
 /// p99, p99.9 and max.
 fn tail(us: Vec<f64>) -> [f64; 3] {
     percentiles(us, [0.99, 0.999, 1.0])
-}
-
-/// A size entry: `N` (both trees) or `TOOL:BUNNY`.
-fn parse_size(s: &str) -> Option<(usize, usize)> {
-    match s.trim().split_once(':') {
-        Some((t, b)) => Some((t.trim().parse().ok()?, b.trim().parse().ok()?)),
-        None => s.trim().parse().ok().map(|n| (n, n)),
-    }
 }
 
 fn to_parry_pose(p: &Pose) -> parry3d::math::Pose {
@@ -147,10 +140,11 @@ fn run_queries(
 }
 
 fn main() {
-    let sizes: Vec<(usize, usize)> = std::env::var("COLLETTE_BENCH_SIZES")
+    // Each entry `N` (both trees) or `TOOL:BUNNY`.
+    let sizes: Vec<SphereCounts> = std::env::var("COLLETTE_BENCH_SIZES")
         .unwrap_or_else(|_| "1000,5000,10000,50000".into())
         .split(',')
-        .filter_map(parse_size)
+        .filter_map(|s| s.parse().ok())
         .collect();
     let budget = Duration::from_micros(env_or("COLLETTE_BENCH_BUDGET_US", 80));
     let stride: usize = env_or("COLLETTE_BENCH_STRIDE", 1).max(1);
@@ -199,8 +193,8 @@ fn main() {
         "\n| spheres | phase | every-pair p50 / p99 / max us | aggregated p50 / p99 / max us |\n|---|---|---|---|"
     );
     let mut json = Vec::new();
-    for &(nt, nb) in &sizes {
-        let n = if nt == nb { nt.to_string() } else { format!("{nt}:{nb}") };
+    for &counts in &sizes {
+        let (nt, nb, n) = (counts.a, counts.b, counts.to_string());
         let b = build_tree(&bunny, nb);
         let t = build_tree(&tool, nt);
         let run = run_queries(&b.tree, &t.tree, &path, budget);

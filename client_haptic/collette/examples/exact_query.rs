@@ -11,7 +11,7 @@
 //! versions of the query.
 
 use clap::Parser;
-use collette::scene::{brilliant_cut, default_bunny_path, load_bunny, trajectory};
+use collette::scene::{SphereCounts, brilliant_cut, default_bunny_path, load_bunny, trajectory};
 use collette::{
     Budget, BuildOptions, ContactSet, InnerSphereTree, Pose, QueryWorkspace, TriMesh, build, overlap_budgeted,
 };
@@ -24,7 +24,7 @@ use std::time::Instant;
 struct Args {
     /// Spheres per tree (tool and bunny), or TOOL:BUNNY.
     #[arg(long, default_value = "10000")]
-    spheres: String,
+    spheres: SphereCounts,
     /// Runs of each pose; the least time counts.
     #[arg(long, default_value_t = 3)]
     runs: usize,
@@ -46,13 +46,7 @@ fn tree(mesh: &TriMesh, n: usize, name: &str) -> InnerSphereTree {
 
 fn main() {
     let args = Args::parse();
-    let (nt, nb) = match args.spheres.split_once(':') {
-        Some((a, b)) => (a.parse().expect("tool count"), b.parse().expect("bunny count")),
-        None => {
-            let n: usize = args.spheres.parse().expect("sphere count");
-            (n, n)
-        }
-    };
+    let (nt, nb) = (args.spheres.a, args.spheres.b);
     let bunny_mesh = load_bunny(default_bunny_path()).expect("bunny loads");
     let tool = tree(&brilliant_cut(collette::scene::TOOL_DIAMETER), nt, "gem");
     let bunny = tree(&bunny_mesh, nb, "bunny");

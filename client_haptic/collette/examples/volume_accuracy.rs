@@ -19,7 +19,7 @@
 
 use clap::Parser;
 use collette::packing::to_parry_oriented;
-use collette::scene::{brilliant_cut, default_bunny_path, load_bunny};
+use collette::scene::{SphereCounts, brilliant_cut, default_bunny_path, load_bunny};
 use collette::shape::{box_buffers, torus_buffers, uv_sphere_buffers};
 use collette::{BuildOptions, InnerSphereTree, Pose, QueryWorkspace, TriMesh, build, overlap_volume};
 use glam::{Quat, Vec3};
@@ -39,8 +39,8 @@ struct Args {
     #[arg(long, default_value_t = 1_000_000)]
     samples: usize,
     /// Sphere counts of the trees: N for both, or A:B (the pair's first mesh gets A, its second B).
-    #[arg(long, value_delimiter = ',', default_value = "1000,10000", value_parser = sphere_counts)]
-    spheres: Vec<(usize, usize)>,
+    #[arg(long, value_delimiter = ',', default_value = "1000,10000")]
+    spheres: Vec<SphereCounts>,
     /// Mesh pairs: torus-bunny, gem-bunny, bunny-bunny, ball-box.
     #[arg(long, value_delimiter = ',', default_value = "torus-bunny,gem-bunny,bunny-bunny,ball-box")]
     pairs: Vec<String>,
@@ -50,15 +50,6 @@ struct Args {
     /// Seed of the poses and the samples.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-}
-
-/// `N` (both trees) or `A:B`.
-fn sphere_counts(s: &str) -> Result<(usize, usize), String> {
-    let count = |t: &str| t.trim().parse::<usize>().map_err(|e| format!("sphere count {t:?}: {e}"));
-    match s.split_once(':') {
-        Some((a, b)) => Ok((count(a)?, count(b)?)),
-        None => count(s).map(|n| (n, n)),
-    }
 }
 
 fn mesh(name: &str) -> Result<TriMesh, String> {
@@ -197,12 +188,11 @@ fn run(args: &Args) -> Result<(), String> {
             pool.len(),
             started.elapsed().as_secs_f64()
         );
-        for &(n_a, n_b) in &args.spheres {
+        for &counts in &args.spheres {
             let tree = |m: &TriMesh, n: usize| -> Result<InnerSphereTree, String> {
                 build(m, &BuildOptions::spheres(n), &mut |_| {}).map(|(t, _)| t).map_err(|e| e.to_string())
             };
-            let (ta, tb) = (tree(&ma, n_a)?, tree(&mb, n_b)?);
-            let n = if n_a == n_b { n_a.to_string() } else { format!("{n_a}:{n_b}") };
+            let (ta, tb) = (tree(&ma, counts.a)?, tree(&mb, counts.b)?);
             let (ua, ub) = (ta.unweighted(), tb.unweighted());
             let mut ws = QueryWorkspace::new();
             let mut ratios = |a: &InnerSphereTree, b: &InnerSphereTree| {
@@ -230,7 +220,7 @@ fn run(args: &Args) -> Result<(), String> {
                 return Err(format!("{pair}: no pose overlaps by {} of the smaller volume", args.min_overlap));
             }
             println!(
-                "| {pair} | {n} | {:.3} / {:.3} | {} | {} | {} |",
+                "| {pair} | {counts} | {:.3} / {:.3} | {} | {} | {} |",
                 ta.coverage(),
                 tb.coverage(),
                 packed.len(),
