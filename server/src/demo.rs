@@ -249,24 +249,53 @@ pub struct Tally {
 }
 
 impl Tally {
-    /// Adds one finished heist: its seed, how it ended, and where the bot's time went (`spent`:
-    /// [`ViveBrain::time_spent`]).
-    fn add(&mut self, seed: u64, heist: &Heist, phase: Phase, spent: &TimeSpent) {
-        let game = heist.server.game();
-        match phase {
-            Phase::Won => self.won.push(seed),
-            Phase::Lost(heist_shared::protocol::LossReason::Caught) => self.caught.push(seed),
-            _ => self.other.push(seed),
+    /// Adds one finished heist.
+    fn add(&mut self, outcome: Outcome) {
+        match outcome.phase {
+            Phase::Won => self.won.push(outcome.seed),
+            Phase::Lost(heist_shared::protocol::LossReason::Caught) => self.caught.push(outcome.seed),
+            _ => self.other.push(outcome.seed),
         }
-        if let Some(place) = caught_where(game) {
+        if let Some(place) = outcome.caught_where {
             *self.caught_where.entry(place).or_default() += 1;
         }
-        let (time_in, carrying_s) = spent;
+        let (time_in, carrying_s) = outcome.spent;
         for (decision, s) in time_in {
             *self.time_in.entry(decision).or_default() += s;
         }
         self.carrying_s += carrying_s;
     }
+}
+
+/// One finished heist of a sweep.
+struct Outcome {
+    seed: u64,
+    phase: Phase,
+    /// The seed's line: result, who caught Vive where, where the bot's time went.
+    line: String,
+    /// "Clara in the west_gallery" when a guard caught Vive.
+    caught_where: Option<String>,
+    /// Where the bot's time went ([`ViveBrain::time_spent`]).
+    spent: TimeSpent,
+}
+
+/// Plays one whole bot heist on `level` with `seed`.
+fn play_seed(
+    level: &heist_shared::level::Level,
+    seed: u64,
+    style: ViveStyle,
+    difficulty: heist_shared::rules::Difficulty,
+) -> anyhow::Result<Outcome> {
+    let mut options = ServerOptions::local_test(seed);
+    options.level = level.clone();
+    options.game.difficulty = difficulty;
+    let (heist, phase, result) = play_to_the_end(options, style)?;
+    let game = heist.server.game();
+    let caught_where = caught_where(game);
+    let by = caught_where.as_ref().map(|w| format!(" by {w}")).unwrap_or_default();
+    let spent = heist.vive.world().resource::<ViveBrain>().time_spent();
+    let line = format!("{result}{by} after {:.1} s ({})", game.elapsed_s, time_line(&spent));
+    Ok(Outcome { seed, phase, line, caught_where, spent })
 }
 
 /// "Clara in the west_gallery" when a guard caught Vive.
@@ -314,26 +343,48 @@ impl std::fmt::Display for Tally {
     }
 }
 
-/// Plays one whole heist per seed on `level` and tallies the outcomes; `each` gets every
-/// seed's result line as it finishes.
+/// Plays one whole heist per seed on `level` and tallies the outcomes, `jobs` heists at a time (each on
+/// a thread of its own; a heist is deterministic for its seed whatever else runs); `each` gets every
+/// seed's result line in the order of `seeds`, as soon as it and the seeds before it have finished.
 pub fn sweep(
     level: &heist_shared::level::Level,
     seeds: impl IntoIterator<Item = u64>,
     style: ViveStyle,
     difficulty: heist_shared::rules::Difficulty,
+    jobs: usize,
     mut each: impl FnMut(u64, &str),
 ) -> anyhow::Result<Tally> {
-    let mut tally = Tally::default();
-    for seed in seeds {
-        let mut options = ServerOptions::local_test(seed);
-        options.level = level.clone();
-        options.game.difficulty = difficulty;
-        let (heist, phase, result) = play_to_the_end(options, style)?;
-        let game = heist.server.game();
-        let by = caught_where(game).map(|w| format!(" by {w}")).unwrap_or_default();
-        let spent = heist.vive.world().resource::<ViveBrain>().time_spent();
-        each(seed, &format!("{result}{by} after {:.1} s ({})", game.elapsed_s, time_line(&spent)));
-        tally.add(seed, &heist, phase, &spent);
-    }
-    Ok(tally)
+    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+    let seeds: Vec<u64> = seeds.into_iter().collect();
+    let (next, stop) = (AtomicUsize::new(0), AtomicBool::new(false));
+    let (sent, finished) = std::sync::mpsc::channel();
+    std::thread::scope(|scope| {
+        for _ in 0..jobs.clamp(1, seeds.len().max(1)) {
+            let (sent, seeds, next, stop) = (sent.clone(), &seeds, &next, &stop);
+            scope.spawn(move || {
+                while !stop.load(Ordering::Relaxed) {
+                    let i = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(&seed) = seeds.get(i) else { break };
+                    if sent.send((i, play_seed(level, seed, style, difficulty))).is_err() {
+                        break;
+                    }
+                }
+            });
+        }
+        drop(sent);
+        // Lines and the tally in seed order, whatever order the heists finish in.
+        let mut tally = Tally::default();
+        let mut waiting = std::collections::BTreeMap::new();
+        let mut due = 0;
+        for (i, outcome) in finished {
+            waiting.insert(i, outcome);
+            while let Some(outcome) = waiting.remove(&due) {
+                let outcome = outcome.inspect_err(|_| stop.store(true, Ordering::Relaxed))?;
+                each(outcome.seed, &outcome.line);
+                tally.add(outcome);
+                due += 1;
+            }
+        }
+        Ok(tally)
+    })
 }

@@ -86,6 +86,10 @@ enum Command {
         /// Level file (default: the shipped museum): to try a level's own difficulty table.
         #[arg(long)]
         level: Option<PathBuf>,
+        /// Heists played at once, each on a thread of its own (default: one per core). The results do
+        /// not depend on it: a heist is deterministic for its seed.
+        #[arg(long, value_parser = clap::value_parser!(u16).range(1..=256))]
+        jobs: Option<u16>,
     },
     /// Serve many sessions: any player may create one (and gets its join code for a partner), up to
     /// --max-sessions at once; each session ends on its own when it is over, the server runs on.
@@ -384,13 +388,14 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             heist_server::demo::run_demo(options, vive.into(), rounds)?;
             Ok(())
         }
-        Command::Sweep { from, to, vive, difficulty, level } => {
+        Command::Sweep { from, to, vive, difficulty, level, jobs } => {
             anyhow::ensure!(from <= to, "--from {from} is after --to {to}");
             let level = load_level(level)?;
+            let jobs = jobs.map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), usize::from);
             let mut tallies = Vec::new();
             for d in difficulty {
                 let each = |seed: u64, line: &str| println!("{d:>6} seed {seed:>4}: {line}");
-                tallies.push((d, heist_server::demo::sweep(&level, from..=to, vive.into(), d, each)?));
+                tallies.push((d, heist_server::demo::sweep(&level, from..=to, vive.into(), d, jobs, each)?));
             }
             for (d, tally) in tallies {
                 println!("{d}: {tally}");
