@@ -134,8 +134,16 @@ impl Heist {
     pub fn run(&mut self, max_game_s: f32) -> Phase {
         let max_ticks = ((max_game_s as f64 + 30.0) * TICK_HZ) as u64;
         let trace = std::env::var_os("HEIST_TRACE").is_some();
+        let mut goal_shown = String::new();
         for _ in 0..max_ticks {
             self.step();
+            let doing = if trace { self.vive.world().resource::<ViveBrain>().doing() } else { None };
+            if let Some((goal, decision)) = &doing
+                && *goal != goal_shown
+            {
+                println!("  t={:.1} Vive bot: {goal} (then {decision})", self.server.game().elapsed_s);
+                goal_shown.clone_from(goal);
+            }
             if trace && self.ticks.is_multiple_of(30) {
                 let g = self.server.game();
                 let guards: Vec<String> = g
@@ -149,7 +157,7 @@ impl Heist {
                     })
                     .collect();
                 println!(
-                    "  t={:.1} vive=({:.1},{:.1}) {:?} seq={} queued={} carry={:?} | {}",
+                    "  t={:.1} vive=({:.1},{:.1}) {:?} seq={} queued={} carry={:?} {} | {}",
                     g.elapsed_s,
                     g.vive.position.x,
                     g.vive.position.y,
@@ -157,6 +165,7 @@ impl Heist {
                     g.vive.last_input_seq,
                     g.vive.inputs.len(),
                     g.vive.carrying,
+                    doing.map_or("", |(_, decision)| decision),
                     guards.join(" ")
                 );
             }

@@ -43,6 +43,17 @@ impl Goal {
     }
 }
 
+impl std::fmt::Display for Goal {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Goal::Go(p) => write!(f, "go to ({:.1}, {:.1})", p.x, p.y),
+            Goal::Break(p, _, item) => write!(f, "break the case at ({:.1}, {:.1}) for item {}", p.x, p.y, item.0),
+            Goal::Take(p, item) => write!(f, "take item {} at ({:.1}, {:.1})", item.0, p.x, p.y),
+            Goal::Deliver(p, item) => write!(f, "bring item {} to the workbench at ({:.1}, {:.1})", item.0, p.x, p.y),
+        }
+    }
+}
+
 /// What goal choice looks at.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub(crate) struct Wants {
@@ -167,6 +178,18 @@ impl Wants {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_goal_reads_as_what_the_bot_goes_for() {
+        let at = Vec2::new(12.0, 11.5);
+        assert_eq!(Goal::Break(at, CaseId(8), ItemId(7)).to_string(), "break the case at (12.0, 11.5) for item 7");
+        assert_eq!(Goal::Take(at, ItemId(7)).to_string(), "take item 7 at (12.0, 11.5)");
+        assert_eq!(
+            Goal::Deliver(Vec2::new(5.0, 12.0), ItemId(7)).to_string(),
+            "bring item 7 to the workbench at (5.0, 12.0)"
+        );
+        assert_eq!(Goal::Go(Vec2::new(5.0, 12.0)).to_string(), "go to (5.0, 12.0)");
+    }
 
     const BENCH: Vec2 = Vec2::new(1.0, 1.0);
 

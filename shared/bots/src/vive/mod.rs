@@ -56,6 +56,8 @@ pub struct ViveBrain {
     spent: (Vec<f32>, f32),
     /// Actions taken, for tests and logs.
     pub actions: Vec<String>,
+    /// This frame's goal and decision (by index in the decision table), for [`ViveBrain::doing`].
+    last: Option<(goal::Goal, usize)>,
 }
 
 /// Plays Vive with a given style.
@@ -134,6 +136,13 @@ impl ViveBrain {
         (by, self.spent.1)
     }
 
+    /// What the bot went for and how it decided to get there in its last frame of the heist, as
+    /// "break the case at (12.0, 11.5) for item 7" and "wait_if_at_goal" (the demo's `HEIST_TRACE` log).
+    pub fn doing(&self) -> Option<(String, &'static str)> {
+        let (goal, decision) = self.last.as_ref()?;
+        Some((goal.to_string(), decide::DECISIONS[*decision].0))
+    }
+
     /// Thinks for one frame of `dt` seconds: what to say, where to go, what to do. The bot plugin sends
     /// the result as messages; the Vive client turns it into the same intents a player's input makes.
     pub fn think(&mut self, sight: &Sight<'_>, dt: f32) -> Turn {
@@ -187,6 +196,7 @@ impl ViveBrain {
         let forecast = Forecast::new(&known, &view.guards, me.position, &heard);
         let perception = act::perceive(map, memory, &view, &forecast, &goal, self.style == ViveStyle::Reckless);
         let (decision, plan) = decide::decide(&perception);
+        self.last = Some((goal.clone(), decision));
         let waiting_at_case = perception.at_goal
             && matches!(perception.action, Some(ViveMsg::Break(_)))
             && matches!(plan, decide::Plan::Wait | decide::Plan::Throw(..));
