@@ -43,6 +43,26 @@ fn the_demo_prints_a_result_line() {
 }
 
 #[test]
+fn the_demo_trace_shows_each_goal_the_vive_bot_picks_and_its_decisions() {
+    let out = Command::new(env!("CARGO_BIN_EXE_heist-server"))
+        .args(["demo", "--seed", "1", "--vive", "reckless"])
+        .env("HEIST_TRACE", "1")
+        .output()
+        .expect("the server binary runs");
+    assert!(out.status.success());
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let goals: Vec<&str> = stdout.lines().filter(|l| l.contains(" Vive bot: ")).collect();
+    assert!(goals.first().is_some_and(|l| l.starts_with("  t=0.0 Vive bot: ")), "{stdout}");
+    assert!(
+        goals.iter().all(|l| l.ends_with("(then rush_if_reckless)")
+            && ["break the case at (", "take item ", "bring item ", "go to ("].iter().any(|g| l.contains(g))),
+        "{goals:?}"
+    );
+    assert!(goals.iter().any(|l| l.contains("break the case at (")), "{goals:?}");
+    assert!(stdout.lines().any(|l| l.contains(" vive=(") && l.contains(" rush_if_reckless | Bruno(")), "{stdout}");
+}
+
+#[test]
 fn a_sweep_tallies_every_seed() {
     let out = Command::new(env!("CARGO_BIN_EXE_heist-server"))
         .args(["sweep", "--from", "1", "--to", "3", "--vive", "reckless", "--jobs", "2"])
