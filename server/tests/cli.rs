@@ -64,19 +64,19 @@ fn the_demo_trace_shows_each_goal_the_vive_bot_picks_and_its_decisions() {
 
 #[test]
 fn a_sweep_tallies_every_seed() {
-    let out = Command::new(env!("CARGO_BIN_EXE_heist-server"))
-        .args(["sweep", "--from", "1", "--to", "3", "--vive", "reckless", "--jobs", "2"])
-        .output()
-        .expect("the server binary runs");
+    let sweep = |jobs: &str| {
+        Command::new(env!("CARGO_BIN_EXE_heist-server"))
+            .args(["sweep", "--from", "1", "--to", "3", "--vive", "reckless", "--jobs", jobs])
+            .output()
+            .expect("the server binary runs")
+    };
+    let out = sweep("2");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let stdout = String::from_utf8_lossy(&out.stdout);
     // Two heists at a time, the lines still in seed order.
     let at = |seed: &str| stdout.find(&format!("seed    {seed}: RESULT: Lost(caught)")).expect(&stdout);
     assert!(at("1") < at("2") && at("2") < at("3"), "{stdout}");
-    let one_at_a_time = Command::new(env!("CARGO_BIN_EXE_heist-server"))
-        .args(["sweep", "--from", "1", "--to", "3", "--vive", "reckless", "--jobs", "1"])
-        .output()
-        .expect("the server binary runs");
+    let one_at_a_time = sweep("1");
     assert_eq!(String::from_utf8_lossy(&one_at_a_time.stdout), stdout, "the same heists, whatever runs beside them");
     assert!(stdout.contains("\nnormal: won 0 of 3 (0.0%), caught 3, other losses 0; winning seeds: []\n"), "{stdout}");
     assert!(stdout.contains("\n  caught by: "), "the causes of the losses: {stdout}");
