@@ -31,14 +31,19 @@ struct Args {
     /// Writes each pose's volume and contact count to this file.
     #[arg(long)]
     dump: Option<PathBuf>,
+    /// How far the spheres may reach past each surface, in voxels (`BuildOptions::surface_offset`).
+    #[arg(long, default_value_t = BuildOptions::DEFAULT_SURFACE_OFFSET)]
+    surface_offset: f32,
 }
 
-fn tree(mesh: &TriMesh, n: usize, name: &str) -> InnerSphereTree {
-    let cache = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../../target/collette-bench/{name}-{n}.ist"));
+fn tree(mesh: &TriMesh, n: usize, name: &str, surface_offset: f32) -> InnerSphereTree {
+    let file = format!("../../target/collette-bench/{name}-{n}-offset{surface_offset}.ist");
+    let cache = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(file);
     if let Ok(t) = InnerSphereTree::load(&cache) {
         return t;
     }
-    let (t, _) = build(mesh, &BuildOptions::spheres(n), &mut |_| {}).expect("the scene meshes are valid");
+    let (t, _) = build(mesh, &BuildOptions { surface_offset, ..BuildOptions::spheres(n) }, &mut |_| {})
+        .expect("the scene meshes are valid");
     let _ = std::fs::create_dir_all(cache.parent().expect("cache has a folder"));
     let _ = t.save(&cache);
     t
@@ -48,8 +53,8 @@ fn main() {
     let args = Args::parse();
     let (nt, nb) = (args.spheres.a, args.spheres.b);
     let bunny_mesh = load_bunny(default_bunny_path()).expect("bunny loads");
-    let tool = tree(&brilliant_cut(collette::scene::TOOL_DIAMETER), nt, "gem");
-    let bunny = tree(&bunny_mesh, nb, "bunny");
+    let tool = tree(&brilliant_cut(collette::scene::TOOL_DIAMETER), nt, "gem", args.surface_offset);
+    let bunny = tree(&bunny_mesh, nb, "bunny", args.surface_offset);
     let path = trajectory(&bunny_mesh);
 
     let mut ws = QueryWorkspace::new();

@@ -35,6 +35,9 @@ enum Command {
         /// Smallest sphere radius, mesh units (default: a quarter voxel).
         #[arg(long)]
         min_radius: Option<f32>,
+        /// How far spheres may reach past the surface, in voxels (0 keeps them all inside the mesh).
+        #[arg(long, default_value_t = BuildOptions::DEFAULT_SURFACE_OFFSET)]
+        surface_offset: f32,
         /// Multiply the mesh's coordinates by this factor first (e.g. 0.01 for centimetres to metres).
         #[arg(long, default_value_t = 1.0)]
         scale: f32,
@@ -72,7 +75,7 @@ enum Command {
 /// Parses the process arguments and runs the command.
 pub fn run() -> anyhow::Result<()> {
     match Cli::parse().command {
-        Command::Build { mesh, output, spheres, coverage, resolution, min_radius, scale, json } => {
+        Command::Build { mesh, output, spheres, coverage, resolution, min_radius, surface_offset, scale, json } => {
             let raw = TriMesh::from_obj(&mesh).with_context(|| format!("loading {}", mesh.display()))?;
             let mesh_data = if scale == 1.0 { raw } else { raw.map_vertices(|v| v * scale)? };
             let options = BuildOptions {
@@ -80,6 +83,7 @@ pub fn run() -> anyhow::Result<()> {
                 target_coverage: coverage,
                 min_radius,
                 grid_resolution: resolution,
+                surface_offset,
                 ..BuildOptions::default()
             };
             let bar = if json { indicatif::ProgressBar::hidden() } else { indicatif::ProgressBar::new(1000) };

@@ -51,6 +51,22 @@ fn build_info_and_render_work_end_to_end() {
     assert!(out.status.success());
     assert!(std::fs::read(&png).expect("png written").starts_with(b"\x89PNG"));
 
+    // The spheres reach past the surface by default; `--surface-offset 0` keeps them inside, and an
+    // offset out of range is refused on one line.
+    let packed = |offset: &str| -> f64 {
+        let args = ["--spheres", "200", "--json", "--surface-offset", offset];
+        let out = bin().arg("build").arg(&obj).arg("-o").arg(&ist).args(args).output().expect("runs");
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let summary: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json summary");
+        summary["packed_volume"].as_f64().expect("number")
+    };
+    let (inside, default) = (packed("0"), summary["packed_volume"].as_f64().expect("number"));
+    assert!(inside < 1.0 && default > inside * 1.01, "offset packing {default} against {inside} inside");
+    let out = bin().arg("build").arg(&obj).arg("-o").arg(&ist).args(["--surface-offset", "5"]).output().expect("runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("surface offset"), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "one line, no backtrace: {err}");
+
     // A foreign file and an open mesh are clear errors, not panics.
     let out = bin().arg("info").arg(&obj).output().expect("runs");
     let err = String::from_utf8_lossy(&out.stderr);

@@ -34,6 +34,12 @@ pub struct BuildOptions {
     /// Move each centre within its voxel to the point of largest free radius (slower, denser).
     /// Default: true.
     pub refine_centers: bool,
+    /// How far the spheres may reach past the surface, in voxels: the packing fills the mesh grown by
+    /// `surface_offset × voxel size` (centres stay inside the mesh). With the weights this moves the
+    /// volume the packing misses under the surface to straddle it, so shallow touches are counted
+    /// (see docs/collette.md, *Volume accuracy*). 0 keeps every sphere inside the mesh (the packing is
+    /// then a lower bound of the mesh). Default: [`BuildOptions::DEFAULT_SURFACE_OFFSET`].
+    pub surface_offset: f32,
 }
 
 impl Default for BuildOptions {
@@ -44,6 +50,7 @@ impl Default for BuildOptions {
             min_radius: None,
             grid_resolution: None,
             refine_centers: true,
+            surface_offset: Self::DEFAULT_SURFACE_OFFSET,
         }
     }
 }
@@ -51,6 +58,14 @@ impl Default for BuildOptions {
 impl BuildOptions {
     /// Sphere count used when no target is given.
     pub const DEFAULT_SPHERES: usize = 10_000;
+
+    /// How far spheres reach past the surface by default, in voxels: over 1,000 random poses of the gem
+    /// against the bunny (10k spheres each) it raised the 5th percentile of volume ÷ exact from 0.70
+    /// to 0.89 and kept the 95th at 1.05; larger offsets overshoot.
+    pub const DEFAULT_SURFACE_OFFSET: f32 = 0.3;
+
+    /// Largest accepted [`BuildOptions::surface_offset`], in voxels.
+    pub const MAX_SURFACE_OFFSET: f32 = 2.0;
 
     /// Options for a sphere-count target.
     pub fn spheres(n: usize) -> Self {
@@ -146,9 +161,19 @@ pub fn build(
             "grid resolution {resolution} needs {voxels:.3e} voxels (at most {MAX_VOXELS})"
         )));
     }
+    if !(0.0..=BuildOptions::MAX_SURFACE_OFFSET).contains(&options.surface_offset) {
+        return Err(BuildError::InvalidOption(format!(
+            "surface offset {} voxels is outside 0..={}",
+            options.surface_offset,
+            BuildOptions::MAX_SURFACE_OFFSET
+        )));
+    }
     let mesh_volume = mesh.volume() as f64;
     progress(BuildProgress::DistanceField);
-    let field = DistanceField::new(mesh, resolution);
+    let mut field = DistanceField::new(mesh, resolution);
+    // Interior voxels only: the centres stay inside the mesh.
+    let offset = options.surface_offset * field.voxel_size;
+    field.distance.iter_mut().filter(|d| **d > 0.0).for_each(|d| *d += offset);
     let interior_voxels = field.interior_count();
     if interior_voxels == 0 {
         return Err(BuildError::NoInteriorVoxel);
@@ -158,7 +183,7 @@ pub fn build(
         target_volume: options.target_coverage.map_or(f64::INFINITY, |c| c as f64 * mesh_volume),
         min_radius: options.min_radius.unwrap_or(field.voxel_size * 0.25).max(f32::MIN_POSITIVE),
     };
-    let mut refiner = options.refine_centers.then(|| refine::Refiner::new(mesh, field.voxel_size * 0.5));
+    let mut refiner = options.refine_centers.then(|| refine::Refiner::new(mesh, field.voxel_size * 0.5, offset));
     let spheres = greedy::pack(&field, stop, refiner.as_mut(), &mut |placed, packed| {
         progress(BuildProgress::Packing { placed, target: max_spheres, coverage: packed / mesh_volume })
     });
@@ -190,13 +215,20 @@ mod tests {
         TriMesh::new(v, t).expect("valid")
     }
 
-    #[test]
-    fn every_sphere_lies_inside_the_mesh_and_none_overlap() {
-        let (tree, report) = build(&slab(), &BuildOptions::spheres(400), &mut |_| {}).expect("builds");
+    /// The spheres of a slab packed with `surface_offset`, checked disjoint, centres inside and reaching
+    /// at most `surface_offset` voxels past the faces; also how far past the faces they reach at most.
+    fn disjoint_spheres_within_reach(surface_offset: f32) -> f32 {
+        let options = BuildOptions { surface_offset, ..BuildOptions::spheres(400) };
+        let (tree, report) = build(&slab(), &options, &mut |_| {}).expect("builds");
         assert_eq!(report.spheres, 400);
         let half = Vec3::new(1.0, 0.5, 0.3);
+        let voxel = 2.0 * half.x / options.resolution() as f32;
+        let reach = surface_offset * voxel;
+        let mut farthest = f32::NEG_INFINITY;
         for s in tree.spheres() {
-            assert!((s.center.abs() + s.radius).cmple(half * 1.0001).all(), "{s:?} leaves the box");
+            assert!(s.center.abs().cmplt(half).all(), "{s:?} is centred outside the box");
+            assert!((s.center.abs() + s.radius).cmple(half + reach + 1e-4).all(), "{s:?} reaches too far");
+            farthest = farthest.max((s.center.abs() + s.radius - half).max_element());
         }
         let sp = tree.spheres();
         for i in 0..sp.len() {
@@ -208,6 +240,19 @@ mod tests {
             }
         }
         assert!((report.coverage - tree.coverage() as f64).abs() < 1e-3);
+        farthest / voxel
+    }
+
+    #[test]
+    fn every_sphere_lies_inside_the_mesh_and_none_overlap() {
+        let past = disjoint_spheres_within_reach(0.0);
+        assert!(past <= 1e-3, "a sphere reaches {past} voxels past the surface");
+    }
+
+    #[test]
+    fn with_a_surface_offset_the_spheres_straddle_the_surface_by_at_most_that_and_none_overlap() {
+        let past = disjoint_spheres_within_reach(BuildOptions::DEFAULT_SURFACE_OFFSET);
+        assert!(past > 0.25, "the outermost spheres reach past the faces: {past} voxels");
     }
 
     #[test]
@@ -225,5 +270,12 @@ mod tests {
         assert!(matches!(build(&slab(), &BuildOptions::spheres(0), &mut |_| {}), Err(BuildError::InvalidOption(_))));
         let huge = BuildOptions { grid_resolution: Some(2000), ..BuildOptions::spheres(10) };
         assert!(matches!(build(&slab(), &huge, &mut |_| {}), Err(BuildError::InvalidOption(_))));
+        for surface_offset in [-0.1, 2.5, f32::NAN] {
+            let bad = BuildOptions { surface_offset, ..BuildOptions::spheres(10) };
+            let Err(BuildError::InvalidOption(why)) = build(&slab(), &bad, &mut |_| {}) else {
+                panic!("{surface_offset} accepted")
+            };
+            assert!(why.contains("surface offset"), "{why}");
+        }
     }
 }

@@ -17,13 +17,14 @@ pub(crate) struct Refiner {
     cells: HashMap<IVec3, Vec<u32>>,
     spheres: Vec<Sphere>,
     step: f32,
+    offset: f32,
 }
 
 impl Refiner {
     /// A refiner for `mesh` whose first search step is `step` (half a voxel).
-    pub(crate) fn new(mesh: &TriMesh, step: f32) -> Self {
+    pub(crate) fn new(mesh: &TriMesh, step: f32, offset: f32) -> Self {
         let mesh = super::to_parry_oriented(mesh);
-        Self { mesh, cell: step * 8.0, cells: HashMap::new(), spheres: Vec::new(), step }
+        Self { mesh, cell: step * 8.0, cells: HashMap::new(), spheres: Vec::new(), step, offset }
     }
 
     fn key(&self, p: Vec3) -> IVec3 {
@@ -52,7 +53,7 @@ impl Refiner {
         if !proj.is_inside {
             return -1.0;
         }
-        let mut f = (proj.point - q).length();
+        let mut f = (proj.point - q).length() + self.offset;
         let (lo, hi) = (self.key(p - reach), self.key(p + reach));
         for z in lo.z..=hi.z {
             for y in lo.y..=hi.y {

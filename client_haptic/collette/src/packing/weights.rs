@@ -3,7 +3,8 @@
 //! The packing leaves gaps (between the spheres, and between the outermost spheres and the surface).
 //! Every interior voxel centre in a gap is given to the sphere whose surface is nearest; a sphere's
 //! weight is then (its volume + its gap voxels' volume) / its volume, the gap voxels scaled so that
-//! the shares add up to the exact mesh volume.
+//! the shares add up to the exact mesh volume. A packing allowed past the surface may hold more than the
+//! mesh (a ball's single sphere): then every weight is mesh volume / packed volume, below 1.
 
 use super::DistanceField;
 use crate::partitioning::InnerSphereTree;
@@ -30,12 +31,17 @@ pub(super) fn weigh(tree: &mut InnerSphereTree, field: &DistanceField) {
         counts[s as usize] += 1;
     }
     let per_voxel = if owners.is_empty() { 0.0 } else { gap_volume / owners.len() as f64 };
+    let surplus = (packed > 0.0 && packed > tree.mesh_volume() as f64).then(|| tree.mesh_volume() as f64 / packed);
     let weights = spheres
         .iter()
         .zip(&counts)
         .map(|(s, &n)| {
             let v = s.volume() as f64;
-            if v > 0.0 { (1.0 + n as f64 * per_voxel / v) as f32 } else { 1.0 }
+            match surplus {
+                Some(scale) => scale as f32,
+                None if v > 0.0 => (1.0 + n as f64 * per_voxel / v) as f32,
+                None => 1.0,
+            }
         })
         .collect();
     tree.set_weights(weights);
@@ -94,7 +100,7 @@ fn nearest_surface(tree: &InnerSphereTree, p: Vec3, stack: &mut Vec<u32>) -> (u3
 
 #[cfg(test)]
 mod tests {
-    use crate::shape::{box_buffers, torus_buffers};
+    use crate::shape::{box_buffers, torus_buffers, uv_sphere_buffers};
     use crate::{BuildOptions, TriMesh, build};
     use glam::Vec3;
 
@@ -112,5 +118,19 @@ mod tests {
             let plain = tree.unweighted();
             assert!((plain.mesh_share() - plain.packed_volume()).abs() < 1e-4 * plain.packed_volume());
         }
+    }
+
+    #[test]
+    fn spheres_that_reach_past_the_surface_and_hold_more_than_the_mesh_are_weighed_down_to_it() {
+        // A ball's packing is nearly its inscribed ball; grown past the facets it holds more than the mesh.
+        let (v, t) = uv_sphere_buffers(1.0, 32, 64);
+        let mesh = TriMesh::new(v, t).expect("valid");
+        let (tree, report) = build(&mesh, &BuildOptions::spheres(200), &mut |_| {}).expect("builds");
+        assert!(report.coverage > 1.0, "the packing holds more than the mesh: {}", report.coverage);
+        let share = tree.mesh_share() as f64;
+        assert!((share / report.mesh_volume - 1.0).abs() < 1e-3, "{share} vs {}", report.mesh_volume);
+        let w = (report.mesh_volume / report.packed_volume) as f32;
+        assert!(tree.weights().iter().all(|&x| (x - w).abs() < 1e-6), "every weight is {w}");
+        tree.validate().expect("node shares add up");
     }
 }

@@ -22,8 +22,8 @@ impl InnerSphereTree {
         if self.weights.len() != self.spheres.len() {
             return Err(format!("{} weights for {} spheres", self.weights.len(), self.spheres.len()));
         }
-        if let Some(i) = self.weights.iter().position(|w| !(w.is_finite() && *w >= 1.0 && *w <= 1e6)) {
-            return Err(format!("sphere {i} has weight {} (expected 1 to 1e6)", self.weights[i]));
+        if let Some(i) = self.weights.iter().position(|w| !(w.is_finite() && *w > 0.0 && *w <= 1e6)) {
+            return Err(format!("sphere {i} has weight {} (expected above 0, at most 1e6)", self.weights[i]));
         }
         let mut seen = vec![false; self.spheres.len()];
         let mut visited = vec![false; self.nodes.len()];

@@ -9,9 +9,16 @@ fn tree_of(v: Vec<Vec3>, t: Vec<[u32; 3]>, spheres: usize) -> InnerSphereTree {
     build(&mesh, &BuildOptions::spheres(spheres), &mut |_| {}).expect("builds").0
 }
 
+/// A tree whose spheres all lie inside the mesh (`surface_offset` 0): its packing is a lower bound.
+fn inner_tree_of(v: Vec<Vec3>, t: Vec<[u32; 3]>, spheres: usize) -> InnerSphereTree {
+    let mesh = TriMesh::new(v, t).expect("valid mesh");
+    let options = BuildOptions { surface_offset: 0.0, ..BuildOptions::spheres(spheres) };
+    build(&mesh, &options, &mut |_| {}).expect("builds").0
+}
+
 fn ball(spheres: usize) -> InnerSphereTree {
     let (v, t) = uv_sphere_buffers(1.0, 32, 64);
-    tree_of(v, t, spheres)
+    inner_tree_of(v, t, spheres)
 }
 
 /// A torus (R 0.7, r 0.3) of 300 spheres: many spheres of many sizes (a ball's packing is nearly one
@@ -82,7 +89,8 @@ fn the_overlap_of_two_boxes_converges_to_the_exact_value_and_the_weights_close_t
     let pb = Pose::from_translation(Vec3::new(0.5, 0.25, 0.0));
     let (mut packed_errors, mut weighted_errors) = (Vec::new(), Vec::new());
     for n in [200, 2000, 8000] {
-        let t = unit_box(n);
+        let (v, t) = box_buffers(Vec3::splat(0.5));
+        let t = inner_tree_of(v, t, n);
         let packed = volume(&t.unweighted(), &Pose::IDENTITY, &t.unweighted(), &pb) as f64;
         let got = volume(&t, &Pose::IDENTITY, &t, &pb) as f64;
         assert!(packed <= exact * 1.0001, "the packing's own overlap never exceeds the true one");
@@ -274,5 +282,34 @@ mod properties {
             let small = SMALL.get_or_init(|| unit_box(400).scaled(0.3));
             check_every_query(small, &pa, small_tree(), &pb);
         }
+    }
+}
+
+#[test]
+fn spheres_reaching_past_the_surface_count_a_shallow_touch_and_keep_a_deep_one_exact() {
+    // A 0.8 × 0.8 × 0.2 slab pressed flat into the top of a unit cube: exact overlap 0.64 × depth.
+    let ratios = |offset: f32| -> Vec<f64> {
+        let tree = |half: Vec3| {
+            let (v, t) = box_buffers(half);
+            let options = BuildOptions { surface_offset: offset, ..BuildOptions::spheres(2000) };
+            build(&TriMesh::new(v, t).expect("valid mesh"), &options, &mut |_| {}).expect("builds").0
+        };
+        let (slab, block) = (tree(Vec3::new(0.4, 0.4, 0.1)), tree(Vec3::splat(0.5)));
+        [0.005f32, 0.01, 0.02, 0.1, 0.2]
+            .iter()
+            .map(|&depth| {
+                let pose = Pose::new(Vec3::new(0.03, 0.01, 0.6 - depth), Quat::from_rotation_z(0.3));
+                volume(&slab, &pose, &block, &Pose::IDENTITY) as f64 / (0.64 * depth as f64)
+            })
+            .collect()
+    };
+    let (inside, reaching) = (ratios(0.0), ratios(BuildOptions::DEFAULT_SURFACE_OFFSET));
+    // Measured: inside 0.05, 0.18, 0.55, 1.01, 1.00; reaching 0.37, 0.51, 0.78, 1.00, 0.99 (the voxel
+    // is 11 mm here: the shallow presses are half a voxel to two voxels deep).
+    for k in 0..3 {
+        assert!(reaching[k] > inside[k] + 0.15, "depth #{k}: {} against {} inside", reaching[k], inside[k]);
+    }
+    for r in inside[3..].iter().chain(&reaching[3..]) {
+        assert!((r - 1.0).abs() < 0.05, "a deep press is counted whole: {inside:?} / {reaching:?}");
     }
 }
