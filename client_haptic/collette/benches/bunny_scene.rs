@@ -6,7 +6,9 @@
 //! sphere count, then runs a few criterion micro-benchmarks. Environment:
 //! `COLLETTE_BENCH_SIZES` (default `1000,5000,10000,50000`; `TOOL:BUNNY`, e.g. `4000:20000`, gives the
 //! two trees different counts), `COLLETTE_BENCH_BUDGET_US` (default 80),
-//! `COLLETTE_BENCH_STRIDE` (use every n-th pose, default 1), `COLLETTE_BENCH_TABLE_ONLY` (skip criterion).
+//! `COLLETTE_BENCH_STRIDE` (use every n-th pose, default 1), `COLLETTE_BENCH_TABLE_ONLY` (skip criterion),
+//! `COLLETTE_BENCH_SURFACE_OFFSET` (voxels the spheres reach past the surface; default
+//! `BuildOptions::DEFAULT_SURFACE_OFFSET`, 0 for the inner packing).
 
 use collette::scene::{
     Phase, SphereCounts, TrajectorySample, brilliant_cut, default_bunny_path, load_bunny, trajectory,
@@ -58,7 +60,9 @@ struct Built {
 }
 
 fn build_tree(mesh: &TriMesh, n: usize) -> Built {
-    let (tree, report) = build(mesh, &BuildOptions::spheres(n), &mut |_| {}).expect("the scene meshes are valid");
+    let surface_offset = env_or("COLLETTE_BENCH_SURFACE_OFFSET", BuildOptions::DEFAULT_SURFACE_OFFSET);
+    let options = BuildOptions { surface_offset, ..BuildOptions::spheres(n) };
+    let (tree, report) = build(mesh, &options, &mut |_| {}).expect("the scene meshes are valid");
     Built { tree, seconds: report.build_seconds, coverage: report.coverage }
 }
 
