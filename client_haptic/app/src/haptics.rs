@@ -388,7 +388,7 @@ pub fn immersed_volume(spheres: &[collette::Sphere], weights: &[f32], normal: Ve
 /// Content hash of a mesh and the build settings, as the cache file's name.
 pub fn cache_key(mesh: &HapticMesh, spheres: usize) -> String {
     let mut h = blake3::Hasher::new();
-    h.update(b"phantom-heist ist v3"); // v2: weighted spheres; v3: spheres reach 0.3 voxel past the surface
+    h.update(b"phantom-heist ist v4"); // v2: weighted spheres; v3: past the surface; v4: power-diagram weights
     h.update(&(spheres as u64).to_le_bytes());
     for v in &mesh.vertices {
         for c in v {

@@ -1,8 +1,9 @@
 //! Sphere weights: the share of the mesh each inner sphere stands for.
 //!
 //! The packing leaves gaps (between the spheres, and between the outermost spheres and the surface).
-//! Every interior voxel centre in a gap is given to the sphere whose surface is nearest; a sphere's
-//! weight is then (its volume + its gap voxels' volume) / its volume, the gap voxels scaled so that
+//! Every interior voxel centre in a gap is given to the sphere of least power distance `|p − c|² − r²`
+//! (its cell of the spheres' power diagram, which gives a gap between a large and a small sphere more to
+//! the large one than the nearest surface would); a sphere's weight is then (its volume + its gap voxels' volume) / its volume, the gap voxels scaled so that
 //! the shares add up to the exact mesh volume. A packing allowed past the surface may hold more than the
 //! mesh (a ball's single sphere): then every weight is mesh volume / packed volume, below 1.
 
@@ -18,8 +19,8 @@ pub(super) fn weigh(tree: &mut InnerSphereTree, field: &DistanceField) {
         .into_par_iter()
         .filter(|&i| field.distance[i] > 0.0 && !covered[i])
         .map_init(Vec::new, |stack, i| {
-            let (sphere, gap) = nearest_surface(tree, field.voxel_center(i), stack);
-            if gap > 0.0 { sphere } else { u32::MAX }
+            let (sphere, power) = least_power(tree, field.voxel_center(i), stack);
+            if power > 0.0 { sphere } else { u32::MAX }
         })
         .filter(|&s| s != u32::MAX)
         .collect();
@@ -72,21 +73,25 @@ fn covered_voxels(tree: &InnerSphereTree, field: &DistanceField) -> Vec<bool> {
     covered
 }
 
-/// The sphere whose surface is nearest to `p` and the distance to that surface (negative inside it):
-/// branch and bound over the hierarchy (a node's spheres are no nearer than its bound's surface).
-fn nearest_surface(tree: &InnerSphereTree, p: Vec3, stack: &mut Vec<u32>) -> (u32, f32) {
+/// The sphere of least power distance `|p − c|² − r²` from `p`, and that distance (negative inside
+/// it): branch and bound over the hierarchy. A sphere inside a node's bound (centre C, radius R) has
+/// `|c − C| = t ≤ R` and `r ≤ R − t`, so from `p` at `D = |p − C| ≥ R` its power distance is at least
+/// `(D − t)² − (R − t)² ≥ (D − R)²`; from inside the bound, at least `−R²`.
+fn least_power(tree: &InnerSphereTree, p: Vec3, stack: &mut Vec<u32>) -> (u32, f32) {
     let (nodes, spheres) = (tree.nodes(), tree.spheres());
     let mut best = (u32::MAX, f32::INFINITY);
     stack.clear();
     stack.push(0);
     while let Some(n) = stack.pop() {
         let node = &nodes[n as usize];
-        if p.distance(node.bound.center) - node.bound.radius >= best.1 {
+        let (d, r) = (p.distance(node.bound.center), node.bound.radius);
+        let bound = if d >= r { (d - r) * (d - r) } else { -r * r };
+        if bound >= best.1 {
             continue;
         }
         if node.leaf {
             for s in node.range() {
-                let d = p.distance(spheres[s].center) - spheres[s].radius;
+                let d = p.distance_squared(spheres[s].center) - spheres[s].radius * spheres[s].radius;
                 if d < best.1 {
                     best = (s as u32, d);
                 }
