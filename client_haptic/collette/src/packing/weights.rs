@@ -2,8 +2,8 @@
 //!
 //! The packing leaves gaps (between the spheres, and between the outermost spheres and the surface).
 //! Every interior voxel centre in a gap is given to the sphere of least power distance `|p − c|² − r²`
-//! (its cell of the spheres' power diagram, which gives a gap between a large and a small sphere more to
-//! the large one than the nearest surface would); a sphere's weight is then (its volume + its gap voxels' volume) / its volume, the gap voxels scaled so that
+//! (its cell of the spheres' power diagram: a point as far from a large sphere's surface as from a small
+//! one's goes to the large one); a sphere's weight is then (its volume + its gap voxels' volume) / its volume, the gap voxels scaled so that
 //! the shares add up to the exact mesh volume. A packing allowed past the surface may hold more than the
 //! mesh (a ball's single sphere): then every weight is mesh volume / packed volume, below 1.
 
