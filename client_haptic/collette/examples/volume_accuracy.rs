@@ -14,8 +14,8 @@
 //! ```
 //!
 //! Prints, per pair and sphere count, the ratio's p5 / p50 / p95 (and min / max): the packing's own
-//! volume (the lens sum, always short) and the volume the trees stand for (each sphere weighted by
-//! the share of the mesh it stands for). The packing alone is always short with `--surface-offset 0`.
+//! volume (the lens sum; always short with `--surface-offset 0`) and the volume the trees stand for
+//! (each sphere weighted by the share of the mesh it stands for).
 
 use clap::Parser;
 use collette::packing::to_parry_oriented;

@@ -2,10 +2,11 @@
 //!
 //! The packing leaves gaps (between the spheres, and between the outermost spheres and the surface).
 //! Every interior voxel centre in a gap is given to the sphere of least power distance `|p − c|² − r²`
-//! (its cell of the spheres' power diagram: a point as far from a large sphere's surface as from a small
-//! one's goes to the large one); a sphere's weight is then (its volume + its gap voxels' volume) / its volume, the gap voxels scaled so that
-//! the shares add up to the exact mesh volume. A packing allowed past the surface may hold more than the
-//! mesh (a ball's single sphere): then every weight is mesh volume / packed volume, below 1.
+//! (its cell of the spheres' power diagram: a point as far from a large sphere's surface as from a
+//! small one's goes to the large one); a sphere's weight is then (its volume + its gap voxels' volume) /
+//! its volume, the gap voxels scaled so that the shares add up to the exact mesh volume. A packing
+//! allowed past the surface may hold more than the mesh (a ball's single sphere): then every weight is
+//! mesh volume / packed volume, below 1.
 
 use super::DistanceField;
 use crate::partitioning::InnerSphereTree;
@@ -14,6 +15,13 @@ use rayon::prelude::*;
 
 /// Weighs every sphere of `tree` (built from the mesh `field` samples) and updates its nodes.
 pub(super) fn weigh(tree: &mut InnerSphereTree, field: &DistanceField) {
+    let mesh = tree.mesh_volume() as f64;
+    let packed: f64 = tree.spheres().iter().map(|s| s.volume() as f64).sum();
+    if packed > mesh {
+        let weights = vec![(mesh / packed) as f32; tree.spheres().len()];
+        tree.set_weights(weights);
+        return;
+    }
     let covered = covered_voxels(tree, field);
     let owners: Vec<u32> = (0..field.distance.len())
         .into_par_iter()
@@ -25,24 +33,18 @@ pub(super) fn weigh(tree: &mut InnerSphereTree, field: &DistanceField) {
         .filter(|&s| s != u32::MAX)
         .collect();
     let spheres = tree.spheres();
-    let packed: f64 = spheres.iter().map(|s| s.volume() as f64).sum();
-    let gap_volume = (tree.mesh_volume() as f64 - packed).max(0.0);
+    let gap_volume = mesh - packed;
     let mut counts = vec![0u32; spheres.len()];
     for &s in &owners {
         counts[s as usize] += 1;
     }
     let per_voxel = if owners.is_empty() { 0.0 } else { gap_volume / owners.len() as f64 };
-    let surplus = (packed > 0.0 && packed > tree.mesh_volume() as f64).then(|| tree.mesh_volume() as f64 / packed);
     let weights = spheres
         .iter()
         .zip(&counts)
         .map(|(s, &n)| {
             let v = s.volume() as f64;
-            match surplus {
-                Some(scale) => scale as f32,
-                None if v > 0.0 => (1.0 + n as f64 * per_voxel / v) as f32,
-                None => 1.0,
-            }
+            if v > 0.0 { (1.0 + n as f64 * per_voxel / v) as f32 } else { 1.0 }
         })
         .collect();
     tree.set_weights(weights);

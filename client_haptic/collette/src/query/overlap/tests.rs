@@ -4,16 +4,17 @@ use crate::{BuildOptions, TriMesh, build};
 use glam::Quat;
 use std::sync::OnceLock;
 
+fn tree_with((v, t): (Vec<Vec3>, Vec<[u32; 3]>), options: &BuildOptions) -> InnerSphereTree {
+    build(&TriMesh::new(v, t).expect("valid mesh"), options, &mut |_| {}).expect("builds").0
+}
+
 fn tree_of(v: Vec<Vec3>, t: Vec<[u32; 3]>, spheres: usize) -> InnerSphereTree {
-    let mesh = TriMesh::new(v, t).expect("valid mesh");
-    build(&mesh, &BuildOptions::spheres(spheres), &mut |_| {}).expect("builds").0
+    tree_with((v, t), &BuildOptions::spheres(spheres))
 }
 
 /// A tree whose spheres all lie inside the mesh (`surface_offset` 0): its packing is a lower bound.
 fn inner_tree_of(v: Vec<Vec3>, t: Vec<[u32; 3]>, spheres: usize) -> InnerSphereTree {
-    let mesh = TriMesh::new(v, t).expect("valid mesh");
-    let options = BuildOptions { surface_offset: 0.0, ..BuildOptions::spheres(spheres) };
-    build(&mesh, &options, &mut |_| {}).expect("builds").0
+    tree_with((v, t), &BuildOptions { surface_offset: 0.0, ..BuildOptions::spheres(spheres) })
 }
 
 fn ball(spheres: usize) -> InnerSphereTree {
@@ -289,11 +290,8 @@ mod properties {
 fn spheres_reaching_past_the_surface_count_a_shallow_touch_and_keep_a_deep_one_exact() {
     // A 0.8 × 0.8 × 0.2 slab pressed flat into the top of a unit cube: exact overlap 0.64 × depth.
     let ratios = |offset: f32| -> Vec<f64> {
-        let tree = |half: Vec3| {
-            let (v, t) = box_buffers(half);
-            let options = BuildOptions { surface_offset: offset, ..BuildOptions::spheres(2000) };
-            build(&TriMesh::new(v, t).expect("valid mesh"), &options, &mut |_| {}).expect("builds").0
-        };
+        let options = BuildOptions { surface_offset: offset, ..BuildOptions::spheres(2000) };
+        let tree = |half: Vec3| tree_with(box_buffers(half), &options);
         let (slab, block) = (tree(Vec3::new(0.4, 0.4, 0.1)), tree(Vec3::splat(0.5)));
         [0.005f32, 0.01, 0.02, 0.1, 0.2]
             .iter()
