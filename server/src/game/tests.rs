@@ -687,7 +687,10 @@ const HIDEOUT: Vec2 = Vec2::new(1.0, 15.0);
 fn a_guard_who_sees_vive_radios_and_the_two_others_split_up_to_search_the_rooms_around() {
     use heist_shared::protocol::RadioAbout;
     let mut g = started(7);
-    // Vive stands in plain sight three metres in front of Bruno.
+    // Bruno is at the east end of the west gallery, within radio range of both others (Clara at the
+    // west end of her round, Dmitri at the north end of his), and Vive stands in plain sight three
+    // metres in front of him.
+    g.guards[0].position = Vec2::new(26.0, 5.0);
     let bruno = &g.guards[0];
     g.vive.position = bruno.position + Vec2::from_angle(bruno.facing) * 3.0;
     let call = step_until_event(&mut g, 10.0, |e| match e {
@@ -698,7 +701,9 @@ fn a_guard_who_sees_vive_radios_and_the_two_others_split_up_to_search_the_rooms_
     });
     let (caller, seen_at, answering) = call.expect("Bruno radios once he is sure");
     assert_eq!(caller, g.guards[0].id);
-    assert_eq!(answering, vec![g.guards[1].id, g.guards[2].id], "both others are in range, nearest first");
+    let mut others = [&g.guards[1], &g.guards[2]];
+    others.sort_by(|a, b| a.position.distance(seen_at).total_cmp(&b.position.distance(seen_at)));
+    assert_eq!(answering, others.map(|o| o.id).to_vec(), "both others are in range, nearest the spot first");
     g.vive.position = HIDEOUT; // gone
     let expected = heist_shared::level::patrol::search_spots(&g.nav, seen_at, guard::SEARCH_SPOTS);
     assert!(expected.len() >= 3, "the spot and the rooms next to it: {expected:?}");

@@ -614,13 +614,13 @@ mod tests {
     #[test]
     fn a_spot_clear_now_where_a_guard_is_about_to_look_is_no_hiding_place() {
         let m = Museum::new();
-        // Clara walks up and down x = 17 between z 13.5 and 19. Creeping to a spot just past the north
-        // end of her line is clear while she walks away south, but the spot is no harbour: she comes
-        // back within seconds.
-        let g = guard(CLARA, Vec2::new(17.0, 14.0), -FRAC_PI_2, GuardAlert::Patrolling); // walking back south
+        // Clara walks up and down z = 15 between x 13 and 33. Creeping to a spot on her line behind her
+        // is clear while she walks away west, but the spot is no harbour: she turns at the end of her
+        // round and comes back within seconds.
+        let g = guard(CLARA, Vec2::new(14.0, 15.0), PI, GuardAlert::Patrolling); // walking west, to her end
         let f = m.forecast(&g, &Heard::default());
-        let on_her_line = [Vec2::new(17.0, 20.2)];
-        let from = Vec2::new(14.5, 20.2);
+        let on_her_line = [Vec2::new(20.2, 15.0)];
+        let from = Vec2::new(20.2, 17.5);
         assert!(f.hidden_for(from, 2.0, &m.walls), "here is fine for now");
         assert!(!f.hiding_place(from, &on_her_line, rules_crouch(), true, &m.walls));
     }

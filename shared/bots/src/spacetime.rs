@@ -559,9 +559,10 @@ mod tests {
     #[test]
     fn a_guard_pacing_across_the_way_is_waited_out_or_crept_past_never_walked_into() {
         let m = Museum::new();
-        // Clara paces x = 17 between z 13.5 and 19, in the sculpture hall; Vive crosses the hall.
-        let clara = guard(CLARA, Vec2::new(17.0, 16.0), -std::f32::consts::FRAC_PI_2);
-        let (from, goal) = (Vec2::new(12.0, 16.0), Vec2::new(22.0, 16.0));
+        // Clara paces z = 15 between x 13 and 33 (the sculpture hall and the treasury) and comes west
+        // towards Vive, who crosses her line in the sculpture hall.
+        let clara = guard(CLARA, Vec2::new(22.0, 15.0), std::f32::consts::PI);
+        let (from, goal) = (Vec2::new(15.0, 11.0), Vec2::new(15.0, 20.0));
         let forecast = m.forecast(&[clara], from);
         // Walking straight over is seen: the test means something.
         let straight = (0..=40).any(|k| {
