@@ -49,8 +49,9 @@ impl From<Style> for ViveStyle {
 enum Command {
     /// Host a session on loopback with both bots, print the live log and the result.
     Demo {
-        /// Seed for the copies and the guards (default 1: on easy, a heist the bots win).
-        #[arg(long, default_value_t = 1)]
+        /// Seed for the copies and the guards (default 20: on normal, a heist the bots win after breaking
+        /// glass in the west gallery, the sculpture hall and the treasury).
+        #[arg(long, default_value_t = 20)]
         seed: u64,
         /// Level file (default: the shipped museum).
         #[arg(long)]
@@ -64,9 +65,9 @@ enum Command {
         /// Heists in the session: after each result the bots ask for another round (a new seed).
         #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100))]
         rounds: u32,
-        /// How hard the guards are: easy, normal or hard (the level's tuning for it). The demo shows easy,
-        /// where the careful bot wins most often (docs/rules.md, "Bot status").
-        #[arg(long, default_value_t = Difficulty::Easy)]
+        /// How hard the guards are: easy, normal or hard (the level's tuning for it). The demo shows
+        /// normal, the museum as designed (docs/rules.md, "Bot status").
+        #[arg(long, default_value_t = Difficulty::Normal)]
         difficulty: Difficulty,
     },
     /// Play one whole bot heist per seed (no live log) and print each result and the tally.
