@@ -104,15 +104,18 @@ mod tests {
     fn without_alarm_a_guard_walks_its_route_and_with_it_also_a_gallery_that_holds_targets() {
         let level = Level::museum();
         let nav = NavGraph::new(&level);
-        let treasury = level.room_index("treasury").expect("room");
+        // Clara walks the sculpture hall and the treasury; the west gallery is off her round.
+        let gallery = level.room_index("west_gallery").expect("room");
         let clara = 1;
-        assert_eq!(alert_route(&level, &nav, clara, 0, &[treasury]), level.guards[clara].route);
-        let alerted = alert_route(&level, &nav, clara, 1, &[treasury]);
+        assert_eq!(alert_route(&level, &nav, clara, 0, &[gallery]), level.guards[clara].route);
+        let alerted = alert_route(&level, &nav, clara, 1, &[gallery]);
         assert_eq!(alerted.len(), level.guards[clara].route.len() + 1);
-        assert!(alerted.iter().any(|p| nav.room_at(*p) == Some(treasury)), "{alerted:?}");
+        assert!(alerted.iter().any(|p| nav.room_at(*p) == Some(gallery)), "{alerted:?}");
         // A guard whose route already crosses a hot room keeps it.
-        let sculpture = level.room_index("sculpture_hall").expect("room");
-        assert_eq!(alert_route(&level, &nav, clara, 2, &[sculpture]), level.guards[clara].route);
+        for crossed in ["sculpture_hall", "treasury"] {
+            let room = level.room_index(crossed).expect("room");
+            assert_eq!(alert_route(&level, &nav, clara, 2, &[room]), level.guards[clara].route, "{crossed}");
+        }
     }
 
     #[test]
