@@ -3,14 +3,16 @@
 //!
 //! A patrolling guard walks its round at patrol speed, through the doors, turning as the rules say; the
 //! bot replays that walk ahead of time. A returning guard walks back to the nearest waypoint of his
-//! round first; an investigating one walks to the noise the bot made and looks round there, a searching
-//! one goes round the spots the radio call gave him; both then go back to their rounds. Any other
-//! (staring, chasing, investigating something else) is unpredictable: the bot treats him as coming at
-//! it and looking every way. A spot is graded ([`Sighting`]): in a guard's published sight, only
-//! within the bot's caution margins, or unseen.
+//! round first; an investigating one walks to the latest noise the bot made that he can hear and looks
+//! round there, a searching one goes round the spots the radio call gave him; both then go back to
+//! their rounds. A guard coming to look at glass nobody has reported yet will find the case and radio:
+//! the guards on their rounds within range then come to search round it after the radio's delay, as
+//! the server sends them. Any other (staring, chasing, investigating something else) is unpredictable:
+//! the bot treats him as coming at it and looking every way. A spot is graded ([`Sighting`]): in a
+//! guard's published sight, only within the bot's caution margins, or unseen.
 
 use glam::Vec2;
-use heist_shared::level::{NavGraph, WallSet};
+use heist_shared::level::{NavGraph, WallSet, patrol};
 use heist_shared::protocol::{GuardAlert, GuardId, GuardView};
 use heist_shared::rules::{self, GUARD_TURN_RATE, GuardTuning, LOOK_AROUND_S, SEARCH_LOOK_S, about_turn};
 
@@ -41,12 +43,27 @@ pub struct Known<'a> {
     pub alarm: u8,
 }
 
+/// A noise the bot made: where, when (the bot's clock) and how loud (its audible radius, metres, as in
+/// `heist_shared::rules`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Noise {
+    /// Where.
+    pub at: Vec2,
+    /// When, seconds on the bot's clock.
+    pub when_s: f32,
+    /// Its audible radius, metres.
+    pub loudness: f32,
+    /// Broken glass no guard has reported yet: the guard who comes to look at it will find the case
+    /// and radio the others to search round it (`rules::EVIDENCE_SPOTS`).
+    pub evidence: bool,
+}
+
 /// What the bot heard: the noises it made lately (a guard who comes to look comes to one of them) and
 /// the search spots radio calls gave each guard (by guard id).
 #[derive(Clone, Copy, Default)]
 pub struct Heard<'a> {
-    /// Where the bot made a noise lately (and when: the bot's clock).
-    pub noises: &'a [(Vec2, f32)],
+    /// The noises the bot made lately, oldest first.
+    pub noises: &'a [Noise],
     /// The spots each radioed guard has still to search.
     pub searches: &'a [(GuardId, Vec<Vec2>)],
 }
@@ -64,6 +81,9 @@ enum Future {
     Goes { path: Vec<(Vec2, f32)>, start: Vec2, facing: f32, speed: f32, then: Option<Box<Future>> },
     /// Unpredictable: assumed to walk straight at the bot, looking all round.
     Alert(Vec2, Vec2),
+    /// `before` until `switch_s`, then `after` (from where `before` left him): a guard who will hear
+    /// a radio call the bot expects.
+    Later { before: Box<Future>, switch_s: f32, after: Box<Future> },
 }
 
 /// How well a spot would be seen, worst first last.
@@ -160,93 +180,63 @@ impl Forecast {
     /// Builds the forecast of `guards` (those in sight and those imagined) from what any player knows
     /// (`known`) and what the bot heard (`heard`); `me` is the bot's position.
     pub fn new(known: &Known<'_>, guards: &[&GuardView], me: Vec2, heard: &Heard<'_>) -> Self {
-        let Known { tuning, nav, routes, alarm } = *known;
-        let (patrol_speed, hurry) =
-            (tuning.hasted(tuning.patrol_speed, alarm), tuning.hasted(tuning.investigate_speed, alarm));
-        let futures = guards
-            .iter()
-            .map(|g| {
-                let waypoints = routes.get(usize::from(g.id.0)).map_or(&[][..], |r| &r[..]);
-                // Back from `from` to the nearest waypoint of his round, then on along it (as the
-                // server's guards do), or along it from where he is if he is on it.
-                let round = |from: Vec2, facing: f32, on_it: bool| {
-                    if waypoints.len() < 2 {
-                        return None;
-                    }
-                    let (route, at) = walked(nav, waypoints);
-                    let (speed, lead_speed) = (patrol_speed, hurry);
-                    if on_it && off_route(&route, from) < OFF_ROUTE_M {
-                        let next = next_waypoint(&route, from, facing);
-                        return Some(Future::Patrol {
-                            lead: Vec::new(),
-                            lead_speed,
-                            route,
-                            next,
-                            start: from,
-                            facing,
-                            speed,
-                        });
-                    }
-                    let k = (0..waypoints.len())
-                        .min_by(|&a, &b| from.distance(waypoints[a]).total_cmp(&from.distance(waypoints[b])))
-                        .unwrap_or(0);
-                    let mut lead = nav.route(from, waypoints[k]).unwrap_or_default();
-                    lead.pop();
-                    Some(Future::Patrol { lead, lead_speed, route, next: at[k], start: from, facing, speed })
+        let built: Vec<(Future, Option<(Vec2, f32)>)> = guards.iter().map(|g| future(known, g, me, heard)).collect();
+        let callers: Vec<(usize, Vec2, f32)> =
+            built.iter().enumerate().filter_map(|(i, (_, call))| call.map(|(at, when)| (i, at, when))).collect();
+        let mut forecast =
+            Self { futures: built.into_iter().map(|(f, _)| f).collect(), alarm: known.alarm, tuning: *known.tuning };
+        forecast.expect_evidence_calls(known, guards, me, &callers);
+        forecast
+    }
+
+    /// The guards who will hear the radio calls `callers` make (guard, broken case found, seconds from
+    /// now) come to search round it after the radio's delay, as the server sends them: those on their
+    /// rounds within the radio's range of the caller then, nearest to the case first, each his share of
+    /// [`rules::EVIDENCE_SPOTS`] spots (`patrol::orders`). One call per guard, the earliest.
+    fn expect_evidence_calls(
+        &mut self,
+        known: &Known<'_>,
+        guards: &[&GuardView],
+        me: Vec2,
+        callers: &[(usize, Vec2, f32)],
+    ) {
+        let t = known.tuning;
+        if t.radio_range_m <= 0.0 {
+            return;
+        }
+        let mut callers = callers.to_vec();
+        callers.sort_by(|a, b| a.2.total_cmp(&b.2));
+        let mut answered = vec![false; guards.len()];
+        let mut switches = Vec::new();
+        for &(caller, at, when) in &callers {
+            let calm = |j: usize| matches!(self.futures[j], Future::Patrol { .. });
+            let mut answering: Vec<(usize, Vec2)> = (0..guards.len())
+                .filter(|&j| j != caller && !answered[j] && calm(j))
+                .map(|j| (j, self.pose(j, when).0))
+                .filter(|(_, p)| p.distance(at) <= t.radio_range_m)
+                .collect();
+            answering.sort_by(|a, b| a.1.distance(at).total_cmp(&b.1.distance(at)));
+            let heard_s = when + t.radio_delay_s;
+            let orders = patrol::orders(known.nav, at, rules::EVIDENCE_SPOTS, answering.len());
+            for (&(j, _), spots) in answering.iter().zip(orders) {
+                answered[j] = true;
+                let (position, facing) = self.pose(j, heard_s);
+                let g = guards[j];
+                let searching = GuardView {
+                    position,
+                    facing: facing.unwrap_or(g.facing),
+                    alert: GuardAlert::Searching,
+                    ..g.clone()
                 };
-                let goes = |mut path: Vec<(Vec2, f32)>| {
-                    // A guard stops to look round as soon as he is within [`rules::ARRIVED_M`] of the
-                    // spot, short of it on his way there.
-                    for i in 0..path.len() {
-                        if path[i].1 > 0.0 {
-                            let before = if i == 0 { g.position } else { path[i - 1].0 };
-                            let back = (before - path[i].0).clamp_length_max(rules::ARRIVED_M - 0.1);
-                            path[i].0 += back;
-                        }
-                    }
-                    let end = path.last().map_or(g.position, |p| p.0);
-                    let then = round(end, g.facing, false).map(Box::new);
-                    Future::Goes { path, start: g.position, facing: g.facing, speed: hurry, then }
-                };
-                if g.alert == GuardAlert::Searching
-                    && let Some((_, spots)) = heard.searches.iter().find(|(id, _)| *id == g.id)
-                {
-                    // Radioed to search these spots: through the doors to each, looking round there.
-                    let mut path = Vec::new();
-                    let mut from = g.position;
-                    for &spot in spots {
-                        path.extend(nav.route(from, spot).unwrap_or_else(|| vec![spot]).into_iter().map(|p| (p, 0.0)));
-                        if let Some(last) = path.last_mut() {
-                            last.1 = SEARCH_LOOK_S;
-                        }
-                        from = spot;
-                    }
-                    return goes(path);
-                }
-                if g.alert == GuardAlert::Investigating {
-                    // Coming to look at a noise the bot made (the nearest by the doors), if any.
-                    let nearest = heard
-                        .noises
-                        .iter()
-                        .map(|&(n, _)| (nav.route_length(g.position, n), n))
-                        .filter(|(d, _)| d.is_finite())
-                        .min_by(|a, b| a.0.total_cmp(&b.0));
-                    if let Some(path) = nearest.and_then(|(_, n)| nav.route(g.position, n)) {
-                        let mut path: Vec<(Vec2, f32)> = path.into_iter().map(|p| (p, 0.0)).collect();
-                        if let Some(last) = path.last_mut() {
-                            last.1 = LOOK_AROUND_S;
-                        }
-                        return goes(path);
-                    }
-                }
-                let calm = matches!(g.alert, GuardAlert::Patrolling | GuardAlert::Returning);
-                match round(g.position, g.facing, g.alert == GuardAlert::Patrolling) {
-                    Some(future) if calm => future,
-                    _ => Future::Alert(g.position, me),
-                }
-            })
-            .collect();
-        Self { futures, alarm, tuning: *tuning }
+                let searches = [(g.id, spots)];
+                let (after, _) = future(known, &searching, me, &Heard { noises: &[], searches: &searches });
+                switches.push((j, heard_s, after));
+            }
+        }
+        for (j, switch_s, after) in switches {
+            let before = std::mem::replace(&mut self.futures[j], Future::Alert(me, me));
+            self.futures[j] = Future::Later { before: Box::new(before), switch_s, after: Box::new(after) };
+        }
     }
 
     /// Where a guard last seen as `last`, `ago_s` seconds ago, is likely now (what a player who lost
@@ -280,6 +270,13 @@ impl Forecast {
                 let d = *towards - *p;
                 let walk = (self.tuning.investigate_speed * t.min(ALERT_APPROACH_S)).min((d.length() - 1.0).max(0.0));
                 (*p + d.normalize_or_zero() * walk, None)
+            }
+            Future::Later { before, switch_s, after } => {
+                if t < *switch_s {
+                    self.pose_of(before, t)
+                } else {
+                    self.pose_of(after, t - switch_s)
+                }
             }
             Future::Goes { path, start, facing, speed, then } => {
                 let (mut at, mut left) = (*start, t);
@@ -463,6 +460,94 @@ enum Walk {
     Arrived(Vec2, f32),
 }
 
+/// The future of guard `g` (see [`Forecast::new`]), and, when he is coming to look at broken glass no
+/// guard has reported yet, the call he will make there: (the case, seconds from now).
+fn future(known: &Known<'_>, g: &GuardView, me: Vec2, heard: &Heard<'_>) -> (Future, Option<(Vec2, f32)>) {
+    let Known { tuning, nav, routes, alarm } = *known;
+    let (patrol_speed, hurry) =
+        (tuning.hasted(tuning.patrol_speed, alarm), tuning.hasted(tuning.investigate_speed, alarm));
+    let waypoints = routes.get(usize::from(g.id.0)).map_or(&[][..], |r| &r[..]);
+    // Back from `from` to the nearest waypoint of his round, then on along it (as the
+    // server's guards do), or along it from where he is if he is on it.
+    let round = |from: Vec2, facing: f32, on_it: bool| {
+        if waypoints.len() < 2 {
+            return None;
+        }
+        let (route, at) = walked(nav, waypoints);
+        let (speed, lead_speed) = (patrol_speed, hurry);
+        if on_it && off_route(&route, from) < OFF_ROUTE_M {
+            let next = next_waypoint(&route, from, facing);
+            return Some(Future::Patrol { lead: Vec::new(), lead_speed, route, next, start: from, facing, speed });
+        }
+        let k = (0..waypoints.len())
+            .min_by(|&a, &b| from.distance(waypoints[a]).total_cmp(&from.distance(waypoints[b])))
+            .unwrap_or(0);
+        let mut lead = nav.route(from, waypoints[k]).unwrap_or_default();
+        lead.pop();
+        Some(Future::Patrol { lead, lead_speed, route, next: at[k], start: from, facing, speed })
+    };
+    let goes = |mut path: Vec<(Vec2, f32)>| {
+        // A guard stops to look round as soon as he is within [`rules::ARRIVED_M`] of the
+        // spot, short of it on his way there.
+        for i in 0..path.len() {
+            if path[i].1 > 0.0 {
+                let before = if i == 0 { g.position } else { path[i - 1].0 };
+                let back = (before - path[i].0).clamp_length_max(rules::ARRIVED_M - 0.1);
+                path[i].0 += back;
+            }
+        }
+        let end = path.last().map_or(g.position, |p| p.0);
+        let then = round(end, g.facing, false).map(Box::new);
+        Future::Goes { path, start: g.position, facing: g.facing, speed: hurry, then }
+    };
+    if g.alert == GuardAlert::Searching
+        && let Some((_, spots)) = heard.searches.iter().find(|(id, _)| *id == g.id)
+    {
+        // Radioed to search these spots: through the doors to each, looking round there.
+        let mut path = Vec::new();
+        let mut from = g.position;
+        for &spot in spots {
+            path.extend(nav.route(from, spot).unwrap_or_else(|| vec![spot]).into_iter().map(|p| (p, 0.0)));
+            if let Some(last) = path.last_mut() {
+                last.1 = SEARCH_LOOK_S;
+            }
+            from = spot;
+        }
+        return (goes(path), None);
+    }
+    if g.alert == GuardAlert::Investigating {
+        // Coming to look at a noise the bot made: the latest he can hear from where he is
+        // (a guard goes to the last noise he heard), else the nearest by the doors, if any.
+        let hearing = tuning.hearing_at(alarm);
+        let latest_heard =
+            heard.noises.iter().rev().find(|n| nav.heard_margin(n.at, g.position, n.loudness * hearing) >= 0.0);
+        let nearest = || {
+            heard
+                .noises
+                .iter()
+                .map(|n| (nav.route_length(g.position, n.at), n))
+                .filter(|(d, _)| d.is_finite())
+                .min_by(|a, b| a.0.total_cmp(&b.0))
+                .map(|(_, n)| n)
+        };
+        let noise = latest_heard.or_else(nearest);
+        if let Some((noise, path)) = noise.and_then(|n| Some((n, nav.route(g.position, n.at)?))) {
+            let mut path: Vec<(Vec2, f32)> = path.into_iter().map(|p| (p, 0.0)).collect();
+            if let Some(last) = path.last_mut() {
+                last.1 = LOOK_AROUND_S;
+            }
+            // He finds the case (and radios) as he gets there.
+            let call = noise.evidence.then(|| (noise.at, nav.route_length(g.position, noise.at) / hurry));
+            return (goes(path), call);
+        }
+    }
+    let calm = matches!(g.alert, GuardAlert::Patrolling | GuardAlert::Returning);
+    match round(g.position, g.facing, g.alert == GuardAlert::Patrolling) {
+        Some(future) if calm => (future, None),
+        _ => (Future::Alert(g.position, me), None),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -472,6 +557,7 @@ mod tests {
 
     const BRUNO: usize = 0;
     const CLARA: usize = 1;
+    const DMITRI: usize = 2;
 
     struct Museum {
         level: Level,
@@ -576,7 +662,8 @@ mod tests {
         let m = Museum::new();
         let glass = Vec2::new(21.0, 1.2);
         let g = guard(BRUNO, Vec2::new(30.0, 5.0), 0.0, GuardAlert::Investigating);
-        let f = m.forecast(&g, &Heard { noises: &[(glass, 0.0)], searches: &[] });
+        let noise = Noise { at: glass, when_s: 0.0, loudness: rules::GLASS_LOUDNESS, evidence: false };
+        let f = m.forecast(&g, &Heard { noises: &[noise], searches: &[] });
         let (p, facing) = f.pose(0, 2.0);
         assert!(p.x < 30.0 - 2.0, "walks towards the glass: {p:?}");
         assert!(facing.is_some(), "looking where he goes");
@@ -590,6 +677,28 @@ mod tests {
         assert!(back.distance(there) > 0.5 && look.is_some(), "then walks back to his round: {back:?}");
         let unknown = m.forecast(&g, &Heard::default());
         assert!(unknown.pose(0, 2.0).1.is_none(), "without a noise he is unpredictable: looks every way");
+    }
+
+    #[test]
+    fn an_investigating_guard_comes_to_the_latest_noise_he_heard_not_an_older_nearer_one() {
+        let m = Museum::new();
+        // A prop thrown by him a while ago, then glass broken down the gallery: he goes to the glass.
+        let (thud, glass) = (Vec2::new(27.0, 6.0), Vec2::new(21.0, 1.2));
+        let g = guard(BRUNO, Vec2::new(30.0, 5.0), 0.0, GuardAlert::Investigating);
+        let noises = [
+            Noise { at: thud, when_s: 0.0, loudness: rules::THUD_LOUDNESS, evidence: false },
+            Noise { at: glass, when_s: 5.0, loudness: rules::GLASS_LOUDNESS, evidence: true },
+        ];
+        let f = m.forecast(&g, &Heard { noises: &noises, searches: &[] });
+        let arrives = m.nav.route_length(g.position, glass) / m.tuning.investigate_speed;
+        let (there, _) = f.pose(0, arrives);
+        assert!(there.distance(glass) < ARRIVED_M, "at the glass when he would be: {there:?}");
+        // A noise he cannot hear from where he is (a thud far off behind closed doors) is not his.
+        let far = Noise { at: Vec2::new(2.0, 14.0), when_s: 6.0, loudness: rules::THUD_LOUDNESS, evidence: false };
+        assert!(m.nav.heard_margin(far.at, g.position, far.loudness) < 0.0);
+        let noises = [noises[1], far];
+        let f = m.forecast(&g, &Heard { noises: &noises, searches: &[] });
+        assert!(f.pose(0, arrives).0.distance(glass) < ARRIVED_M, "still the glass");
     }
 
     #[test]
@@ -609,6 +718,42 @@ mod tests {
         assert!((p.x - (20.0 - short + speed)).abs() < 1e-3 && facing == Some(0.0), "then on to the next: {p:?}");
         let (last, look) = f.pose(0, at_a + SEARCH_LOOK_S + (b.x - a.x) / speed + SEARCH_LOOK_S + 3.0);
         assert!(last.distance(b) > ARRIVED_M && look.is_some(), "after the last, back to his round: {last:?}");
+    }
+
+    #[test]
+    fn a_guard_coming_to_unreported_glass_radios_there_and_the_guards_in_range_come_to_search_round_it() {
+        let m = Museum::new();
+        let case = Vec2::new(28.0, 20.8);
+        let clara = guard(CLARA, Vec2::new(18.0, 15.5), 0.0, GuardAlert::Investigating);
+        let dmitri = guard(DMITRI, m.routes[DMITRI][1], std::f32::consts::FRAC_PI_2, GuardAlert::Patrolling);
+        let glass = |evidence| [Noise { at: case, when_s: 0.0, loudness: rules::GLASS_LOUDNESS, evidence }];
+        let forecast = |noises: &[Noise], tuning: &GuardTuning| {
+            let known = Known { tuning, ..m.known() };
+            Forecast::new(&known, &[&clara, &dmitri], Vec2::ZERO, &Heard { noises, searches: &[] })
+        };
+        let (reported, unreported) = (forecast(&glass(false), &m.tuning), forecast(&glass(true), &m.tuning));
+        let speed = m.tuning.investigate_speed;
+        let heard_s = m.nav.route_length(clara.position, case) / speed + m.tuning.radio_delay_s;
+        // Until the call reaches him, Dmitri walks his round either way.
+        let before = heard_s - 0.5;
+        assert_eq!(unreported.pose(1, before), reported.pose(1, before));
+        // Then he searches his share of the spots round the case, looking round at the first.
+        let first = patrol::orders(&m.nav, case, rules::EVIDENCE_SPOTS, 1)[0][0];
+        let from = unreported.pose(1, heard_s).0;
+        let there = heard_s + (m.nav.route_length(from, first) - (ARRIVED_M - 0.1)) / speed + 0.5 * SEARCH_LOOK_S;
+        let (p, look) = unreported.pose(1, there);
+        assert!(p.distance(first) < ARRIVED_M && look.is_none(), "looks round at {first}: {p:?}");
+        assert!(reported.pose(1, there).0.distance(first) > 2.0, "glass already reported: no call, no search");
+        // Guards without radio (easy) never come.
+        let easy = rules::Difficulty::Easy.tuning();
+        let quiet = forecast(&glass(true), &easy);
+        let unradioed = Forecast::new(
+            &Known { tuning: &easy, ..m.known() },
+            &[&clara, &dmitri],
+            Vec2::ZERO,
+            &Heard { noises: &glass(false), searches: &[] },
+        );
+        assert_eq!(quiet.pose(1, there), unradioed.pose(1, there));
     }
 
     #[test]

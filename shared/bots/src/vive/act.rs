@@ -10,7 +10,7 @@ use super::decide::{LURE_AFTER_S, Perception, Plan};
 use super::goal::Goal;
 use super::map::Map;
 use super::memory::Memory;
-use crate::forecast::{Forecast, HOLD_S};
+use crate::forecast::{Forecast, HOLD_S, Noise};
 use crate::spacetime::{self, Order, Timed};
 
 /// Closer than this beyond a guard's all-round noticing radius counts as exposed, seen or not (walls
@@ -194,14 +194,25 @@ pub(crate) fn carry_out(
             if let ViveMsg::Break(c) = action
                 && let Some(case) = view.cases.iter().find(|cv| cv.id == c)
             {
-                memory.noises.push((case.position, memory.clock_s));
+                memory.noises.push(Noise {
+                    at: case.position,
+                    when_s: memory.clock_s,
+                    loudness: rules::GLASS_LOUDNESS,
+                    evidence: true,
+                });
             }
             (Vec2::ZERO, Gait::Walk, Some(action))
         }
         Plan::Wait => (Vec2::ZERO, Gait::Crouch, None),
         Plan::Throw(item, target) => {
             memory.lured_at = Some(memory.clock_s);
-            memory.noises.push((target, memory.clock_s));
+            let landing = rules::throw_landing(&map.level, &map.walls, me, target);
+            memory.noises.push(Noise {
+                at: landing,
+                when_s: memory.clock_s,
+                loudness: rules::THUD_LOUDNESS,
+                evidence: false,
+            });
             (Vec2::ZERO, Gait::Crouch, Some(ViveMsg::Throw { item, target }))
         }
         Plan::GiveUp => {

@@ -4,7 +4,7 @@
 
 use std::collections::VecDeque;
 
-use crate::forecast::{Forecast, Known};
+use crate::forecast::{Forecast, Known, Noise};
 use crate::spacetime::Timed;
 use glam::Vec2;
 use heist_shared::level::{Level, NavGraph, patrol};
@@ -53,7 +53,7 @@ pub(crate) struct Memory {
     pub trail: VecDeque<Vec2>,
     /// Noises the bot made (glass it broke, props it threw: where, and when), the last few seconds:
     /// a guard who comes to look is coming to one of them.
-    pub noises: Vec<(Vec2, f32)>,
+    pub noises: Vec<Noise>,
     /// The spots each guard was radioed to search (by guard id), those he has not yet been seen at:
     /// worked out from the call as the server does (`heist_shared::level::patrol::orders`).
     pub searches: Vec<(GuardId, Vec<Vec2>)>,
@@ -64,6 +64,12 @@ pub(crate) struct Memory {
 impl Memory {
     /// Hears a radio call: the guards answering it will search their share of the spots around `at`.
     pub fn heard_radio(&mut self, nav: &NavGraph, about: RadioAbout, at: Vec2, answering: &[GuardId]) {
+        if about == RadioAbout::Evidence {
+            // That glass is reported: nobody will radio about it again.
+            for n in self.noises.iter_mut().filter(|n| n.at.distance(at) < 0.5) {
+                n.evidence = false;
+            }
+        }
         for (&id, spots) in answering.iter().zip(patrol::orders(nav, at, about.search_spots(), answering.len())) {
             self.searches.retain(|(g, _)| *g != id);
             self.searches.push((id, spots));
@@ -173,6 +179,18 @@ mod tests {
         assert!(m.searches.iter().all(|(id, _)| *id != GuardId(2)), "back to his round: his search is over");
         m.heard_radio(&nav, RadioAbout::Evidence, at, &[GuardId(1)]);
         assert_eq!(m.searches, vec![(GuardId(1), patrol::orders(&nav, at, rules::EVIDENCE_SPOTS, 1)[0].clone())]);
+    }
+
+    #[test]
+    fn glass_the_bot_broke_stays_evidence_until_a_guard_radios_that_he_found_it() {
+        let nav = NavGraph::new(&heist_shared::level::Level::museum());
+        let (case, other) = (Vec2::new(28.0, 20.8), Vec2::new(13.0, 1.2));
+        let glass = |at| Noise { at, when_s: 0.0, loudness: rules::GLASS_LOUDNESS, evidence: true };
+        let mut m = Memory { noises: vec![glass(case), glass(other)], ..Default::default() };
+        m.heard_radio(&nav, RadioAbout::Sighting, case, &[GuardId(1)]);
+        assert!(m.noises.iter().all(|n| n.evidence), "a sighting reports no glass");
+        m.heard_radio(&nav, RadioAbout::Evidence, case, &[GuardId(1)]);
+        assert_eq!(m.noises.iter().map(|n| n.evidence).collect::<Vec<_>>(), vec![false, true]);
     }
 
     #[test]

@@ -191,7 +191,7 @@ impl ViveBrain {
         memory.avoid.retain(|(_, until)| *until > now);
         let goal = goal::choose(&goal::Wants::new(&view, memory, map.workbench));
         memory.committed = goal.item();
-        memory.noises.retain(|(_, at)| now - at < NOISE_MEMORY_S);
+        memory.noises.retain(|n| now - n.when_s < NOISE_MEMORY_S);
         let heard = Heard { noises: &memory.noises, searches: &memory.searches };
         let forecast = Forecast::new(&known, &view.guards, me.position, &heard);
         let perception = act::perceive(map, memory, &view, &forecast, &goal, self.style == ViveStyle::Reckless);
