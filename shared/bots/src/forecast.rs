@@ -531,13 +531,13 @@ fn future(known: &Known<'_>, g: &GuardView, me: Vec2, heard: &Heard<'_>) -> (Fut
                 .map(|(_, n)| n)
         };
         let noise = latest_heard.or_else(nearest);
-        if let Some((noise, path)) = noise.and_then(|n| Some((n, nav.route(g.position, n.at)?))) {
-            let mut path: Vec<(Vec2, f32)> = path.into_iter().map(|p| (p, 0.0)).collect();
+        if let Some((noise, route)) = noise.and_then(|n| Some((n, nav.route(g.position, n.at)?))) {
+            // He finds the case (and radios) as he gets there.
+            let call = noise.evidence.then(|| (noise.at, NavGraph::path_length(g.position, &route) / hurry));
+            let mut path: Vec<(Vec2, f32)> = route.into_iter().map(|p| (p, 0.0)).collect();
             if let Some(last) = path.last_mut() {
                 last.1 = LOOK_AROUND_S;
             }
-            // He finds the case (and radios) as he gets there.
-            let call = noise.evidence.then(|| (noise.at, nav.route_length(g.position, noise.at) / hurry));
             return (goes(path), call);
         }
     }

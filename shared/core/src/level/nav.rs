@@ -105,10 +105,14 @@ impl NavGraph {
 
     /// Length of the route from `from` to `to`, metres (infinite when there is none).
     pub fn route_length(&self, from: Vec2, to: Vec2) -> f32 {
-        let Some(points) = self.route(from, to) else { return f32::INFINITY };
+        self.route(from, to).map_or(f32::INFINITY, |points| Self::path_length(from, &points))
+    }
+
+    /// The length of the walk from `from` through `points` in turn (a [`NavGraph::route`]), metres.
+    pub fn path_length(from: Vec2, points: &[Vec2]) -> f32 {
         let mut at = from;
         let mut length = 0.0;
-        for p in points {
+        for &p in points {
             length += at.distance(p);
             at = p;
         }
