@@ -15,7 +15,8 @@ use collette::scene::{
     write_trajectory_csv,
 };
 use collette::{
-    Budget, BuildOptions, ContactSet, InnerSphereTree, Pose, QueryWorkspace, TriMesh, build, overlap, overlap_budgeted,
+    Budget, BuildOptions, CoherentOverlap, ContactSet, InnerSphereTree, Pose, QueryWorkspace, TriMesh, build, overlap,
+    overlap_budgeted,
 };
 use criterion::Criterion;
 use std::fmt::Write as _;
@@ -79,6 +80,13 @@ struct QueryRun {
     budget_error_grazing: f64,
     max_pairs: u32,
     contact_fraction: f64,
+    /// The exact aggregated query with temporal coherence ([`CoherentOverlap`]), every pose once in
+    /// trajectory order in a pass of its own.
+    coherent: Vec<f64>,
+    /// Share of the coherent queries that collected their neighbour list anew.
+    coherent_collections: f64,
+    /// Largest relative difference between the coherent and the plain aggregated volume.
+    coherent_volume_error: f64,
 }
 
 fn run_queries(
@@ -93,6 +101,7 @@ fn run_queries(
     let mut aggregated = Vec::with_capacity(path.len());
     let mut overshoot = Vec::with_capacity(path.len());
     let mut overshoot_least = Vec::with_capacity(path.len());
+    let mut volumes = Vec::with_capacity(path.len());
     let (mut max_pairs, mut touching) = (0u32, 0usize);
     // Per phase: summed absolute error of the budgeted volume and summed exact volume.
     let (mut deep_err, mut deep_vol, mut graze_err, mut graze_vol) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
@@ -103,8 +112,9 @@ fn run_queries(
         max_pairs = max_pairs.max(full.leaf_pairs);
         touching += (full.total_volume > 0.0) as usize;
         let t2 = Instant::now();
-        overlap_budgeted(tool, &s.tool, bunny, &Pose::IDENTITY, Budget::Unlimited, &mut ws, &mut set);
+        let exact = overlap_budgeted(tool, &s.tool, bunny, &Pose::IDENTITY, Budget::Unlimited, &mut ws, &mut set);
         aggregated.push(t2.elapsed().as_secs_f64() * 1e6);
+        volumes.push(exact.total_volume);
         let t1 = Instant::now();
         let deadline = t1 + budget;
         let part =
@@ -130,7 +140,23 @@ fn run_queries(
             }
         }
     }
+    // The coherent query keeps state from pose to pose: its own pass, each pose once, in order.
+    let mut list = CoherentOverlap::new(CoherentOverlap::skin_for(tool, bunny)).expect("a valid skin");
+    let mut coherent = Vec::with_capacity(path.len());
+    let mut coherent_volume_error = 0.0f64;
+    for (s, &plain) in path.iter().zip(&volumes) {
+        let t0 = Instant::now();
+        let r = list.query(tool, &s.tool, bunny, &Pose::IDENTITY, &mut ws, &mut set);
+        coherent.push(t0.elapsed().as_secs_f64() * 1e6);
+        if plain > 0.0 {
+            coherent_volume_error = coherent_volume_error.max(((r.total_volume - plain) / plain).abs() as f64);
+        }
+    }
+    let st = list.stats();
     QueryRun {
+        coherent,
+        coherent_collections: st.collections as f64 / st.queries as f64,
+        coherent_volume_error,
         exact,
         aggregated,
         budgeted,
@@ -188,9 +214,9 @@ fn main() {
     );
     let _ = writeln!(
         table,
-        "| spheres | bunny build s | bunny coverage | tool build s | tool coverage | every-pair p50 / p99 / max us | aggregated p50 / p99 / max us | budgeted p50 / p99 / max us | budget error grazing / deep (volume-weighted) | deadline overshoot p99 / p99.9 / max us | least of 3 runs per pose: p99 / p99.9 / max us | max pairs | parry/aggregated p50 | parry/aggregated p99 |"
+        "| spheres | bunny build s | bunny coverage | tool build s | tool coverage | every-pair p50 / p99 / max us | aggregated p50 / p99 / max us | budgeted p50 / p99 / max us | budget error grazing / deep (volume-weighted) | deadline overshoot p99 / p99.9 / max us | least of 3 runs per pose: p99 / p99.9 / max us | max pairs | parry/aggregated p50 | parry/aggregated p99 | coherent exact p50 / p99 / max us | coherent: lists collected, largest volume difference | parry/coherent p99 |"
     );
-    let _ = writeln!(table, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(table, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     let mut phases = String::new();
     let _ = writeln!(
         phases,
@@ -207,9 +233,10 @@ fn main() {
         let aggregated = stats(run.aggregated.clone());
         let overshoot = tail(run.overshoot.clone());
         let least = tail(run.overshoot_least.clone());
+        let coherent = stats(run.coherent.clone());
         let _ = writeln!(
             table,
-            "| {n} | {:.2} | {:.1} % | {:.2} | {:.1} % | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} / {:.1} | {:.1} % / {:.1} % | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} / {:.1} | {} | {:.2} | {:.2} |",
+            "| {n} | {:.2} | {:.1} % | {:.2} | {:.1} % | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} / {:.1} | {:.1} % / {:.1} % | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} / {:.1} | {} | {:.2} | {:.2} | {:.1} / {:.1} / {:.1} | {:.1} % of poses, {:.1e} | {:.2} |",
             b.seconds,
             b.coverage * 100.0,
             t.seconds,
@@ -233,7 +260,13 @@ fn main() {
             least[2],
             run.max_pairs,
             parry[0] / aggregated[0],
-            parry[1] / aggregated[1]
+            parry[1] / aggregated[1],
+            coherent[0],
+            coherent[1],
+            coherent[2],
+            run.coherent_collections * 100.0,
+            run.coherent_volume_error,
+            parry[1] / coherent[1]
         );
         for phase in [Phase::Free, Phase::Grazing, Phase::Deep] {
             let p = stats(run.exact.iter().filter(|e| e.1 == phase).map(|e| e.0).collect());
@@ -257,6 +290,7 @@ fn main() {
             "every_pair_us": exact, "aggregated_us": aggregated, "budgeted_us": budgeted, "overshoot_p99_p999_max_us": overshoot, "overshoot_least_of_3_p99_p999_max_us": least, "budget_us": budget.as_micros() as u64,
             "deep_budget_volume_weighted_error": run.budget_error_deep, "grazing_budget_volume_weighted_error": run.budget_error_grazing, "max_leaf_pairs": run.max_pairs,
             "contact_fraction": run.contact_fraction, "parry_us": parry,
+            "coherent_us": coherent, "coherent_collections": run.coherent_collections, "coherent_volume_error": run.coherent_volume_error,
         }));
         eprintln!("{n} spheres done");
     }

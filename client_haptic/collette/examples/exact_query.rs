@@ -9,11 +9,16 @@
 //! the machine taking the core away), the work at the slowest pose, and a checksum of every pose's
 //! volume and contact count; `--dump FILE` writes one line per pose (volume, contacts) to compare two
 //! versions of the query.
+//!
+//! `--coherent` answers the poses in order, once each, with the temporal-coherence query
+//! (`CoherentOverlap`, `--skin-um` to choose its skin) and splits the times into the poses that reused
+//! the neighbour list and those that collected it; its volume checksum matches the plain query's.
 
 use clap::Parser;
 use collette::scene::{SphereCounts, brilliant_cut, default_bunny_path, load_bunny, trajectory};
 use collette::{
-    Budget, BuildOptions, ContactSet, InnerSphereTree, Pose, QueryWorkspace, TriMesh, build, overlap_budgeted,
+    Budget, BuildOptions, CoherentOverlap, ContactSet, InnerSphereTree, Pose, QueryWorkspace, TriMesh, build,
+    overlap_budgeted,
 };
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -34,6 +39,13 @@ struct Args {
     /// How far the spheres may reach past each surface, in voxels (`BuildOptions::surface_offset`).
     #[arg(long, default_value_t = BuildOptions::DEFAULT_SURFACE_OFFSET)]
     surface_offset: f32,
+    /// Answer the poses in order with the temporal-coherence query (`CoherentOverlap`, one neighbour
+    /// list kept along the trajectory); every pose runs once (a repeat would find its list ready).
+    #[arg(long)]
+    coherent: bool,
+    /// The neighbour list's skin in micrometres (default: `CoherentOverlap::skin_for` the two trees).
+    #[arg(long, requires = "coherent")]
+    skin_um: Option<f32>,
 }
 
 fn tree(mesh: &TriMesh, n: usize, name: &str, surface_offset: f32) -> InnerSphereTree {
@@ -57,6 +69,16 @@ fn main() {
     let bunny = tree(&bunny_mesh, nb, "bunny", args.surface_offset);
     let path = trajectory(&bunny_mesh);
 
+    let mut coherent = args.coherent.then(|| {
+        let skin = args.skin_um.map_or_else(|| CoherentOverlap::skin_for(&tool, &bunny), |um| um * 1e-6);
+        CoherentOverlap::new(skin).unwrap_or_else(|e| {
+            eprintln!("error: --skin-um: {e}");
+            std::process::exit(2)
+        })
+    });
+    let runs = if coherent.is_some() { 1 } else { args.runs.max(1) };
+    let (mut volume_sum, mut most_candidates) = (0.0f64, (0, 0));
+    let (mut reused, mut collecting) = (Vec::new(), Vec::new());
     let mut ws = QueryWorkspace::new();
     let mut set = ContactSet::new();
     let mut times = Vec::with_capacity(path.len());
@@ -65,10 +87,21 @@ fn main() {
     for (i, s) in path.iter().enumerate() {
         let mut best = f64::MAX;
         let mut result = Default::default();
-        for _ in 0..args.runs.max(1) {
+        for _ in 0..runs {
             let t0 = Instant::now();
-            result = overlap_budgeted(&tool, &s.tool, &bunny, &Pose::IDENTITY, Budget::Unlimited, &mut ws, &mut set);
+            result = match &mut coherent {
+                Some(list) => list.query(&tool, &s.tool, &bunny, &Pose::IDENTITY, &mut ws, &mut set),
+                None => overlap_budgeted(&tool, &s.tool, &bunny, &Pose::IDENTITY, Budget::Unlimited, &mut ws, &mut set),
+            };
             best = best.min(t0.elapsed().as_secs_f64() * 1e6);
+        }
+        if let Some(list) = &coherent {
+            let (p, n) = list.len();
+            most_candidates = (most_candidates.0.max(p), most_candidates.1.max(n));
+        }
+        volume_sum += result.total_volume as f64 * 1e6;
+        if coherent.is_some() {
+            if result.node_pairs == 0 { reused.push(best) } else { collecting.push(best) }
         }
         times.push(best);
         checksum += result.total_volume as f64 * 1e6 + set.len() as f64;
@@ -87,10 +120,11 @@ fn main() {
     let at = |q: f64| sorted[((sorted.len() - 1) as f64 * q).round() as usize];
     let total: f64 = times.iter().sum();
     println!(
-        "{} poses, {nt}:{nb} spheres, least of {} runs: p50 {:.1} us, p99 {:.1} us, p99.9 {:.1} us, max {:.1} us, \
-         mean {:.1} us",
+        "{} poses, {nt}:{nb} spheres, {}least of {} runs: p50 {:.1} us, p99 {:.1} us, p99.9 {:.1} us, \
+         max {:.1} us, mean {:.1} us",
         path.len(),
-        args.runs,
+        if coherent.is_some() { "coherent, " } else { "" },
+        runs,
         at(0.5),
         at(0.99),
         at(0.999),
@@ -105,5 +139,31 @@ fn main() {
         r.leaf_pairs,
         r.aggregated_pairs
     );
-    println!("checksum {checksum:.6}");
+    println!("checksum {checksum:.6} (volumes alone {volume_sum:.6})");
+    if let Some(list) = &coherent {
+        for (name, mut v) in [("reusing the list", reused), ("collecting it", collecting)] {
+            v.sort_by(f64::total_cmp);
+            let q = |q: f64| v.get(((v.len().max(1) - 1) as f64 * q).round() as usize).copied().unwrap_or(0.0);
+            let over = v.iter().filter(|&&t| t > 100.0).count();
+            println!(
+                "  {name}: {} poses, p50 {:.1} us, p99 {:.1} us, max {:.1} us, {over} over 100 us",
+                v.len(),
+                q(0.5),
+                q(0.99),
+                q(1.0)
+            );
+        }
+        let st = list.stats();
+        println!(
+            "neighbour list: skin {:.1} um, collected {} times in {} queries ({:.1} %), {} overflows, at most {} \
+             candidate pairs and {} nested nodes",
+            list.skin() * 1e6,
+            st.collections,
+            st.queries,
+            100.0 * st.collections as f64 / st.queries as f64,
+            st.overflows,
+            most_candidates.0,
+            most_candidates.1
+        );
+    }
 }

@@ -1,4 +1,4 @@
-//! Errors of the collette library: bad meshes, failed builds and unreadable `.ist` files.
+//! Errors of the collette library: bad meshes, failed builds, unreadable `.ist` files and bad query settings.
 
 use std::path::PathBuf;
 
@@ -157,3 +157,8 @@ pub enum TrajectoryError {
         message: String,
     },
 }
+
+/// A neighbour list's skin that is not a length ([`crate::query::CoherentOverlap::new`]).
+#[derive(Debug, thiserror::Error, Clone, Copy, PartialEq)]
+#[error("invalid skin {0}: a neighbour list's skin must be a finite length >= 0")]
+pub struct SkinError(pub f32);

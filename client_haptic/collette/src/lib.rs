@@ -10,7 +10,8 @@
 //! - Build: [`TriMesh::from_obj`] / [`TriMesh::from_buffers`], then [`build`] with [`BuildOptions`].
 //! - Store: [`InnerSphereTree::save`] / [`InnerSphereTree::load`] (the `.ist` format, see [`io`]).
 //! - Query: [`overlap()`], [`overlap_budgeted`], [`overlap_volume`], [`probe()`], [`separation`], each with a
-//!   caller-owned [`QueryWorkspace`] and (for contacts) a [`ContactSet`].
+//!   caller-owned [`QueryWorkspace`] and (for contacts) a [`ContactSet`]; [`CoherentOverlap`] keeps a
+//!   neighbour list between one pair's exact queries (temporal coherence).
 //! - Run: [`CollisionThread::spawn`] gives a [`CollisionHandle`]; poses in through [`PoseWriter`],
 //!   contacts out through [`ContactReader`].
 //! - Benchmark scene (gemstone tool, bunny, scripted trajectory): [`scene`].
@@ -28,13 +29,13 @@ pub mod render;
 pub mod scene;
 pub mod shape;
 
-pub use error::{BuildError, IstFileError, MeshError, TrajectoryError};
+pub use error::{BuildError, IstFileError, MeshError, SkinError, TrajectoryError};
 pub use packing::{BuildOptions, BuildProgress, BuildReport, build};
 pub use partitioning::{InnerSphereTree, Node};
 pub use pipeline::{CollisionConfig, CollisionHandle, CollisionThread, ContactReader, ObjectId, PoseWriter, WatcherId};
 pub use query::{
-    Budget, OverlapResult, ProbeHit, QueryWorkspace, Separation, overlap, overlap_budgeted, overlap_volume, probe,
-    separation,
+    Budget, CoherenceStats, CoherentOverlap, OverlapResult, ProbeHit, QueryWorkspace, Separation, overlap,
+    overlap_budgeted, overlap_volume, probe, separation,
 };
 pub use shape::{Sphere, TriMesh};
 

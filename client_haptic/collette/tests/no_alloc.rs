@@ -4,8 +4,8 @@ use assert_no_alloc::{AllocDisabler, assert_no_alloc};
 use collette::pipeline::{CollisionConfig, CollisionWorld, Command, ObjectId, TimedPose, WatcherId, WatcherOutput};
 use collette::shape::box_buffers;
 use collette::{
-    Budget, BuildOptions, ContactSet, Pose, QueryWorkspace, TriMesh, build, overlap, overlap_budgeted, overlap_volume,
-    probe, separation,
+    Budget, BuildOptions, CoherentOverlap, ContactSet, Pose, QueryWorkspace, TriMesh, build, overlap, overlap_budgeted,
+    overlap_volume, probe, separation,
 };
 use glam::{Quat, Vec3};
 use std::sync::Arc;
@@ -21,6 +21,9 @@ fn queries_and_collision_steps_do_not_allocate_once_warmed_up() {
     let mut ws = QueryWorkspace::new();
     let mut set = ContactSet::new();
     let (pa, pb) = (Pose::IDENTITY, Pose::new(Vec3::new(0.4, 0.2, 0.1), Quat::from_rotation_z(0.5)));
+    // Collected at the first pose, reused at the second, collected again at the third (moved by 0.05).
+    let mut list = CoherentOverlap::new(0.02).expect("a valid skin");
+    let moved = [pb, Pose::new(pb.translation + Vec3::X * 0.005, pb.rotation), Pose::from_translation(Vec3::X * 0.45)];
     let run = |ws: &mut QueryWorkspace, set: &mut ContactSet| {
         overlap(&tree, &pa, &tree, &pb, ws, set);
         overlap_budgeted(&tree, &pa, &tree, &pb, Budget::NodePairs(100), ws, set);
@@ -31,6 +34,14 @@ fn queries_and_collision_steps_do_not_allocate_once_warmed_up() {
     };
     run(&mut ws, &mut set);
     assert_no_alloc(|| run(&mut ws, &mut set));
+    let mut coherent = |ws: &mut QueryWorkspace, set: &mut ContactSet| {
+        for pose in &moved {
+            assert!(list.query(&tree, &pa, &tree, pose, ws, set).total_volume > 0.0);
+        }
+    };
+    coherent(&mut ws, &mut set);
+    assert_no_alloc(|| coherent(&mut ws, &mut set));
+    assert_eq!(list.stats().collections, 4, "collected at the first and third pose of each round");
 
     let config = CollisionConfig::default();
     let mut world = CollisionWorld::new(&config);

@@ -4,6 +4,7 @@
 use glam::{Affine3A, Vec4};
 
 /// An affine map's entries, each in all four lanes: moves four points (structure of arrays) at once.
+#[derive(Clone, Copy)]
 pub(super) struct WideAffine {
     xx: Vec4,
     xy: Vec4,

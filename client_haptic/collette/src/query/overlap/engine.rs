@@ -22,11 +22,32 @@ const LOCAL_DEPTH: usize = 200;
 /// against one node's bound (`c`, `r`; `leaf` when it is a leaf): the squared distances, the lanes that
 /// overlap it, and the lanes that containment may settle (one bound inside the other, the outer one a
 /// leaf's, as a node inside a leaf sphere needs).
+///
+/// With a `margin` (a neighbour list's skin, [`super::coherent`]) a lane hits when the bounds come
+/// within `margin` of each other and nests only when it stays nested after either moves by `margin`;
+/// the exact queries pass a literal 0, which compiles to the test without it.
 #[inline(always)]
-fn four_against(centres: [Vec4; 3], radii: Vec4, leaves: u32, c: Vec3, r: f32, leaf: bool) -> (Vec4, u32, u32) {
+fn four_against(
+    centres: [Vec4; 3],
+    radii: Vec4,
+    leaves: u32,
+    c: Vec3,
+    r: f32,
+    leaf: bool,
+    margin: f32,
+) -> (Vec4, u32, u32) {
     let (dx, dy, dz) = (centres[0] - Vec4::splat(c.x), centres[1] - Vec4::splat(c.y), centres[2] - Vec4::splat(c.z));
     let d2 = dx * dx + dy * dy + dz * dz;
     let (reach, gap) = (radii + Vec4::splat(r), radii - Vec4::splat(r));
+    if margin != 0.0 {
+        let reach = reach + Vec4::splat(margin);
+        let hits = d2.cmplt(reach * reach).bitmask();
+        // Child inside a leaf `c`: |d| + radius + margin <= r; leaf child around `c`: |d| + r + margin <= radius.
+        let (inner, outer) = (gap + Vec4::splat(margin), gap - Vec4::splat(margin));
+        let in_leaf = if leaf { d2.cmple(inner * inner).bitmask() & inner.cmple(Vec4::ZERO).bitmask() } else { 0 };
+        let around = leaves & d2.cmple(outer * outer).bitmask() & outer.cmpge(Vec4::ZERO).bitmask();
+        return (d2, hits, in_leaf | around);
+    }
     let hits = d2.cmplt(reach * reach).bitmask();
     let outer_is_leaf =
         if leaf { gap.cmple(Vec4::ZERO).bitmask() } else { 0 } | (leaves & gap.cmpge(Vec4::ZERO).bitmask());
@@ -38,10 +59,10 @@ pub(super) struct Engine<'a, S> {
     b: &'a InnerSphereTree,
     pos12: Affine3A,
     /// `pos12`'s entries, each in all four lanes (moving four of B's centres at once).
-    wide: WideAffine,
+    pub(super) wide: WideAffine,
     budget: Budget,
     aggregate: bool,
-    sink: S,
+    pub(super) sink: S,
     pairs: PairBatch,
     /// Stack of A's blocks for [`Engine::subtree_in_sphere`].
     local: [u32; LOCAL_DEPTH],
@@ -84,6 +105,12 @@ impl<'a, S: Sink> Engine<'a, S> {
     #[inline(always)]
     fn tp(&self, p: Vec3) -> Vec3 {
         Vec3::from(self.pos12.transform_point3a(p.into()))
+    }
+
+    /// The skin a neighbour list is collected with; a literal 0 for every other query.
+    #[inline(always)]
+    fn margin(&self) -> f32 {
+        if S::COLLECTS { self.sink.margin() } else { 0.0 }
     }
 
     /// Exact depth-first descent.
@@ -149,7 +176,7 @@ impl<'a, S: Sink> Engine<'a, S> {
     fn root_needs_visit(&mut self) -> bool {
         let (na, nb) = (self.a.nodes[0], self.b.nodes[0]);
         let cb = self.tp(nb.bound.center);
-        let r = na.bound.radius + nb.bound.radius;
+        let r = na.bound.radius + nb.bound.radius + self.margin();
         if na.bound.center.distance_squared(cb) >= r * r {
             return false;
         }
@@ -218,7 +245,8 @@ impl<'a, S: Sink> Engine<'a, S> {
             let (cb, rb) = Self::bound_of(b, nb);
             let cb = self.tp(cb);
             let blk = a.block(ia);
-            let (_, mut hits, nested) = four_against([blk.x, blk.y, blk.z], blk.r, blk.leaf, cb, rb, nb.leaf);
+            let (_, mut hits, nested) =
+                four_against([blk.x, blk.y, blk.z], blk.r, blk.leaf, cb, rb, nb.leaf, self.margin());
             while hits != 0 {
                 let lane = hits.trailing_zeros() as usize;
                 hits &= hits - 1;
@@ -242,7 +270,7 @@ impl<'a, S: Sink> Engine<'a, S> {
             let (ca, ra) = Self::bound_of(a, na);
             let blk = b.block(ib);
             let [x, y, z] = self.wide.point(blk.x, blk.y, blk.z);
-            let (_, mut hits, nested) = four_against([x, y, z], blk.r, blk.leaf, ca, ra, na.leaf);
+            let (_, mut hits, nested) = four_against([x, y, z], blk.r, blk.leaf, ca, ra, na.leaf, self.margin());
             while hits != 0 {
                 let lane = hits.trailing_zeros() as usize;
                 hits &= hits - 1;
@@ -276,7 +304,7 @@ impl<'a, S: Sink> Engine<'a, S> {
             len -= 1;
             self.result.node_pairs += 1;
             let blk = a.block_at(self.local[len]);
-            let (d2, hits, nested) = four_against([blk.x, blk.y, blk.z], blk.r, blk.leaf, cb, rb, true);
+            let (d2, hits, nested) = four_against([blk.x, blk.y, blk.z], blk.r, blk.leaf, cb, rb, true, self.margin());
             let leaves = hits & blk.leaf;
             for lane in Lanes(leaves & blk.single) {
                 let ca = Vec3::new(blk.x[lane], blk.y[lane], blk.z[lane]);
@@ -290,10 +318,26 @@ impl<'a, S: Sink> Engine<'a, S> {
             let inside = if self.aggregate { inner & nested } else { 0 };
             for lane in Lanes(inside) {
                 let ca = Vec3::new(blk.x[lane], blk.y[lane], blk.z[lane]);
+                if S::COLLECTS {
+                    self.sink.nested(ca, blk.r[lane], self.b.spheres[sb as usize], blk.share[lane] * wb, false);
+                    continue;
+                }
                 let l = Lens { volume: blk.share[lane] * wb, centroid: ca, depth: blk.r[lane] + rb - d2[lane].sqrt() };
                 self.emit_aggregate(&l, ca, cb);
             }
-            for lane in Lanes(inner & !inside) {
+            let mut descend = inner & !inside;
+            if S::COLLECTS && self.aggregate {
+                // Inside the sphere now, but nearer its surface than the margin: the list keeps the node and
+                // its sphere, to settle whether it is still inside at each query.
+                let (_, _, now) = four_against([blk.x, blk.y, blk.z], blk.r, blk.leaf, cb, rb, true, 0.0);
+                for lane in Lanes(descend & now) {
+                    let ca = Vec3::new(blk.x[lane], blk.y[lane], blk.z[lane]);
+                    let sphere = self.b.spheres[sb as usize];
+                    self.sink.maybe_nested(blk.node[lane], ca, blk.r[lane], sb, ib, sphere, blk.share[lane] * wb);
+                }
+                descend &= !now;
+            }
+            for lane in Lanes(descend) {
                 if len < LOCAL_DEPTH {
                     self.local[len] = blk.link[lane];
                     len += 1;
@@ -302,6 +346,15 @@ impl<'a, S: Sink> Engine<'a, S> {
                 }
             }
         }
+    }
+
+    /// Every overlap of A's subtree under inner node `ia` with B's sphere `sb` (in leaf `ib`), as the
+    /// exact descent finds it (a neighbour list's node that has left the sphere it was inside).
+    pub(super) fn subtree_against_sphere(&mut self, ia: u32, sb: u32, ib: u32, ws: &mut QueryWorkspace) {
+        let s = self.b.spheres[sb as usize];
+        ws.stack.clear();
+        self.subtree_in_sphere(ia, self.tp(s.center), s.radius, sb, ib, &mut ws.stack);
+        self.drain_stack(ws);
     }
 
     /// A node's bound in its own frame: the sphere itself for a one-sphere leaf (what its parent's
@@ -319,6 +372,10 @@ impl<'a, S: Sink> Engine<'a, S> {
     /// One pair of leaf spheres (A's sphere `sa` at `ca`, B's sphere `sb` at `cb`, both in A's frame).
     #[inline(always)]
     fn sphere_pair(&mut self, ca: Vec3, ra: f32, sa: u32, cb: Vec3, rb: f32, sb: u32) {
+        if S::COLLECTS {
+            self.sink.pair(sa, sb);
+            return;
+        }
         let weight = self.a.weights[sa as usize] * self.b.weights[sb as usize];
         if self.pairs.push(ca, ra, cb, rb, weight) {
             self.flush_pairs();
@@ -326,7 +383,7 @@ impl<'a, S: Sink> Engine<'a, S> {
     }
 
     /// Computes the queued sphere pairs' lenses four at once and reports them.
-    fn flush_pairs(&mut self) {
+    pub(super) fn flush_pairs(&mut self) {
         let n = self.pairs.len;
         self.pairs.len = 0;
         let p = &self.pairs;
@@ -369,8 +426,12 @@ impl<'a, S: Sink> Engine<'a, S> {
                 let sb = &self.b.spheres[ib];
                 let c = self.tp(sb.center);
                 let d = na.bound.center.distance(c);
-                if d + na.bound.radius <= sb.radius {
+                if d + na.bound.radius + self.margin() <= sb.radius {
                     let volume = na.mesh_share * self.b.weights[ib];
+                    if S::COLLECTS {
+                        self.sink.nested(na.bound.center, na.bound.radius, *sb, volume, false);
+                        return true;
+                    }
                     let l = Lens { volume, centroid: na.bound.center, depth: sb.radius + na.bound.radius - d };
                     self.emit_aggregate(&l, na.bound.center, c);
                     return true;
@@ -380,8 +441,12 @@ impl<'a, S: Sink> Engine<'a, S> {
             for ia in na.range() {
                 let sa = &self.a.spheres[ia];
                 let d = sa.center.distance(cb);
-                if d + nb.bound.radius <= sa.radius {
+                if d + nb.bound.radius + self.margin() <= sa.radius {
                     let volume = nb.mesh_share * self.a.weights[ia];
+                    if S::COLLECTS {
+                        self.sink.nested(sa.center, sa.radius, nb.bound, volume, true);
+                        return true;
+                    }
                     let l = Lens { volume, centroid: cb, depth: sa.radius + nb.bound.radius - d };
                     self.emit_aggregate(&l, sa.center, cb);
                     return true;

@@ -5,8 +5,11 @@
 
 mod affine;
 mod batch;
+mod coherent;
 mod engine;
 mod sink;
+
+pub use coherent::{CoherenceStats, CoherentOverlap};
 
 use crate::partitioning::InnerSphereTree;
 use crate::query::QueryWorkspace;

@@ -12,6 +12,40 @@ pub(super) trait Sink {
     fn one(&mut self, lens: &Lens, ca: Vec3, cb: Vec3);
     /// Four sphere pairs at once; only the lanes whose bit is set in `lanes` count.
     fn four(&mut self, lenses: &Lens4, ca: [Vec4; 3], cb: [Vec4; 3], lanes: u32);
+
+    /// True for a sink that collects a neighbour list ([`super::coherent`]): the descent then tests
+    /// with [`Sink::margin`] and hands over candidates ([`Sink::pair`], [`Sink::nested`]) instead of
+    /// computing lenses. Known at compile time, so the other queries carry none of it.
+    const COLLECTS: bool = false;
+
+    /// The skin the candidates are collected with.
+    fn margin(&self) -> f32 {
+        0.0
+    }
+
+    /// A's sphere `sa` and B's sphere `sb` come within the margin.
+    fn pair(&mut self, _sa: u32, _sb: u32) {}
+
+    /// A node's bound (`inner`) lies inside a leaf sphere (`outer`) of the other tree with the margin
+    /// to spare, standing for `volume` of overlap: `ca`/`ra` on A's side (A's frame), `pb` on B's
+    /// (B's frame); `b_inside` when B's node is the one inside A's sphere.
+    fn nested(&mut self, _ca: Vec3, _ra: f32, _pb: crate::shape::Sphere, _volume: f32, _b_inside: bool) {}
+
+    /// A's inner node `node` (bound `ca`, `ra`) lies inside B's sphere `sb` (in leaf `ib`; `pb` in B's
+    /// frame) but nearer its surface than the margin: inside it stands for `volume`, else its subtree
+    /// must be descended against the sphere.
+    #[allow(clippy::too_many_arguments)]
+    fn maybe_nested(
+        &mut self,
+        _node: u32,
+        _ca: Vec3,
+        _ra: f32,
+        _sb: u32,
+        _ib: u32,
+        _pb: crate::shape::Sphere,
+        _volume: f32,
+    ) {
+    }
 }
 
 /// Keeps nothing: the query's result carries the volume.

@@ -17,14 +17,14 @@ fn inner_tree_of(v: Vec<Vec3>, t: Vec<[u32; 3]>, spheres: usize) -> InnerSphereT
     tree_with((v, t), &BuildOptions { surface_offset: 0.0, ..BuildOptions::spheres(spheres) })
 }
 
-fn ball(spheres: usize) -> InnerSphereTree {
+pub(super) fn ball(spheres: usize) -> InnerSphereTree {
     let (v, t) = uv_sphere_buffers(1.0, 32, 64);
     inner_tree_of(v, t, spheres)
 }
 
 /// A torus (R 0.7, r 0.3) of 300 spheres: many spheres of many sizes (a ball's packing is nearly one
 /// sphere, too simple to exercise a descent).
-fn torus(spheres: usize) -> InnerSphereTree {
+pub(super) fn torus(spheres: usize) -> InnerSphereTree {
     let (v, t) = torus_buffers(0.7, 0.3, 48, 24);
     tree_of(v, t, spheres)
 }
@@ -34,13 +34,13 @@ fn small_tree() -> &'static InnerSphereTree {
     T.get_or_init(|| torus(300))
 }
 
-fn unit_box(spheres: usize) -> InnerSphereTree {
+pub(super) fn unit_box(spheres: usize) -> InnerSphereTree {
     let (v, t) = box_buffers(Vec3::splat(0.5));
     tree_of(v, t, spheres)
 }
 
 /// Brute force over all sphere pairs (weighted lens volumes): the reference for the tree traversal.
-fn brute_force(a: &InnerSphereTree, pa: &Pose, b: &InnerSphereTree, pb: &Pose) -> f64 {
+pub(super) fn brute_force(a: &InnerSphereTree, pa: &Pose, b: &InnerSphereTree, pb: &Pose) -> f64 {
     let mut sum = 0.0;
     for (sa, wa) in a.spheres().iter().zip(a.weights()) {
         let ca = pa.transform_point(sa.center);
