@@ -3,7 +3,9 @@
 //!
 //! `cargo bench -p collette --bench bunny_scene` first prints (and writes to
 //! `target/collette-bench/`) the table of build time, coverage and query time percentiles for each
-//! sphere count, then runs a few criterion micro-benchmarks. Environment:
+//! sphere count (the exact aggregated query also with temporal coherence, `CoherentOverlap`, in a pass
+//! of its own that takes every pose once, in order), then runs a few criterion micro-benchmarks.
+//! Environment:
 //! `COLLETTE_BENCH_SIZES` (default `1000,5000,10000,50000`; `TOOL:BUNNY`, e.g. `4000:20000`, gives the
 //! two trees different counts), `COLLETTE_BENCH_BUDGET_US` (default 80),
 //! `COLLETTE_BENCH_STRIDE` (use every n-th pose, default 1), `COLLETTE_BENCH_TABLE_ONLY` (skip criterion),
