@@ -79,6 +79,7 @@ fn main() {
     let runs = if coherent.is_some() { 1 } else { args.runs.max(1) };
     let (mut volume_sum, mut most_candidates) = (0.0f64, (0, 0));
     let (mut reused, mut collecting) = (Vec::new(), Vec::new());
+    let (mut collections, mut slowest_reuse) = (0, (0.0f64, 0usize, collette::OverlapResult::default(), (0, 0)));
     let mut ws = QueryWorkspace::new();
     let mut set = ContactSet::new();
     let mut times = Vec::with_capacity(path.len());
@@ -100,8 +101,17 @@ fn main() {
             most_candidates = (most_candidates.0.max(p), most_candidates.1.max(n));
         }
         volume_sum += result.total_volume as f64 * 1e6;
-        if coherent.is_some() {
-            if result.node_pairs == 0 { reused.push(best) } else { collecting.push(best) }
+        if let Some(list) = &coherent {
+            let collected = list.stats().collections > collections;
+            collections = list.stats().collections;
+            if collected {
+                collecting.push(best)
+            } else {
+                reused.push(best)
+            }
+            if !collected && best > slowest_reuse.0 {
+                slowest_reuse = (best, i, result, list.len());
+            }
         }
         times.push(best);
         checksum += result.total_volume as f64 * 1e6 + set.len() as f64;
@@ -153,10 +163,16 @@ fn main() {
                 q(1.0)
             );
         }
+        let (t, i, r, (rows, nodes)) = slowest_reuse;
+        println!(
+            "  slowest pose reusing the list: {i}, {t:.1} us, {rows} candidate pairs and {nodes} nodes listed, {} leaf \
+             pairs, {} aggregated, {} node pairs visited",
+            r.leaf_pairs, r.aggregated_pairs, r.node_pairs
+        );
         let st = list.stats();
         println!(
             "neighbour list: skin {:.1} um, collected {} times in {} queries ({:.1} %), {} overflows, at most {} \
-             candidate pairs and {} nested nodes",
+             candidate pairs and {} nodes",
             list.skin() * 1e6,
             st.collections,
             st.queries,

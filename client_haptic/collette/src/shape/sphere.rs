@@ -124,6 +124,8 @@ pub(crate) struct Lens4 {
     pub volume: Vec4,
     pub centroid: [Vec4; 3],
     pub depth: Vec4,
+    /// One over the centres' distance (infinite where they coincide): the normal without another root.
+    pub inv_d: Vec4,
 }
 
 /// [`lens`] for four pairs of balls at once.
@@ -158,7 +160,7 @@ pub(crate) fn lens_x4(c1: [Vec4; 3], r1: Vec4, c2: [Vec4; 3], r2: Vec4) -> Lens4
         centroid[k] = Vec4::select(inside, small_c, lens_c);
     }
     let volume = Vec4::select(inside, small_volume, lens_volume.max(Vec4::ZERO));
-    Lens4 { volume: Vec4::select(apart, Vec4::ZERO, volume), centroid, depth }
+    Lens4 { volume: Vec4::select(apart, Vec4::ZERO, volume), centroid, depth, inv_d }
 }
 
 #[cfg(test)]

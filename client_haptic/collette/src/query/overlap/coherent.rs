@@ -19,6 +19,7 @@
 //! straddled that sphere's surface or was within the skin of another sphere when the list was
 //! collected): same volume, more contacts.
 
+use super::affine::WideAffine;
 use super::engine::Engine;
 use super::sink::{Contacts, Sink};
 use super::{Budget, OverlapResult, fallback_normal};
@@ -115,6 +116,16 @@ impl<const N: usize> Columns<N> {
     fn four(&self, k: usize, at: usize) -> Vec4 {
         Vec4::from_slice(&self.col[k][at..at + 4])
     }
+
+    /// The four rows from `at` as two spheres each, from columns 0–3 (A's side, A's frame) and 4–7
+    /// (B's side, moved into A's frame by `wide`): centres, radii and squared centre distances.
+    #[inline(always)]
+    fn sides(&self, at: usize, wide: &WideAffine) -> ([Vec4; 3], Vec4, [Vec4; 3], Vec4, Vec4) {
+        let ca = [self.four(0, at), self.four(1, at), self.four(2, at)];
+        let cb = wide.point(self.four(4, at), self.four(5, at), self.four(6, at));
+        let (dx, dy, dz) = (ca[0] - cb[0], ca[1] - cb[1], ca[2] - cb[2]);
+        (ca, self.four(3, at), cb, self.four(7, at), dx * dx + dy * dy + dz * dz)
+    }
 }
 
 impl CoherentOverlap {
@@ -189,7 +200,8 @@ impl CoherentOverlap {
     /// The exact aggregated overlap of `a` at `pose_a` and `b` at `pose_b`, as
     /// [`super::overlap_budgeted`] with [`Budget::Unlimited`] gives it, from the list (collected
     /// first when there is none, the trees are others, or A has moved by the skin since).
-    /// `node_pairs` counts the collecting descent's visits (0 when the list was reused).
+    /// `node_pairs` counts the node pairs visited: by the collecting descent, if the list was collected,
+    /// and by the nodes descended against a sphere they have left.
     pub fn query(
         &mut self,
         a: &InnerSphereTree,
@@ -225,7 +237,7 @@ impl CoherentOverlap {
         }
         let visited = result.node_pairs;
         result = engine.result;
-        result.node_pairs = visited;
+        result.node_pairs += visited;
         out.total_volume = result.total_volume;
         out.estimated_volume = 0.0;
         out.truncated |= !result.complete;
@@ -295,13 +307,9 @@ impl CoherentOverlap {
         let (mut leaf_pairs, mut aggregated) = (0, 0);
         let p = &self.pairs;
         for at in (0..p.len).step_by(4) {
-            let ca = [p.four(0, at), p.four(1, at), p.four(2, at)];
-            let cb = wide.point(p.four(4, at), p.four(5, at), p.four(6, at));
-            let (ra, rb) = (p.four(3, at), p.four(7, at));
+            let (ca, ra, cb, rb, d2) = p.sides(at, &wide);
             // Most candidates are still apart: four distances settle them before any lens is computed.
-            let (dx, dy, dz) = (cb[0] - ca[0], cb[1] - ca[1], cb[2] - ca[2]);
-            let reach = ra + rb;
-            if (dx * dx + dy * dy + dz * dz).cmplt(reach * reach).bitmask() == 0 {
+            if d2.cmplt((ra + rb) * (ra + rb)).bitmask() == 0 {
                 continue;
             }
             let mut lenses = lens_x4(ca, ra, cb, rb);
@@ -315,25 +323,19 @@ impl CoherentOverlap {
         }
         let n = &self.nested;
         for at in (0..n.len).step_by(4) {
-            let ca = [n.four(0, at), n.four(1, at), n.four(2, at)];
-            let cb = wide.point(n.four(4, at), n.four(5, at), n.four(6, at));
+            let (ca, ra, cb, rb, d2) = n.sides(at, &wide);
             let volume = n.four(8, at);
             let b_side = n.four(9, at).cmpgt(Vec4::ZERO);
-            let (dx, dy, dz) = (ca[0] - cb[0], ca[1] - cb[1], ca[2] - cb[2]);
-            let depth = n.four(3, at) + n.four(7, at) - (dx * dx + dy * dy + dz * dz).sqrt();
+            let d = d2.sqrt();
             let centroid = std::array::from_fn(|k| Vec4::select(b_side, cb[k], ca[k]));
             let lanes = volume.cmpgt(Vec4::ZERO).bitmask();
             total += volume;
             aggregated += lanes.count_ones();
-            engine.sink.four(&Lens4 { volume, centroid, depth }, ca, cb, lanes);
+            engine.sink.four(&Lens4 { volume, centroid, depth: ra + rb - d, inv_d: d.recip() }, ca, cb, lanes);
         }
         let m = &self.maybe;
         for at in (0..m.len).step_by(4) {
-            let ca = [m.four(0, at), m.four(1, at), m.four(2, at)];
-            let cb = wide.point(m.four(4, at), m.four(5, at), m.four(6, at));
-            let (ra, rb) = (m.four(3, at), m.four(7, at));
-            let (dx, dy, dz) = (ca[0] - cb[0], ca[1] - cb[1], ca[2] - cb[2]);
-            let d2 = dx * dx + dy * dy + dz * dz;
+            let (ca, ra, cb, rb, d2) = m.sides(at, &wide);
             let gap = rb - ra;
             let rows = (1u32 << (m.len - at).min(4)) - 1;
             let inside = d2.cmple(gap * gap).bitmask() & gap.cmpge(Vec4::ZERO).bitmask() & rows;
@@ -345,7 +347,8 @@ impl CoherentOverlap {
                 );
                 total += volume;
                 aggregated += inside.count_ones();
-                let lens = Lens4 { volume, centroid: ca, depth: ra + rb - d2.sqrt() };
+                let d = d2.sqrt();
+                let lens = Lens4 { volume, centroid: ca, depth: ra + rb - d, inv_d: d.recip() };
                 engine.sink.four(&lens, ca, cb, inside);
             }
             for lane in super::batch::Lanes(rows & !inside) {

@@ -98,11 +98,11 @@ impl Sink for Contacts<'_> {
     #[inline]
     fn four(&mut self, lenses: &Lens4, ca: [Vec4; 3], cb: [Vec4; 3], mut lanes: u32) {
         let delta = [ca[0] - cb[0], ca[1] - cb[1], ca[2] - cb[2]];
-        let len2 = delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2];
-        let inv = len2.sqrt().recip();
+        let inv = lenses.inv_d;
         let normal = self.wide.vector(delta[0] * inv, delta[1] * inv, delta[2] * inv);
         let point = self.wide.point(lenses.centroid[0], lenses.centroid[1], lenses.centroid[2]);
-        let coincident = len2.cmple(Vec4::splat(COINCIDENT)).bitmask();
+        // |d| <= 1e-12, as |d|² <= COINCIDENT.
+        let coincident = inv.cmpge(Vec4::splat(COINCIDENT.sqrt().recip())).bitmask();
         while lanes != 0 {
             let lane = lanes.trailing_zeros() as usize;
             lanes &= lanes - 1;
