@@ -11,8 +11,8 @@
 //! have left its sphere, so the exact answer is the list's alone: the pairs' lenses four at once from
 //! contiguous memory, the nodes' volumes, and for a node of the third kind either its volume (still
 //! inside) or the exact descent of its subtree against that one sphere. Once A has moved farther, the
-//! list is collected again, for a pose half a skin ahead along A's last step, so that it serves about
-//! twice as many ticks of a steady motion.
+//! list is collected again, for a pose 0.7 skin ahead along A's last step, so that it serves 1.7
+//! skins of a steady motion rather than one.
 //!
 //! The volume is the plain query's (up to the order of the f32 sums), and so are the contacts, except
 //! that a node the plain query settles inside a leaf sphere may come as its sphere pairs here (when it
@@ -259,13 +259,13 @@ impl CoherentOverlap {
         moved + 8.0 * f32::EPSILON * scale
     }
 
-    /// Where to collect the list when A is at `now`: half a skin ahead along its last step (the list
-    /// then serves the way there and as far again), or `now` when it has no last step or stands still.
+    /// Where to collect the list when A is at `now`: 0.7 skin ahead along its last step (the list then
+    /// serves the way there and a skin beyond), or `now` when it has no last step or stands still.
     fn ahead(&self, now: &Pose, a: &InnerSphereTree, b: &InnerSphereTree) -> Pose {
         let Some(last) = self.last else { return *now };
         let step = self.moved(&last, now, a, b);
         // NaN (a step of 0 with a skin of 0) and less than one step ahead both mean: collect at `now`.
-        let steps = (0.5 * self.skin / step).floor().min(1000.0);
+        let steps = (0.7 * self.skin / step).floor().min(1000.0);
         if steps.is_nan() || steps < 1.0 {
             return *now;
         }
@@ -274,8 +274,8 @@ impl CoherentOverlap {
             now.translation + (now.translation - last.translation) * steps,
             (Quat::from_scaled_axis(turn * steps) * now.rotation).normalize(),
         );
-        // A turn and a shift do not add up exactly along a curve: keep the list useful from `now` on.
-        if ahead.is_finite() && self.moved(&ahead, now, a, b) < 0.75 * self.skin { ahead } else { *now }
+        // A turn and a shift do not add up exactly along a curve: keep the list answering from `now` on.
+        if ahead.is_finite() && self.moved(&ahead, now, a, b) < 0.9 * self.skin { ahead } else { *now }
     }
 
     /// Collects the list at relative pose `pos12` (B's frame into A's); returns the node pairs visited.
