@@ -129,8 +129,8 @@ impl<const N: usize> Columns<N> {
 }
 
 impl CoherentOverlap {
-    /// Room for this many candidate pairs (and as many nested nodes) by default: 2.3 MB, more than the
-    /// bunny scene's 10k-sphere trees need with the default skin.
+    /// Room for this many candidate pairs (and as many nodes of each kind) by default: about 8 MB,
+    /// five times what the bunny scene's 10k-sphere trees need with the default skin.
     pub const DEFAULT_CAPACITY: usize = 1 << 16;
 
     /// A list collected with `skin` (tree units: how far A may move relative to B before the list is
