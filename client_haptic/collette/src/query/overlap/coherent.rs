@@ -20,13 +20,15 @@
 //! collected): same volume, more contacts.
 
 use super::affine::WideAffine;
+use super::batch::Lanes;
 use super::engine::Engine;
 use super::sink::{Contacts, Sink};
 use super::{Budget, OverlapResult, fallback_normal};
 use crate::error::SkinError;
 use crate::partitioning::InnerSphereTree;
 use crate::query::QueryWorkspace;
-use crate::shape::{Lens4, Sphere, lens_x4};
+use crate::shape::{Lens4, Sphere};
+use eight::Pairs8;
 use glam::{Affine3A, Quat, Vec3, Vec4};
 use haptic_common::{ContactSet, Pose};
 
@@ -64,6 +66,8 @@ pub struct CoherentOverlap {
     /// r), B's sphere (x, y, z, r), the volume; and per row A's node, B's sphere and B's leaf.
     maybe: Columns<9>,
     maybe_ids: Vec<[u32; 3]>,
+    /// The pairs that overlap at a query, eight to a group (scratch, allocated once).
+    groups: Vec<Pairs8>,
     overflow: bool,
     stats: CoherenceStats,
 }
@@ -154,6 +158,7 @@ impl CoherentOverlap {
             nested: Columns::with_capacity(capacity),
             maybe: Columns::with_capacity(capacity),
             maybe_ids: Vec::with_capacity(capacity),
+            groups: Vec::with_capacity(capacity.div_ceil(eight::LANES)),
             overflow: false,
             stats: CoherenceStats::default(),
         })
@@ -232,7 +237,9 @@ impl CoherentOverlap {
             self.anchor = None;
             engine.run_depth_first(ws);
         } else {
-            self.evaluate(&mut engine, ws);
+            let mut groups = std::mem::take(&mut self.groups);
+            self.evaluate(&mut groups, &mut engine, ws);
+            self.groups = groups;
             engine.flush_pairs();
         }
         let visited = result.node_pairs;
@@ -301,26 +308,32 @@ impl CoherentOverlap {
 
     /// The list's lenses and nodes' volumes at the engine's pose, into its sink and result; a node
     /// that has left the sphere it was inside is descended against it.
-    fn evaluate<S: Sink>(&self, engine: &mut Engine<'_, S>, ws: &mut QueryWorkspace) {
+    fn evaluate<S: Sink>(&self, groups: &mut Vec<Pairs8>, engine: &mut Engine<'_, S>, ws: &mut QueryWorkspace) {
         let wide = engine.wide;
-        let mut total = Vec4::ZERO;
-        let (mut leaf_pairs, mut aggregated) = (0, 0);
+        let mut aggregated = 0;
+        // Most candidates are still apart: four distances at a time settle them, and the pairs that
+        // overlap are gathered eight to a group for their lenses.
         let p = &self.pairs;
+        groups.clear();
+        let mut lane = eight::LANES;
         for at in (0..p.len).step_by(4) {
-            let (ca, ra, cb, rb, d2) = p.sides(at, &wide);
-            // Most candidates are still apart: four distances settle them before any lens is computed.
-            if d2.cmplt((ra + rb) * (ra + rb)).bitmask() == 0 {
-                continue;
-            }
-            let mut lenses = lens_x4(ca, ra, cb, rb);
-            lenses.volume *= p.four(8, at);
-            let lanes = lenses.volume.cmpgt(Vec4::ZERO).bitmask();
-            if lanes != 0 {
-                total += lenses.volume;
-                leaf_pairs += lanes.count_ones();
-                engine.sink.four(&lenses, ca, cb, lanes);
+            let (_, ra, _, rb, d2) = p.sides(at, &wide);
+            for row in Lanes(d2.cmplt((ra + rb) * (ra + rb)).bitmask()).map(|i| at + i) {
+                if lane == eight::LANES {
+                    groups.push(Pairs8::default());
+                    lane = 0;
+                }
+                let g = groups.last_mut().expect("a group was just pushed");
+                for k in 0..3 {
+                    g.ca[k][lane] = p.col[k][row];
+                    g.cb[k][lane] = p.col[4 + k][row];
+                }
+                (g.ra[lane], g.rb[lane], g.w[lane]) = (p.col[3][row], p.col[7][row], p.col[8][row]);
+                lane += 1;
             }
         }
+        let found = eight::lenses(groups, &engine.pos12, &mut engine.sink);
+        let (mut total, leaf_pairs) = (Vec4::new(found.volume, 0.0, 0.0, 0.0), found.pairs);
         let n = &self.nested;
         for at in (0..n.len).step_by(4) {
             let (ca, ra, cb, rb, d2) = n.sides(at, &wide);
@@ -351,7 +364,7 @@ impl CoherentOverlap {
                 let lens = Lens4 { volume, centroid: ca, depth: ra + rb - d, inv_d: d.recip() };
                 engine.sink.four(&lens, ca, cb, inside);
             }
-            for lane in super::batch::Lanes(rows & !inside) {
+            for lane in Lanes(rows & !inside) {
                 let [node, sb, ib] = self.maybe_ids[at + lane];
                 engine.subtree_against_sphere(node, sb, ib, ws);
             }
@@ -407,5 +420,6 @@ impl Sink for Collector<'_, '_> {
     }
 }
 
+mod eight;
 #[cfg(test)]
 mod tests;

@@ -57,7 +57,7 @@ fn four_against(
 pub(super) struct Engine<'a, S> {
     a: &'a InnerSphereTree,
     b: &'a InnerSphereTree,
-    pos12: Affine3A,
+    pub(super) pos12: Affine3A,
     /// `pos12`'s entries, each in all four lanes (moving four of B's centres at once).
     pub(super) wide: WideAffine,
     budget: Budget,
