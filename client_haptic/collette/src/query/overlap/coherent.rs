@@ -28,7 +28,6 @@ use crate::error::SkinError;
 use crate::partitioning::InnerSphereTree;
 use crate::query::QueryWorkspace;
 use crate::shape::{Lens4, Sphere};
-use eight::Pairs8;
 use glam::{Affine3A, Quat, Vec3, Vec4};
 use haptic_common::{ContactSet, Pose};
 
@@ -57,7 +56,7 @@ pub struct CoherentOverlap {
     anchor: Option<Pose>,
     /// A's pose in B's frame at the last query.
     last: Option<Pose>,
-    /// Candidate sphere pairs (A's side in A's frame, B's in B's frame), padded to whole groups of four.
+    /// Candidate sphere pairs (A's side in A's frame, B's in B's frame), padded to whole groups of eight.
     pairs: Columns<9>,
     /// Nodes inside a leaf sphere of the other tree: A's side (x, y, z, r), B's side (x, y, z, r), the
     /// volume, and 1 where the centroid is B's side (B's node inside A's sphere), padded likewise.
@@ -66,13 +65,11 @@ pub struct CoherentOverlap {
     /// r), B's sphere (x, y, z, r), the volume; and per row A's node, B's sphere and B's leaf.
     maybe: Columns<9>,
     maybe_ids: Vec<[u32; 3]>,
-    /// The pairs that overlap at a query, eight to a group (scratch, allocated once).
-    groups: Vec<Pairs8>,
     overflow: bool,
     stats: CoherenceStats,
 }
 
-/// `N` columns of f32 with room for `capacity` rows (allocated once), padded to a multiple of four.
+/// `N` columns of f32 with room for `capacity` rows (allocated once), padded to a multiple of eight.
 #[derive(Clone, Debug)]
 struct Columns<const N: usize> {
     col: [Vec<f32>; N],
@@ -81,7 +78,7 @@ struct Columns<const N: usize> {
 
 impl<const N: usize> Columns<N> {
     fn with_capacity(capacity: usize) -> Self {
-        Self { col: std::array::from_fn(|_| vec![0.0; capacity.next_multiple_of(4)]), len: 0 }
+        Self { col: std::array::from_fn(|_| vec![0.0; capacity.next_multiple_of(eight::LANES)]), len: 0 }
     }
 
     fn clear(&mut self) {
@@ -107,9 +104,9 @@ impl<const N: usize> Columns<N> {
         self.len == self.col[0].len()
     }
 
-    /// Zeroes the rows after the last up to a multiple of four (zero radii and volumes count nothing).
+    /// Zeroes the rows after the last up to a multiple of eight (zero radii and volumes count nothing).
     fn pad(&mut self) {
-        let end = self.len.next_multiple_of(4).min(self.col[0].len());
+        let end = self.len.next_multiple_of(eight::LANES).min(self.col[0].len());
         for c in &mut self.col {
             c[self.len..end].fill(0.0);
         }
@@ -158,7 +155,6 @@ impl CoherentOverlap {
             nested: Columns::with_capacity(capacity),
             maybe: Columns::with_capacity(capacity),
             maybe_ids: Vec::with_capacity(capacity),
-            groups: Vec::with_capacity(capacity.div_ceil(eight::LANES)),
             overflow: false,
             stats: CoherenceStats::default(),
         })
@@ -237,9 +233,7 @@ impl CoherentOverlap {
             self.anchor = None;
             engine.run_depth_first(ws);
         } else {
-            let mut groups = std::mem::take(&mut self.groups);
-            self.evaluate(&mut groups, &mut engine, ws);
-            self.groups = groups;
+            self.evaluate(&mut engine, ws);
             engine.flush_pairs();
         }
         let visited = result.node_pairs;
@@ -308,31 +302,10 @@ impl CoherentOverlap {
 
     /// The list's lenses and nodes' volumes at the engine's pose, into its sink and result; a node
     /// that has left the sphere it was inside is descended against it.
-    fn evaluate<S: Sink>(&self, groups: &mut Vec<Pairs8>, engine: &mut Engine<'_, S>, ws: &mut QueryWorkspace) {
+    fn evaluate<S: Sink>(&self, engine: &mut Engine<'_, S>, ws: &mut QueryWorkspace) {
         let wide = engine.wide;
         let mut aggregated = 0;
-        // Most candidates are still apart: four distances at a time settle them, and the pairs that
-        // overlap are gathered eight to a group for their lenses.
-        let p = &self.pairs;
-        groups.clear();
-        let mut lane = eight::LANES;
-        for at in (0..p.len).step_by(4) {
-            let (_, ra, _, rb, d2) = p.sides(at, &wide);
-            for row in Lanes(d2.cmplt((ra + rb) * (ra + rb)).bitmask()).map(|i| at + i) {
-                if lane == eight::LANES {
-                    groups.push(Pairs8::default());
-                    lane = 0;
-                }
-                let g = groups.last_mut().expect("a group was just pushed");
-                for k in 0..3 {
-                    g.ca[k][lane] = p.col[k][row];
-                    g.cb[k][lane] = p.col[4 + k][row];
-                }
-                (g.ra[lane], g.rb[lane], g.w[lane]) = (p.col[3][row], p.col[7][row], p.col[8][row]);
-                lane += 1;
-            }
-        }
-        let found = eight::lenses(groups, &engine.pos12, &mut engine.sink);
+        let found = eight::pairs(&self.pairs.col, self.pairs.len, &engine.pos12, &mut engine.sink);
         let (mut total, leaf_pairs) = (Vec4::new(found.volume, 0.0, 0.0, 0.0), found.pairs);
         let n = &self.nested;
         for at in (0..n.len).step_by(4) {

@@ -1,7 +1,8 @@
-//! The lenses of a neighbour list's overlapping sphere pairs, eight at a time: plain loops over eight
-//! lanes, compiled twice — for AVX2 (eight-wide, chosen at run time where the CPU has it) and for the
-//! baseline (SSE2, four-wide) — with the same operations in the same order as [`lens_x4`], so either
-//! gives the same bits as the other and as the four-wide lens.
+//! A neighbour list's candidate pairs evaluated eight at a time: their distances, then the lenses of
+//! those that overlap. Plain loops over eight lanes, compiled twice — for AVX2 (eight-wide, chosen at run
+//! time where the CPU has it) and for the baseline (SSE2, four-wide) — with the same operations in the
+//! same order as `WideAffine::point` and [`lens_x4`], so either gives the same bits as the other and as
+//! the four-wide lens.
 //!
 //! [`lens_x4`]: crate::shape::lens_x4
 
@@ -13,24 +14,23 @@ use std::f32::consts::PI;
 /// Lanes per group.
 pub(super) const LANES: usize = 8;
 
-/// Eight sphere pairs: A's centres and radii in A's frame, B's in B's frame, the weights' products.
+/// Eight overlapping sphere pairs, both sides in A's frame, and the weights' products.
 #[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Pairs8 {
-    pub ca: [[f32; LANES]; 3],
-    pub ra: [f32; LANES],
-    pub cb: [[f32; LANES]; 3],
-    pub rb: [f32; LANES],
-    pub w: [f32; LANES],
+struct Pairs8 {
+    ca: [[f32; LANES]; 3],
+    ra: [f32; LANES],
+    cb: [[f32; LANES]; 3],
+    rb: [f32; LANES],
+    w: [f32; LANES],
 }
 
-/// Their lenses (volumes weighted), with B's centres moved into A's frame.
+/// Their lenses (volumes weighted).
 #[derive(Clone, Copy, Default)]
 struct Lenses8 {
     volume: [f32; LANES],
     centroid: [[f32; LANES]; 3],
     depth: [f32; LANES],
     inv_d: [f32; LANES],
-    cb: [[f32; LANES]; 3],
 }
 
 /// What the groups added: weighted volume and overlapping pairs.
@@ -40,60 +40,97 @@ pub(super) struct Found {
     pub pairs: u32,
 }
 
-/// The lenses of `groups` (B's centres moved into A's frame by `pos12`) into `sink`.
-pub(super) fn lenses(groups: &[Pairs8], pos12: &Affine3A, sink: &mut impl Sink) -> Found {
+/// The pair list's rows `0..len` (columns: A's centre and radius in A's frame, B's in B's frame, the
+/// weight; padded with zero rows to a multiple of eight): their distances eight at a time, the pairs that
+/// overlap gathered eight to a group, their lenses (B's centres moved into A's frame by `pos12`) into
+/// `sink`.
+pub(super) fn pairs(cols: &[Vec<f32>; 9], len: usize, pos12: &Affine3A, sink: &mut impl Sink) -> Found {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the CPU has AVX2, the only feature `lenses_avx2` is compiled for.
-        return unsafe { lenses_avx2(groups, pos12, sink) };
+        // SAFETY: the CPU has AVX2, the only feature `pairs_avx2` is compiled for.
+        return unsafe { pairs_avx2(cols, len, pos12, sink) };
     }
-    lenses_of(groups, pos12, sink)
+    pairs_of(cols, len, pos12, sink)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn lenses_avx2(groups: &[Pairs8], pos12: &Affine3A, sink: &mut impl Sink) -> Found {
-    lenses_of(groups, pos12, sink)
+fn pairs_avx2(cols: &[Vec<f32>; 9], len: usize, pos12: &Affine3A, sink: &mut impl Sink) -> Found {
+    pairs_of(cols, len, pos12, sink)
 }
 
 #[inline(always)]
-fn lenses_of(groups: &[Pairs8], pos12: &Affine3A, sink: &mut impl Sink) -> Found {
+fn pairs_of(cols: &[Vec<f32>; 9], len: usize, m: &Affine3A, sink: &mut impl Sink) -> Found {
+    let (mx, my, mz, t) = (m.matrix3.x_axis, m.matrix3.y_axis, m.matrix3.z_axis, m.translation);
     let mut found = Found::default();
+    let (mut group, mut lane) = (Pairs8::default(), 0);
     let mut l = Lenses8::default();
-    for p in groups {
-        lens8(p, pos12, &mut l);
-        for half in [0, 4] {
-            let v = |a: &[f32; LANES]| Vec4::from_slice(&a[half..half + 4]);
-            let lens = Lens4 {
-                volume: v(&l.volume),
-                centroid: [v(&l.centroid[0]), v(&l.centroid[1]), v(&l.centroid[2])],
-                depth: v(&l.depth),
-                inv_d: v(&l.inv_d),
-            };
-            let lanes = lens.volume.cmpgt(Vec4::ZERO).bitmask();
-            if lanes != 0 {
-                found.volume += lens.volume.element_sum();
-                found.pairs += lanes.count_ones();
-                let ca = [v(&p.ca[0]), v(&p.ca[1]), v(&p.ca[2])];
-                sink.four(&lens, ca, [v(&l.cb[0]), v(&l.cb[1]), v(&l.cb[2])], lanes);
+    for at in (0..len).step_by(LANES) {
+        let row = |k: usize| -> &[f32; LANES] { cols[k][at..at + LANES].try_into().expect("rows come in eights") };
+        let (ax, ay, az, ar, bx, by, bz, br) = (row(0), row(1), row(2), row(3), row(4), row(5), row(6), row(7));
+        let (mut cb, mut hits) = ([[0.0f32; LANES]; 3], 0u32);
+        for i in 0..LANES {
+            // As `WideAffine::point`: the linear part's sum first, then the shift.
+            cb[0][i] = mx.x * bx[i] + my.x * by[i] + mz.x * bz[i] + t.x;
+            cb[1][i] = mx.y * bx[i] + my.y * by[i] + mz.y * bz[i] + t.y;
+            cb[2][i] = mx.z * bx[i] + my.z * by[i] + mz.z * bz[i] + t.z;
+            let (dx, dy, dz) = (ax[i] - cb[0][i], ay[i] - cb[1][i], az[i] - cb[2][i]);
+            let reach = ar[i] + br[i];
+            hits |= ((dx * dx + dy * dy + dz * dz < reach * reach) as u32) << i;
+        }
+        // Most candidates are still apart; the others join the group.
+        while hits != 0 {
+            let i = hits.trailing_zeros() as usize;
+            hits &= hits - 1;
+            for (g, c) in group.cb.iter_mut().zip(&cb) {
+                g[lane] = c[i];
+            }
+            (group.ca[0][lane], group.ca[1][lane], group.ca[2][lane]) = (ax[i], ay[i], az[i]);
+            (group.ra[lane], group.rb[lane], group.w[lane]) = (ar[i], br[i], cols[8][at + i]);
+            lane += 1;
+            if lane == LANES {
+                emit(&group, &mut l, sink, &mut found);
+                lane = 0;
             }
         }
+    }
+    if lane > 0 {
+        // Empty lanes: zero radii, apart.
+        for i in lane..LANES {
+            (group.ra[i], group.rb[i], group.w[i]) = (0.0, 0.0, 0.0);
+        }
+        emit(&group, &mut l, sink, &mut found);
     }
     found
 }
 
-/// [`crate::shape::lens_x4`] lane by lane over eight pairs, after moving B's centres by `m`.
+/// The lenses of one group into `sink`.
 #[inline(always)]
-fn lens8(p: &Pairs8, m: &Affine3A, out: &mut Lenses8) {
-    let (mx, my, mz, t) = (m.matrix3.x_axis, m.matrix3.y_axis, m.matrix3.z_axis, m.translation);
+fn emit(group: &Pairs8, l: &mut Lenses8, sink: &mut impl Sink, found: &mut Found) {
+    lens8(group, l);
+    for half in [0, 4] {
+        let v = |a: &[f32; LANES]| Vec4::from_slice(&a[half..half + 4]);
+        let lens = Lens4 {
+            volume: v(&l.volume),
+            centroid: [v(&l.centroid[0]), v(&l.centroid[1]), v(&l.centroid[2])],
+            depth: v(&l.depth),
+            inv_d: v(&l.inv_d),
+        };
+        let lanes = lens.volume.cmpgt(Vec4::ZERO).bitmask();
+        if lanes != 0 {
+            found.volume += lens.volume.element_sum();
+            found.pairs += lanes.count_ones();
+            let ca = [v(&group.ca[0]), v(&group.ca[1]), v(&group.ca[2])];
+            sink.four(&lens, ca, [v(&group.cb[0]), v(&group.cb[1]), v(&group.cb[2])], lanes);
+        }
+    }
+}
+
+/// [`crate::shape::lens_x4`] lane by lane over eight pairs (B's centres already in A's frame).
+#[inline(always)]
+fn lens8(p: &Pairs8, out: &mut Lenses8) {
     for i in 0..LANES {
-        let (x, y, z) = (p.cb[0][i], p.cb[1][i], p.cb[2][i]);
-        // As `WideAffine::point`: the linear part's sum first, then the shift.
-        let c2 = [
-            mx.x * x + my.x * y + mz.x * z + t.x,
-            mx.y * x + my.y * y + mz.y * z + t.y,
-            mx.z * x + my.z * y + mz.z * z + t.z,
-        ];
+        let c2 = [p.cb[0][i], p.cb[1][i], p.cb[2][i]];
         let c1 = [p.ca[0][i], p.ca[1][i], p.ca[2][i]];
         let (r1, r2) = (p.ra[i], p.rb[i]);
         let delta = [c2[0] - c1[0], c2[1] - c1[1], c2[2] - c1[2]];
@@ -119,7 +156,6 @@ fn lens8(p: &Pairs8, m: &Affine3A, out: &mut Lenses8) {
             let lens_c = (c1[k] * v1 + c2[k] * v2 + delta[k] * moment) * inv_v;
             let small_c = if r1 <= r2 { c1[k] } else { c2[k] };
             out.centroid[k][i] = if inside { small_c } else { lens_c };
-            out.cb[k][i] = c2[k];
         }
         let volume = if inside { small_volume } else { lens_volume.max(0.0) };
         out.volume[i] = if apart { 0.0 } else { volume } * p.w[i];
@@ -160,48 +196,47 @@ mod tests {
     }
 
     #[test]
+    #[allow(clippy::needless_range_loop, reason = "a row fills nine columns")]
     fn eight_lanes_give_the_four_wide_lens_bit_for_bit_on_either_instruction_set() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(17);
         let m = Affine3A::from_rotation_translation(
             Quat::from_euler(glam::EulerRot::XYZ, 0.4, -0.9, 1.7),
             Vec3::new(0.3, -0.1, 0.2),
         );
-        let mut groups = vec![Pairs8::default(); 500];
-        for g in &mut groups {
-            for i in 0..LANES {
-                for k in 0..3 {
-                    g.ca[k][i] = rng.random_range(-1.0..1.0);
-                    g.cb[k][i] = rng.random_range(-1.0..1.0);
-                }
-                // Some coincident centres, some nested, most apart or in a lens.
-                if i == 3 {
-                    let c = m.inverse().transform_point3(Vec3::new(g.ca[0][i], g.ca[1][i], g.ca[2][i]));
-                    (g.cb[0][i], g.cb[1][i], g.cb[2][i]) = (c.x, c.y, c.z);
-                }
-                g.ra[i] = rng.random_range(0.0..1.0);
-                g.rb[i] = rng.random_range(0.0..1.0);
-                g.w[i] = rng.random_range(1.0..3.0);
+        // 4,001 rows (padded with zero rows to a multiple of eight): some coincident centres, some
+        // nested, most apart or in a lens.
+        let len: usize = 4001;
+        let mut cols: [Vec<f32>; 9] = std::array::from_fn(|_| vec![0.0; len.next_multiple_of(LANES)]);
+        for r in 0..len {
+            for k in 0..3 {
+                cols[k][r] = rng.random_range(-1.0..1.0);
+                cols[4 + k][r] = rng.random_range(-1.0..1.0);
             }
+            if r % 8 == 3 {
+                let c = m.inverse().transform_point3(Vec3::new(cols[0][r], cols[1][r], cols[2][r]));
+                (cols[4][r], cols[5][r], cols[6][r]) = (c.x, c.y, c.z);
+            }
+            cols[3][r] = rng.random_range(0.0..1.0);
+            cols[7][r] = rng.random_range(0.0..1.0);
+            cols[8][r] = rng.random_range(1.0..3.0);
         }
         let wide = WideAffine::new(&m);
         let mut expected = Record::default();
-        for g in &groups {
-            for half in [0, 4] {
-                let v = |a: &[f32; LANES]| Vec4::from_slice(&a[half..half + 4]);
-                let ca = [v(&g.ca[0]), v(&g.ca[1]), v(&g.ca[2])];
-                let cb = wide.point(v(&g.cb[0]), v(&g.cb[1]), v(&g.cb[2]));
-                let mut l = lens_x4(ca, v(&g.ra), cb, v(&g.rb));
-                l.volume *= v(&g.w);
-                expected.four(&l, ca, cb, l.volume.cmpgt(Vec4::ZERO).bitmask());
-            }
+        for at in (0..len).step_by(4) {
+            let v = |k: usize| Vec4::from_slice(&cols[k][at..at + 4]);
+            let ca = [v(0), v(1), v(2)];
+            let cb = wide.point(v(4), v(5), v(6));
+            let mut l = lens_x4(ca, v(3), cb, v(7));
+            l.volume *= v(8);
+            expected.four(&l, ca, cb, l.volume.cmpgt(Vec4::ZERO).bitmask());
         }
         assert!(expected.0.len() > 1000, "the pairs overlap often enough to test: {}", expected.0.len());
         let bits = |r: &Record| r.0.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
         let mut baseline = Record::default();
-        lenses_of(&groups, &m, &mut baseline);
+        pairs_of(&cols, len, &m, &mut baseline);
         assert_eq!(bits(&baseline), bits(&expected), "baseline build");
         let mut dispatched = Record::default();
-        let found = lenses(&groups, &m, &mut dispatched);
+        let found = pairs(&cols, len, &m, &mut dispatched);
         assert_eq!(bits(&dispatched), bits(&expected), "the build chosen for this CPU");
         assert_eq!(found.pairs as usize, expected.0.len());
     }
