@@ -13,6 +13,23 @@ pub(super) trait Sink {
     /// Four sphere pairs at once; only the lanes whose bit is set in `lanes` count.
     fn four(&mut self, lenses: &Lens4, ca: [Vec4; 3], cb: [Vec4; 3], lanes: u32);
 
+    /// Eight sphere pairs at once (lane by lane as [`Sink::four`] takes them); only the lanes whose bit
+    /// is set in `lanes` count.
+    #[inline(always)]
+    fn eight(&mut self, lenses: &Lens8, ca: &[[f32; 8]; 3], cb: &[[f32; 8]; 3], lanes: u32) {
+        for half in [0, 4] {
+            let v = |a: &[f32; 8]| Vec4::from_slice(&a[half..half + 4]);
+            let lens = Lens4 {
+                volume: v(&lenses.volume),
+                centroid: [v(&lenses.centroid[0]), v(&lenses.centroid[1]), v(&lenses.centroid[2])],
+                depth: v(&lenses.depth),
+                inv_d: v(&lenses.inv_d),
+            };
+            let (ca, cb) = ([v(&ca[0]), v(&ca[1]), v(&ca[2])], [v(&cb[0]), v(&cb[1]), v(&cb[2])]);
+            self.four(&lens, ca, cb, lanes >> half & 0xf);
+        }
+    }
+
     /// True for a sink that collects a neighbour list ([`super::coherent`]): the descent then tests
     /// with [`Sink::margin`] and hands over candidates ([`Sink::pair`], [`Sink::nested`]) instead of
     /// computing lenses. Known at compile time, so the other queries carry none of it.
@@ -77,7 +94,52 @@ impl<'o> Contacts<'o> {
     }
 }
 
+/// Eight lenses (volumes weighted), lane by lane as [`Lens4`] holds four.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Lens8 {
+    pub volume: [f32; 8],
+    pub centroid: [[f32; 8]; 3],
+    pub depth: [f32; 8],
+    pub inv_d: [f32; 8],
+}
+
 impl Sink for Contacts<'_> {
+    /// As [`Contacts::four`] over eight lanes, in the same order of operations (so the same bits): the
+    /// normals and points moved into the world by plain loops, eight-wide where the caller is compiled so.
+    #[inline(always)]
+    fn eight(&mut self, l: &Lens8, ca: &[[f32; 8]; 3], cb: &[[f32; 8]; 3], mut lanes: u32) {
+        let m = &self.to_world;
+        let (mx, my, mz, t) = (m.matrix3.x_axis, m.matrix3.y_axis, m.matrix3.z_axis, m.translation);
+        let (mut normal, mut point) = ([[0.0f32; 8]; 3], [[0.0f32; 8]; 3]);
+        for i in 0..8 {
+            let inv = l.inv_d[i];
+            let (x, y, z) = ((ca[0][i] - cb[0][i]) * inv, (ca[1][i] - cb[1][i]) * inv, (ca[2][i] - cb[2][i]) * inv);
+            normal[0][i] = mx.x * x + my.x * y + mz.x * z;
+            normal[1][i] = mx.y * x + my.y * y + mz.y * z;
+            normal[2][i] = mx.z * x + my.z * y + mz.z * z;
+            let (x, y, z) = (l.centroid[0][i], l.centroid[1][i], l.centroid[2][i]);
+            point[0][i] = mx.x * x + my.x * y + mz.x * z + t.x;
+            point[1][i] = mx.y * x + my.y * y + mz.y * z + t.y;
+            point[2][i] = mx.z * x + my.z * y + mz.z * z + t.z;
+        }
+        let coincident = COINCIDENT.sqrt().recip();
+        while lanes != 0 {
+            let i = lanes.trailing_zeros() as usize;
+            lanes &= lanes - 1;
+            let normal = if l.inv_d[i] >= coincident {
+                self.fallback
+            } else {
+                Vec3::new(normal[0][i], normal[1][i], normal[2][i])
+            };
+            self.out.push(Contact {
+                point: Vec3::new(point[0][i], point[1][i], point[2][i]),
+                normal,
+                volume: l.volume[i],
+                depth: l.depth[i],
+            });
+        }
+    }
+
     #[inline]
     fn one(&mut self, lens: &Lens, ca: Vec3, cb: Vec3) {
         let delta = ca - cb;

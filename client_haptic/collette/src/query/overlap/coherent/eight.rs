@@ -6,8 +6,7 @@
 //!
 //! [`lens_x4`]: crate::shape::lens_x4
 
-use crate::query::overlap::sink::Sink;
-use crate::shape::Lens4;
+use crate::query::overlap::sink::{Lens8, Sink};
 use glam::{Affine3A, Vec4};
 use std::f32::consts::PI;
 
@@ -22,15 +21,6 @@ struct Pairs8 {
     cb: [[f32; LANES]; 3],
     rb: [f32; LANES],
     w: [f32; LANES],
-}
-
-/// Their lenses (volumes weighted).
-#[derive(Clone, Copy, Default)]
-struct Lenses8 {
-    volume: [f32; LANES],
-    centroid: [[f32; LANES]; 3],
-    depth: [f32; LANES],
-    inv_d: [f32; LANES],
 }
 
 /// What the groups added: weighted volume and overlapping pairs.
@@ -64,7 +54,7 @@ fn pairs_of(cols: &[Vec<f32>; 9], len: usize, m: &Affine3A, sink: &mut impl Sink
     let (mx, my, mz, t) = (m.matrix3.x_axis, m.matrix3.y_axis, m.matrix3.z_axis, m.translation);
     let mut found = Found::default();
     let (mut group, mut lane) = (Pairs8::default(), 0);
-    let mut l = Lenses8::default();
+    let mut l = Lens8::default();
     for at in (0..len).step_by(LANES) {
         let row = |k: usize| -> &[f32; LANES] { cols[k][at..at + LANES].try_into().expect("rows come in eights") };
         let (ax, ay, az, ar, bx, by, bz, br) = (row(0), row(1), row(2), row(3), row(4), row(5), row(6), row(7));
@@ -106,29 +96,25 @@ fn pairs_of(cols: &[Vec<f32>; 9], len: usize, m: &Affine3A, sink: &mut impl Sink
 
 /// The lenses of one group into `sink`.
 #[inline(always)]
-fn emit(group: &Pairs8, l: &mut Lenses8, sink: &mut impl Sink, found: &mut Found) {
+fn emit(group: &Pairs8, l: &mut Lens8, sink: &mut impl Sink, found: &mut Found) {
     lens8(group, l);
-    for half in [0, 4] {
-        let v = |a: &[f32; LANES]| Vec4::from_slice(&a[half..half + 4]);
-        let lens = Lens4 {
-            volume: v(&l.volume),
-            centroid: [v(&l.centroid[0]), v(&l.centroid[1]), v(&l.centroid[2])],
-            depth: v(&l.depth),
-            inv_d: v(&l.inv_d),
-        };
-        let lanes = lens.volume.cmpgt(Vec4::ZERO).bitmask();
-        if lanes != 0 {
-            found.volume += lens.volume.element_sum();
-            found.pairs += lanes.count_ones();
-            let ca = [v(&group.ca[0]), v(&group.ca[1]), v(&group.ca[2])];
-            sink.four(&lens, ca, [v(&group.cb[0]), v(&group.cb[1]), v(&group.cb[2])], lanes);
+    let mut lanes = 0;
+    for i in 0..LANES {
+        lanes |= ((l.volume[i] > 0.0) as u32) << i;
+    }
+    if lanes != 0 {
+        // In lane order, as the four-wide sum would add them.
+        for half in [0, 4] {
+            found.volume += Vec4::from_slice(&l.volume[half..half + 4]).element_sum();
         }
+        found.pairs += lanes.count_ones();
+        sink.eight(l, &group.ca, &group.cb, lanes);
     }
 }
 
 /// [`crate::shape::lens_x4`] lane by lane over eight pairs (B's centres already in A's frame).
 #[inline(always)]
-fn lens8(p: &Pairs8, out: &mut Lenses8) {
+fn lens8(p: &Pairs8, out: &mut Lens8) {
     for i in 0..LANES {
         let c2 = [p.cb[0][i], p.cb[1][i], p.cb[2][i]];
         let c1 = [p.ca[0][i], p.ca[1][i], p.ca[2][i]];
@@ -168,8 +154,10 @@ fn lens8(p: &Pairs8, out: &mut Lenses8) {
 mod tests {
     use super::*;
     use crate::query::overlap::affine::WideAffine;
-    use crate::shape::lens_x4;
+    use crate::query::overlap::sink::Contacts;
+    use crate::shape::{Lens4, lens_x4};
     use glam::{Quat, Vec3};
+    use haptic_common::ContactSet;
     use rand::{Rng, SeedableRng};
 
     /// Records what a sink is given, lane by lane.
@@ -239,5 +227,43 @@ mod tests {
         let found = pairs(&cols, len, &m, &mut dispatched);
         assert_eq!(bits(&dispatched), bits(&expected), "the build chosen for this CPU");
         assert_eq!(found.pairs as usize, expected.0.len());
+
+        // And the world-frame contacts, written eight at a time, as the four-wide sink writes them.
+        let to_world = Affine3A::from_rotation_translation(Quat::from_rotation_y(0.7), Vec3::new(1.0, 2.0, -0.5));
+        let contacts = |run: &dyn Fn(&mut Contacts)| {
+            let mut set = ContactSet::new();
+            run(&mut Contacts::new(to_world, Vec3::Y, &mut set));
+            set.as_slice()
+                .iter()
+                .flat_map(|c| [c.point.to_array(), c.normal.to_array(), [c.volume, c.depth, 0.0]])
+                .flatten()
+                .map(f32::to_bits)
+                .collect::<Vec<_>>()
+        };
+        let four_wide = contacts(&|sink| {
+            for at in (0..len).step_by(4) {
+                let v = |k: usize| Vec4::from_slice(&cols[k][at..at + 4]);
+                let ca = [v(0), v(1), v(2)];
+                let cb = wide.point(v(4), v(5), v(6));
+                let mut l = lens_x4(ca, v(3), cb, v(7));
+                l.volume *= v(8);
+                sink.four(&l, ca, cb, l.volume.cmpgt(Vec4::ZERO).bitmask());
+            }
+        });
+        assert!(four_wide.len() > 1000 * 9);
+        assert_eq!(
+            contacts(&|sink| {
+                pairs_of(&cols, len, &m, sink);
+            }),
+            four_wide,
+            "baseline build"
+        );
+        assert_eq!(
+            contacts(&|sink| {
+                pairs(&cols, len, &m, sink);
+            }),
+            four_wide,
+            "the build chosen for this CPU"
+        );
     }
 }
