@@ -1,8 +1,8 @@
-//! A neighbour list's candidate pairs evaluated eight at a time: their distances, then the lenses of
-//! those that overlap. Plain loops over eight lanes, compiled twice — for AVX2 (eight-wide, chosen at run
-//! time where the CPU has it) and for the baseline (SSE2, four-wide) — with the same operations in the
-//! same order as `WideAffine::point` and [`lens_x4`], so either gives the same bits as the other and as
-//! the four-wide lens.
+//! A neighbour list's candidate pairs evaluated eight at a time: their distances, then the lenses and
+//! contacts of those that overlap ([`Sink::eight`]). Plain loops over eight lanes, compiled twice — for
+//! AVX2 (eight-wide, chosen at run time where the CPU has it) and for the baseline (SSE2, four-wide) —
+//! with the same operations in the same order as `WideAffine::point` and [`lens_x4`], so either gives the
+//! same bits as the other and as the four-wide path.
 //!
 //! [`lens_x4`]: crate::shape::lens_x4
 
