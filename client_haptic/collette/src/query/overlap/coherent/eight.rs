@@ -183,6 +183,19 @@ mod tests {
         }
     }
 
+    /// The four-wide path over the rows: each four rows' lenses into `sink`.
+    fn four_wide(cols: &[Vec<f32>; 9], len: usize, m: &Affine3A, sink: &mut impl Sink) {
+        let wide = WideAffine::new(m);
+        for at in (0..len).step_by(4) {
+            let v = |k: usize| Vec4::from_slice(&cols[k][at..at + 4]);
+            let ca = [v(0), v(1), v(2)];
+            let cb = wide.point(v(4), v(5), v(6));
+            let mut l = lens_x4(ca, v(3), cb, v(7));
+            l.volume *= v(8);
+            sink.four(&l, ca, cb, l.volume.cmpgt(Vec4::ZERO).bitmask());
+        }
+    }
+
     #[test]
     #[allow(clippy::needless_range_loop, reason = "a row fills nine columns")]
     fn eight_lanes_give_the_four_wide_lens_bit_for_bit_on_either_instruction_set() {
@@ -208,16 +221,8 @@ mod tests {
             cols[7][r] = rng.random_range(0.0..1.0);
             cols[8][r] = rng.random_range(1.0..3.0);
         }
-        let wide = WideAffine::new(&m);
         let mut expected = Record::default();
-        for at in (0..len).step_by(4) {
-            let v = |k: usize| Vec4::from_slice(&cols[k][at..at + 4]);
-            let ca = [v(0), v(1), v(2)];
-            let cb = wide.point(v(4), v(5), v(6));
-            let mut l = lens_x4(ca, v(3), cb, v(7));
-            l.volume *= v(8);
-            expected.four(&l, ca, cb, l.volume.cmpgt(Vec4::ZERO).bitmask());
-        }
+        four_wide(&cols, len, &m, &mut expected);
         assert!(expected.0.len() > 1000, "the pairs overlap often enough to test: {}", expected.0.len());
         let bits = |r: &Record| r.0.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
         let mut baseline = Record::default();
@@ -240,16 +245,7 @@ mod tests {
                 .map(f32::to_bits)
                 .collect::<Vec<_>>()
         };
-        let four_wide = contacts(&|sink| {
-            for at in (0..len).step_by(4) {
-                let v = |k: usize| Vec4::from_slice(&cols[k][at..at + 4]);
-                let ca = [v(0), v(1), v(2)];
-                let cb = wide.point(v(4), v(5), v(6));
-                let mut l = lens_x4(ca, v(3), cb, v(7));
-                l.volume *= v(8);
-                sink.four(&l, ca, cb, l.volume.cmpgt(Vec4::ZERO).bitmask());
-            }
-        });
+        let four_wide = contacts(&|sink| four_wide(&cols, len, &m, sink));
         assert!(four_wide.len() > 1000 * 9);
         assert_eq!(
             contacts(&|sink| {
