@@ -375,9 +375,12 @@ impl Sink for Collector<'_, '_> {
         self.list.pairs.push(row);
     }
 
-    fn maybe_nested(&mut self, node: u32, ca: Vec3, ra: f32, sb: u32, ib: u32, pb: Sphere, volume: f32) {
-        let c = pb.center;
-        let row = [ca.x, ca.y, ca.z, ra, c.x, c.y, c.z, pb.radius, volume];
+    fn maybe_nested(&mut self, node: u32, sb: u32, ib: u32) {
+        // An inner node's block entry is its own bound and mesh share.
+        let (n, pb) = (&self.a.nodes[node as usize], self.b.spheres[sb as usize]);
+        let (ca, c) = (n.bound.center, pb.center);
+        let volume = n.mesh_share * self.b.weights[sb as usize];
+        let row = [ca.x, ca.y, ca.z, n.bound.radius, c.x, c.y, c.z, pb.radius, volume];
         if self.list.maybe.push(row) {
             self.list.maybe_ids.push([node, sb, ib]);
         }

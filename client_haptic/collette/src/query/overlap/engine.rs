@@ -331,9 +331,7 @@ impl<'a, S: Sink> Engine<'a, S> {
                 // its sphere, to settle whether it is still inside at each query.
                 let (_, _, now) = four_against([blk.x, blk.y, blk.z], blk.r, blk.leaf, cb, rb, true, 0.0);
                 for lane in Lanes(descend & now) {
-                    let ca = Vec3::new(blk.x[lane], blk.y[lane], blk.z[lane]);
-                    let sphere = self.b.spheres[sb as usize];
-                    self.sink.maybe_nested(blk.node[lane], ca, blk.r[lane], sb, ib, sphere, blk.share[lane] * wb);
+                    self.sink.maybe_nested(blk.node[lane], sb, ib);
                 }
                 descend &= !now;
             }

@@ -48,21 +48,10 @@ pub(super) trait Sink {
     /// (B's frame); `b_inside` when B's node is the one inside A's sphere.
     fn nested(&mut self, _ca: Vec3, _ra: f32, _pb: crate::shape::Sphere, _volume: f32, _b_inside: bool) {}
 
-    /// A's inner node `node` (bound `ca`, `ra`) lies inside B's sphere `sb` (in leaf `ib`; `pb` in B's
-    /// frame) but nearer its surface than the margin: inside it stands for `volume`, else its subtree
-    /// must be descended against the sphere.
-    #[allow(clippy::too_many_arguments)]
-    fn maybe_nested(
-        &mut self,
-        _node: u32,
-        _ca: Vec3,
-        _ra: f32,
-        _sb: u32,
-        _ib: u32,
-        _pb: crate::shape::Sphere,
-        _volume: f32,
-    ) {
-    }
+    /// A's inner node `node` lies inside B's sphere `sb` (in leaf `ib`) but nearer its surface than the
+    /// margin: inside it stands for its mesh share times the sphere's weight, else its subtree must be
+    /// descended against the sphere.
+    fn maybe_nested(&mut self, _node: u32, _sb: u32, _ib: u32) {}
 }
 
 /// Keeps nothing: the query's result carries the volume.
