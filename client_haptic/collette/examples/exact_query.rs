@@ -61,6 +61,11 @@ fn tree(mesh: &TriMesh, n: usize, name: &str, surface_offset: f32) -> InnerSpher
     t
 }
 
+/// The value at fraction `q` (0–1) of `sorted` (0 when it is empty).
+fn quantile(sorted: &[f64], q: f64) -> f64 {
+    sorted.get((sorted.len().saturating_sub(1) as f64 * q).round() as usize).copied().unwrap_or(0.0)
+}
+
 fn main() {
     let args = Args::parse();
     let (nt, nb) = (args.spheres.a, args.spheres.b);
@@ -96,12 +101,10 @@ fn main() {
             };
             best = best.min(t0.elapsed().as_secs_f64() * 1e6);
         }
+        volume_sum += result.total_volume as f64 * 1e6;
         if let Some(list) = &coherent {
             let (p, n) = list.len();
             most_candidates = (most_candidates.0.max(p), most_candidates.1.max(n));
-        }
-        volume_sum += result.total_volume as f64 * 1e6;
-        if let Some(list) = &coherent {
             let collected = list.stats().collections > collections;
             collections = list.stats().collections;
             if collected {
@@ -127,7 +130,7 @@ fn main() {
     }
     let mut sorted = times.clone();
     sorted.sort_by(f64::total_cmp);
-    let at = |q: f64| sorted[((sorted.len() - 1) as f64 * q).round() as usize];
+    let at = |q: f64| quantile(&sorted, q);
     let total: f64 = times.iter().sum();
     println!(
         "{} poses, {nt}:{nb} spheres, {}least of {} runs: p50 {:.1} us, p99 {:.1} us, p99.9 {:.1} us, \
@@ -153,7 +156,7 @@ fn main() {
     if let Some(list) = &coherent {
         for (name, mut v) in [("reusing the list", reused), ("collecting it", collecting)] {
             v.sort_by(f64::total_cmp);
-            let q = |q: f64| v.get(((v.len().max(1) - 1) as f64 * q).round() as usize).copied().unwrap_or(0.0);
+            let q = |q: f64| quantile(&v, q);
             let over = v.iter().filter(|&&t| t > 100.0).count();
             println!(
                 "  {name}: {} poses, p50 {:.1} us, p99 {:.1} us, max {:.1} us, {over} over 100 us",
