@@ -11,7 +11,8 @@
 //! - Store: [`InnerSphereTree::save`] / [`InnerSphereTree::load`] (the `.ist` format, see [`io`]).
 //! - Query: [`overlap()`], [`overlap_budgeted`], [`overlap_volume`], [`probe()`], [`separation`], each with a
 //!   caller-owned [`QueryWorkspace`] and (for contacts) a [`ContactSet`]; [`CoherentOverlap`] keeps a
-//!   neighbour list between one pair's exact queries (temporal coherence).
+//!   neighbour list between one pair's exact queries (temporal coherence); [`overlap_field`] measures a
+//!   tree against a [`SignedDistanceGrid`] of the touched mesh (the surface, not its packing).
 //! - Run: [`CollisionThread::spawn`] gives a [`CollisionHandle`]; poses in through [`PoseWriter`],
 //!   contacts out through [`ContactReader`].
 //! - Benchmark scene (gemstone tool, bunny, scripted trajectory): [`scene`].
@@ -35,9 +36,9 @@ pub use partitioning::{InnerSphereTree, Node};
 pub use pipeline::{CollisionConfig, CollisionHandle, CollisionThread, ContactReader, ObjectId, PoseWriter, WatcherId};
 pub use query::{
     Budget, CoherenceStats, CoherentOverlap, OverlapResult, ProbeHit, QueryWorkspace, Separation, overlap,
-    overlap_budgeted, overlap_volume, probe, separation,
+    overlap_budgeted, overlap_field, overlap_field_volume, overlap_volume, probe, separation,
 };
-pub use shape::{Sphere, TriMesh};
+pub use shape::{SignedDistanceGrid, Sphere, TriMesh};
 
 /// Types shared with the other haptic crates, re-exported for convenience.
 pub use haptic_common::{Contact, ContactSet, MAX_CONTACTS, Pose};

@@ -4,8 +4,8 @@ use assert_no_alloc::{AllocDisabler, assert_no_alloc};
 use collette::pipeline::{CollisionConfig, CollisionWorld, Command, ObjectId, TimedPose, WatcherId, WatcherOutput};
 use collette::shape::box_buffers;
 use collette::{
-    Budget, BuildOptions, CoherentOverlap, ContactSet, Pose, QueryWorkspace, TriMesh, build, overlap, overlap_budgeted,
-    overlap_volume, probe, separation,
+    Budget, BuildOptions, CoherentOverlap, ContactSet, Pose, QueryWorkspace, SignedDistanceGrid, TriMesh, build,
+    overlap, overlap_budgeted, overlap_field, overlap_field_volume, overlap_volume, probe, separation,
 };
 use glam::{Quat, Vec3};
 use std::sync::Arc;
@@ -17,7 +17,9 @@ static ALLOCATOR: AllocDisabler = AllocDisabler;
 #[test]
 fn queries_and_collision_steps_do_not_allocate_once_warmed_up() {
     let (v, t) = box_buffers(Vec3::splat(0.5));
-    let tree = build(&TriMesh::new(v, t).expect("valid"), &BuildOptions::spheres(500), &mut |_| {}).expect("builds").0;
+    let mesh = TriMesh::new(v, t).expect("valid");
+    let tree = build(&mesh, &BuildOptions::spheres(500), &mut |_| {}).expect("builds").0;
+    let grid = SignedDistanceGrid::new(&mesh, 32).expect("grid");
     let mut ws = QueryWorkspace::new();
     let mut set = ContactSet::new();
     let (pa, pb) = (Pose::IDENTITY, Pose::new(Vec3::new(0.4, 0.2, 0.1), Quat::from_rotation_z(0.5)));
@@ -29,6 +31,8 @@ fn queries_and_collision_steps_do_not_allocate_once_warmed_up() {
         overlap_budgeted(&tree, &pa, &tree, &pb, Budget::NodePairs(100), ws, set);
         overlap_budgeted(&tree, &pa, &tree, &pb, Budget::Deadline(Instant::now() + Duration::from_micros(30)), ws, set);
         overlap_volume(&tree, &pa, &tree, &pb, ws);
+        assert!(overlap_field(&tree, &pa, &tree, &grid, &pb, ws, set).total_volume > 0.0);
+        overlap_field_volume(&tree, &pa, &tree, &grid, &pb, ws);
         probe(&tree, &pb, Vec3::new(0.3, 0.1, 0.0), 0.05, ws, Some(set));
         separation(&tree, &pa, &tree, &Pose::from_translation(Vec3::X * 3.0), ws);
     };

@@ -1,4 +1,5 @@
-//! Queries between trees (overlap volume, time-budgeted overlap, separation distance) and probes.
+//! Queries between trees (overlap volume, time-budgeted overlap, separation distance), between a tree
+//! and a signed distance grid (overlap volume), and probes.
 //!
 //! You need this module to detect collisions. Every query takes the two objects' world poses (the
 //! relative pose `pos12` maps object 2's frame into object 1's), a caller-owned [`QueryWorkspace`]
@@ -6,11 +7,13 @@
 //! query allocates.
 
 pub mod distance;
+pub mod field;
 pub mod overlap;
 pub mod probe;
 mod workspace;
 
 pub use distance::{Separation, separation};
+pub use field::{overlap_field, overlap_field_volume};
 pub use overlap::{Budget, CoherenceStats, CoherentOverlap, OverlapResult, overlap, overlap_budgeted, overlap_volume};
 pub use probe::{ProbeHit, probe, spheres_near};
 pub use workspace::QueryWorkspace;

@@ -1,11 +1,14 @@
-//! Shapes: spheres (with the exact lens of two spheres) and validated closed triangle meshes.
+//! Shapes: spheres (with the exact lens of two spheres), validated closed triangle meshes and their
+//! signed distance grids.
 //!
 //! You need this module to load the mesh you want to pack, or to compute sphere-sphere overlaps yourself.
 
+mod distance_grid;
 mod mesh;
 mod primitives;
 mod sphere;
 
+pub use distance_grid::SignedDistanceGrid;
 pub use mesh::TriMesh;
 pub use primitives::{box_buffers, torus_buffers, uv_sphere_buffers};
 pub use sphere::{Lens, Sphere, lens, lens_volume, sphere_volume};

@@ -1,0 +1,252 @@
+//! Overlap of a tool's Inner Sphere Tree with a touched object's signed distance grid.
+//!
+//! You need this module when the overlap volume must follow the touched object's real surface: two
+//! packings meet with an error set by the coarser packing's hollows (a 1 cm gem against the 10k-sphere
+//! bunny: 0.94–1.05 of the true volume from p5 to p95), while the tool's spheres measured against the
+//! object's distance give 0.99–1.01 (docs/collette.md, *Volume accuracy*). Each inner sphere of the
+//! tool counts the part of it on the inner side of the surface: the cap cut by the tangent plane at the
+//! interpolated distance, corrected for the surface's curvature by the distance's Laplacian over the
+//! sphere (six more samples), times the sphere's weight. A node whose bound lies inside (or outside)
+//! the object by more than the interpolation's error counts whole (or not at all) without descending;
+//! its leaves would give the same, so the volume stays continuous as the tool moves.
+
+use crate::partitioning::InnerSphereTree;
+use crate::query::QueryWorkspace;
+use crate::query::overlap::OverlapResult;
+use crate::shape::{SignedDistanceGrid, lens_volume, sphere_volume};
+use glam::Vec3;
+use haptic_common::{Contact, ContactSet, Pose};
+use std::f32::consts::PI;
+
+/// Overlap of tree `a` at `pose_a` with the object of grid `b` at `pose_b`: the volume (exact up to the
+/// grid's interpolation and the caps' curvature term) and one world-frame contact per inner sphere or
+/// node of `a` inside `b` (normals from B towards A: the direction that pushes the tool out).
+///
+/// Contacts beyond `out`'s capacity still count in the volume; `out.truncated` is then set.
+pub fn overlap_field(
+    a: &InnerSphereTree,
+    pose_a: &Pose,
+    b: &InnerSphereTree,
+    b_grid: &SignedDistanceGrid,
+    pose_b: &Pose,
+    ws: &mut QueryWorkspace,
+    out: &mut ContactSet,
+) -> OverlapResult {
+    out.clear();
+    let result = descend(a, pose_a, (b, b_grid), pose_b, ws, Some((out, pose_b)));
+    out.total_volume = result.total_volume;
+    result
+}
+
+/// The volume of [`overlap_field`] alone (no contacts).
+pub fn overlap_field_volume(
+    a: &InnerSphereTree,
+    pose_a: &Pose,
+    b: &InnerSphereTree,
+    b_grid: &SignedDistanceGrid,
+    pose_b: &Pose,
+    ws: &mut QueryWorkspace,
+) -> OverlapResult {
+    descend(a, pose_a, (b, b_grid), pose_b, ws, None)
+}
+
+fn descend(
+    a: &InnerSphereTree,
+    pose_a: &Pose,
+    (b_tree, b): (&InnerSphereTree, &SignedDistanceGrid),
+    pose_b: &Pose,
+    ws: &mut QueryWorkspace,
+    mut out: Option<(&mut ContactSet, &Pose)>,
+) -> OverlapResult {
+    let a_in_b = pose_b.relative_to(pose_a);
+    let margin = 2.0 * b.interpolation_error();
+    let (nodes, spheres, weights) = (a.nodes(), a.spheres(), a.weights());
+    let mut result = OverlapResult { complete: true, ..OverlapResult::default() };
+    let mut push = |point: Vec3, into_b: Vec3, volume: f32, depth: f32| {
+        if let Some((set, to_world)) = out.as_mut() {
+            let normal = -into_b.try_normalize().unwrap_or(Vec3::Y);
+            set.push(Contact {
+                point: to_world.transform_point(point),
+                normal: to_world.transform_vector(normal),
+                volume,
+                depth,
+            });
+        }
+    };
+    ws.nodes.clear();
+    ws.nodes.push(0);
+    while let Some(n) = ws.nodes.pop() {
+        let node = &nodes[n as usize];
+        result.node_pairs += 1;
+        let center = a_in_b.transform_point(node.bound.center);
+        let f = b.distance(center);
+        let r = node.bound.radius;
+        // Either bound keeps every leaf on the same side as its node (so the volume is the leaves'):
+        // the interpolation's error twice, or the interpolant's own slope (at most √3) across the node.
+        let margin = margin.min((SLOPE - 1.0) * r);
+        if f <= -r - margin {
+            continue;
+        }
+        if f >= r + margin {
+            result.total_volume += node.mesh_share;
+            result.aggregated_pairs += 1;
+            push(center, b.gradient(center), node.mesh_share, f + r);
+            continue;
+        }
+        if !node.leaf {
+            ws.nodes.extend(node.range().map(|c| c as u32));
+            continue;
+        }
+        for s in node.range() {
+            let sphere = spheres[s];
+            let c = a_in_b.transform_point(sphere.center);
+            if let Some(part) = Part::of((b_tree, b), c, sphere.radius, &mut ws.stack) {
+                let volume = part.volume * weights[s];
+                result.total_volume += volume;
+                result.leaf_pairs += 1;
+                push(part.centroid, part.into_b, volume, part.depth);
+            }
+        }
+    }
+    result
+}
+
+/// The part of one inner sphere inside the object.
+struct Part {
+    /// Its volume (the sphere's own, before its weight).
+    volume: f32,
+    /// Its centroid, B's frame.
+    centroid: Vec3,
+    /// The direction into the object there (not normalized).
+    into_b: Vec3,
+    /// How deep the sphere reaches into the object: radius + the centre's distance.
+    depth: f32,
+}
+
+impl Part {
+    /// The part of the sphere (`c` in B's frame, radius `r`) inside B, `None` when there is none.
+    #[inline]
+    fn of(
+        (tree, b): (&InnerSphereTree, &SignedDistanceGrid),
+        c: Vec3,
+        r: f32,
+        stack: &mut Vec<(u32, u32)>,
+    ) -> Option<Self> {
+        let f = b.distance(c);
+        if f <= -r {
+            return None;
+        }
+        if f >= r {
+            return Some(Self { volume: sphere_volume(r), centroid: c, into_b: b.gradient(c), depth: f + r });
+        }
+        let cut = Cut::of(b, c, r, f);
+        let h = r + cut.distance;
+        let mut volume = PI * h * h * (3.0 * r - h) / 3.0;
+        let packed = cut.packed_share();
+        if packed > 0.0 {
+            volume += packed * (packed_part(tree, c, r, stack) - volume);
+        }
+        if volume <= 0.0 {
+            return None;
+        }
+        let rest = 2.0 * r - h;
+        let offset = if h > 0.0 { 3.0 * rest * rest / (4.0 * (3.0 * r - h)) } else { r };
+        let into_b = cut.into_b;
+        Some(Self { volume, centroid: c + into_b.normalize_or_zero() * offset, into_b, depth: f + r })
+    }
+}
+
+/// Where B's surface cuts one sphere of A.
+struct Cut {
+    /// The cutting plane's signed distance from the centre (positive with the centre inside),
+    /// corrected for curvature.
+    distance: f32,
+    /// The direction into B (not normalized).
+    into_b: Vec3,
+    /// The curvature correction over the radius, before it fades: how far the surface inside the
+    /// sphere is from a plane.
+    bend: f32,
+    /// `(1 − (f/r)²)²`.
+    fade: f32,
+}
+
+impl Cut {
+    /// Where the surface cuts the sphere whose centre lies at interpolated distance `f` (|f| < r): the
+    /// cutting plane's signed distance from the centre (positive with the centre inside), corrected for
+    /// curvature, and the direction into the object.
+    ///
+    /// Six samples at `±a` along the axes give the gradient and the Laplacian of the distance. A
+    /// ball's part on one side of a surface of mean curvature `κ` is, to first order in `κ`, the cap of
+    /// the tangent plane moved by `r²/8 × Δφ` (with `Δφ ≈ −2κ` for a distance); the mean of the six
+    /// samples is `f + a²/6 × Δφ`. The correction fades as `(1 − (f/r)²)²`, so a sphere's volume meets
+    /// its whole volume (and zero) with a zero slope where it enters (leaves) the object.
+    #[inline]
+    fn of(b: &SignedDistanceGrid, c: Vec3, r: f32, f: f32) -> Self {
+        let a = 0.866 * r;
+        let px = b.distance(c + Vec3::X * a);
+        let nx = b.distance(c - Vec3::X * a);
+        let py = b.distance(c + Vec3::Y * a);
+        let ny = b.distance(c - Vec3::Y * a);
+        let pz = b.distance(c + Vec3::Z * a);
+        let nz = b.distance(c - Vec3::Z * a);
+        let laplacian = (px + nx + py + ny + pz + nz - 6.0 * f) / (a * a);
+        let t = f / r;
+        let fade = (1.0 - t * t) * (1.0 - t * t);
+        let mut into_b = Vec3::new(px - nx, py - ny, pz - nz);
+        if into_b == Vec3::ZERO {
+            into_b = b.gradient(c);
+        }
+        let correction = r * r * 0.125 * laplacian;
+        Self { distance: (f + correction * fade).clamp(-r, r), into_b, bend: correction.abs() / r, fade }
+    }
+
+    /// How much of the sphere's volume to take from B's packing instead of the cut: none while the
+    /// surface inside the sphere is nearly flat, all of it (where the sphere straddles the surface)
+    /// once the curvature term reaches [`BEND_PACKED`] of the radius: an edge, a corner or a wall
+    /// thinner than the sphere, which a curved cap cannot follow.
+    #[inline]
+    fn packed_share(&self) -> f32 {
+        let t = ((self.bend - BEND_FLAT) / (BEND_PACKED - BEND_FLAT)).clamp(0.0, 1.0);
+        t * t * (3.0 - 2.0 * t) * self.fade
+    }
+}
+
+/// The steepest slope of the interpolated distance: each axis's difference of two exact distances one
+/// voxel apart is at most a voxel.
+const SLOPE: f32 = 1.732_050_8;
+
+/// Below this curvature term (over the radius) a sphere's part inside B is its curved cap alone.
+const BEND_FLAT: f32 = 0.1;
+/// From this curvature term (over the radius) on, it is the sphere's overlap with B's packing.
+const BEND_PACKED: f32 = 0.3;
+
+/// The sphere (`c` in B's frame, radius `r`)'s overlap with B's weighted packing: its lens with each of
+/// B's spheres times their weights, B's nodes inside the sphere counted whole.
+fn packed_part(tree: &InnerSphereTree, c: Vec3, r: f32, stack: &mut Vec<(u32, u32)>) -> f32 {
+    let (nodes, spheres, weights) = (tree.nodes(), tree.spheres(), tree.weights());
+    let mut volume = 0.0;
+    stack.clear();
+    stack.push((0, 0));
+    while let Some((n, _)) = stack.pop() {
+        let node = &nodes[n as usize];
+        let d = node.bound.center.distance(c);
+        if d >= r + node.bound.radius {
+            continue;
+        }
+        if d + node.bound.radius <= r {
+            volume += node.mesh_share;
+            continue;
+        }
+        if node.leaf {
+            for s in node.range() {
+                volume += lens_volume(r, spheres[s].radius, spheres[s].center.distance(c)) * weights[s];
+            }
+        } else {
+            stack.extend(node.range().map(|child| (child as u32, 0)));
+        }
+    }
+    volume
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,230 @@
+//! A closed mesh's signed distance, sampled on a regular grid and interpolated trilinearly.
+//!
+//! You need this module when a tool's overlap with an object should follow the object's surface
+//! rather than its sphere packing: [`overlap_field`](crate::query::overlap_field) measures each of the
+//! tool's inner spheres against this grid (see docs/collette.md, *Volume accuracy*).
+
+use crate::bounding_volume::Aabb;
+use crate::error::BuildError;
+use crate::packing::{MAX_VOXELS, to_parry_oriented};
+use crate::shape::TriMesh;
+use glam::Vec3;
+use parry3d::query::PointQuery;
+use rayon::prelude::*;
+
+/// Signed distance to a closed mesh's surface (positive inside, metres of the mesh) at the centres of
+/// a regular grid that reaches [`SignedDistanceGrid::MARGIN_VOXELS`] past the mesh's box.
+#[derive(Clone, Debug)]
+pub struct SignedDistanceGrid {
+    origin: Vec3,
+    /// The last grid point (largest corner).
+    last: Vec3,
+    /// The largest cell index along each axis (dims − 2), as floats.
+    last_cell: Vec3,
+    voxel: f32,
+    inv_voxel: f32,
+    dims: [usize; 3],
+    values: Vec<f32>,
+    bounds: Aabb,
+    mesh_volume: f32,
+}
+
+impl SignedDistanceGrid {
+    /// Voxels of grid around the mesh's box on every side.
+    pub const MARGIN_VOXELS: usize = 2;
+    /// Largest accepted resolution (voxels along the longest side of the mesh's box).
+    pub const MAX_RESOLUTION: usize = 1024;
+
+    /// Samples `mesh` with `resolution` voxels along the longest side of its box (150 matches the
+    /// packing grid of a 10k-sphere tree). Each value is exact (parry's projection with pseudo-normals).
+    pub fn new(mesh: &TriMesh, resolution: usize) -> Result<Self, BuildError> {
+        if !(2..=Self::MAX_RESOLUTION).contains(&resolution) {
+            return Err(BuildError::InvalidOption(format!(
+                "distance grid resolution {resolution} is outside 2..={}",
+                Self::MAX_RESOLUTION
+            )));
+        }
+        let bounds = mesh.aabb();
+        let ext = bounds.extents();
+        let voxel = ext.max_element() / resolution as f32;
+        let margin = Self::MARGIN_VOXELS as f32 * voxel;
+        let dims = [0, 1, 2].map(|a| ((ext[a] + 2.0 * margin) / voxel).ceil() as usize + 1);
+        let count: f64 = dims.iter().map(|&d| d as f64).product();
+        if count > MAX_VOXELS as f64 {
+            return Err(BuildError::InvalidOption(format!(
+                "distance grid resolution {resolution} needs {count:.3e} voxels (at most {MAX_VOXELS})"
+            )));
+        }
+        let origin = bounds.min - Vec3::splat(margin);
+        let parry = to_parry_oriented(mesh);
+        let mut values = vec![0.0f32; dims[0] * dims[1] * dims[2]];
+        values.par_chunks_mut(dims[0]).enumerate().for_each(|(row, out)| {
+            let (j, k) = (row % dims[1], row / dims[1]);
+            for (i, v) in out.iter_mut().enumerate() {
+                let p = origin + Vec3::new(i as f32, j as f32, k as f32) * voxel;
+                let q = parry3d::math::Vector::new(p.x, p.y, p.z);
+                let proj = parry.project_local_point(q, false);
+                let d = (proj.point - q).length();
+                *v = if proj.is_inside { d } else { -d };
+            }
+        });
+        let last = origin + Vec3::new((dims[0] - 1) as f32, (dims[1] - 1) as f32, (dims[2] - 1) as f32) * voxel;
+        let last_cell = Vec3::new((dims[0] - 2) as f32, (dims[1] - 2) as f32, (dims[2] - 2) as f32);
+        Ok(Self {
+            origin,
+            last,
+            last_cell,
+            voxel,
+            inv_voxel: 1.0 / voxel,
+            dims,
+            values,
+            bounds,
+            mesh_volume: mesh.volume(),
+        })
+    }
+
+    /// Edge length of a voxel (mesh units).
+    pub fn voxel_size(&self) -> f32 {
+        self.voxel
+    }
+
+    /// Voxels along x, y, z.
+    pub fn dims(&self) -> [usize; 3] {
+        self.dims
+    }
+
+    /// The mesh's bounding box.
+    pub fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+
+    /// The mesh's exact volume.
+    pub fn mesh_volume(&self) -> f32 {
+        self.mesh_volume
+    }
+
+    /// How far [`SignedDistanceGrid::distance`] may be from the true signed distance inside the grid:
+    /// the interpolation is a convex combination of exact values at corners at most half a voxel
+    /// diagonal away, and the distance changes by at most the distance moved.
+    pub fn interpolation_error(&self) -> f32 {
+        self.voxel * 3f32.sqrt() * 0.5
+    }
+
+    /// Interpolated signed distance at `p` (mesh frame; positive inside). Outside the grid: the value
+    /// at the nearest point of the grid minus the distance to it.
+    #[inline]
+    pub fn distance(&self, p: Vec3) -> f32 {
+        let (cell, t, outside) = self.locate(p);
+        let [c000, c100, c010, c110, c001, c101, c011, c111] = self.corners(cell);
+        let x00 = c000 + (c100 - c000) * t.x;
+        let x10 = c010 + (c110 - c010) * t.x;
+        let x01 = c001 + (c101 - c001) * t.x;
+        let x11 = c011 + (c111 - c011) * t.x;
+        let y0 = x00 + (x10 - x00) * t.y;
+        let y1 = x01 + (x11 - x01) * t.y;
+        y0 + (y1 - y0) * t.z - outside
+    }
+
+    /// Gradient of the interpolated distance at `p` (points into the mesh, length about 1 near the
+    /// surface); outside the grid, towards it.
+    #[inline]
+    pub fn gradient(&self, p: Vec3) -> Vec3 {
+        let (cell, t, outside) = self.locate(p);
+        if outside > 0.0 {
+            return (p.clamp(self.origin, self.last) - p) / outside;
+        }
+        let [c000, c100, c010, c110, c001, c101, c011, c111] = self.corners(cell);
+        let (u, v, w) = (t.x, t.y, t.z);
+        let lerp = |a: f32, b: f32, s: f32| a + (b - a) * s;
+        let dx = lerp(lerp(c100 - c000, c110 - c010, v), lerp(c101 - c001, c111 - c011, v), w);
+        let dy = lerp(lerp(c010 - c000, c110 - c100, u), lerp(c011 - c001, c111 - c101, u), w);
+        let dz = lerp(lerp(c001 - c000, c101 - c100, u), lerp(c011 - c010, c111 - c110, u), v);
+        Vec3::new(dx, dy, dz) * self.inv_voxel
+    }
+
+    /// The cell holding `p` (clamped into the grid), `p`'s position in it (0..1 per axis) and how far
+    /// `p` lies outside the grid.
+    #[inline]
+    fn locate(&self, p: Vec3) -> (usize, Vec3, f32) {
+        let q = p.clamp(self.origin, self.last);
+        let outside = if q == p { 0.0 } else { p.distance(q) };
+        let g = (q - self.origin) * self.inv_voxel;
+        // The last cell also takes the grid's far faces.
+        let cell = Vec3::new(whole(g.x), whole(g.y), whole(g.z)).min(self.last_cell);
+        let t = (g - cell).clamp(Vec3::ZERO, Vec3::ONE);
+        let (i, j, k) = (cell.x as usize, cell.y as usize, cell.z as usize);
+        ((k * self.dims[1] + j) * self.dims[0] + i, t, outside)
+    }
+
+    #[inline]
+    fn corners(&self, cell: usize) -> [f32; 8] {
+        let (sx, sy) = (self.dims[0], self.dims[0] * self.dims[1]);
+        let v = &self.values;
+        [
+            v[cell],
+            v[cell + 1],
+            v[cell + sx],
+            v[cell + sx + 1],
+            v[cell + sy],
+            v[cell + sy + 1],
+            v[cell + sy + sx],
+            v[cell + sy + sx + 1],
+        ]
+    }
+}
+
+/// The whole part of a non-negative `x`, without libm's `floorf` (which the baseline x86-64 calls: it
+/// has no rounding instruction).
+#[inline]
+fn whole(x: f32) -> f32 {
+    x as u32 as f32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shape::{box_buffers, uv_sphere_buffers};
+
+    #[test]
+    fn the_grid_gives_a_boxs_signed_distance_inside_and_out() {
+        let (v, t) = box_buffers(Vec3::new(1.0, 0.5, 0.5));
+        let grid = SignedDistanceGrid::new(&TriMesh::new(v, t).expect("valid"), 40).expect("builds");
+        for (p, want) in [
+            (Vec3::ZERO, 0.5),
+            (Vec3::new(0.9, 0.0, 0.0), 0.1),
+            (Vec3::new(0.0, 0.0, 0.6), -0.1),
+            (Vec3::new(0.0, 0.3, 0.0), 0.2),
+            (Vec3::new(3.0, 0.0, 0.0), -2.0),
+        ] {
+            let d = grid.distance(p);
+            assert!((d - want).abs() <= grid.interpolation_error() + 1e-5, "{p}: {d} vs {want}");
+        }
+        let g = grid.gradient(Vec3::new(0.0, 0.0, 0.45));
+        assert!((g.normalize() - Vec3::NEG_Z).length() < 1e-3, "gradient into the box: {g}");
+        let far = grid.gradient(Vec3::new(5.0, 0.0, 0.0));
+        assert!((far - Vec3::NEG_X).length() < 1e-5, "outside the grid, towards it: {far}");
+    }
+
+    #[test]
+    fn near_a_balls_surface_the_distance_is_close_to_exact() {
+        let (v, t) = uv_sphere_buffers(1.0, 64, 128);
+        let grid = SignedDistanceGrid::new(&TriMesh::new(v, t).expect("valid"), 64).expect("builds");
+        for i in 0..200 {
+            let dir = Vec3::new((i as f32 * 0.37).sin(), (i as f32 * 0.61).cos(), (i as f32 * 0.13).sin()).normalize();
+            let r = 0.9 + 0.2 * (i as f32 / 200.0);
+            // The facetted ball's surface is within 0.0004 of the unit sphere at this tessellation.
+            let d = grid.distance(dir * r);
+            assert!((d - (1.0 - r)).abs() < 0.004, "at radius {r}: {d}");
+        }
+    }
+
+    #[test]
+    fn bad_resolutions_are_refused_with_their_value() {
+        let (v, t) = box_buffers(Vec3::ONE);
+        let mesh = TriMesh::new(v, t).expect("valid");
+        for bad in [0, 1, 5000] {
+            let why = SignedDistanceGrid::new(&mesh, bad).expect_err("refused").to_string();
+            assert!(why.contains(&bad.to_string()) && why.contains("resolution"), "{why}");
+        }
+    }
+}
