@@ -14,14 +14,18 @@
 //! ```
 //!
 //! Prints, per pair and sphere count, the ratio's p5 / p50 / p95 (and min / max): the packing's own
-//! volume (the lens sum; always short with `--surface-offset 0`) and the volume the trees stand for
-//! (each sphere weighted by the share of the mesh it stands for).
+//! volume (the lens sum; always short with `--surface-offset 0`), the volume the trees stand for
+//! (each sphere weighted by the share of the mesh it stands for), and A's tree measured against B's
+//! signed distance grid (`overlap_field`, the grid as fine as B's packing grid).
 
 use clap::Parser;
 use collette::packing::to_parry_oriented;
 use collette::scene::{SphereCounts, brilliant_cut, default_bunny_path, load_bunny};
 use collette::shape::{box_buffers, torus_buffers, uv_sphere_buffers};
-use collette::{BuildOptions, InnerSphereTree, Pose, QueryWorkspace, TriMesh, build, overlap_volume};
+use collette::{
+    BuildOptions, InnerSphereTree, Pose, QueryWorkspace, SignedDistanceGrid, TriMesh, build, overlap_field_volume,
+    overlap_volume,
+};
 use glam::{Quat, Vec3};
 use parry3d::query::PointQuery;
 use rand::{Rng, SeedableRng};
@@ -163,9 +167,9 @@ fn main() {
 fn run(args: &Args) -> Result<(), String> {
     let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
     println!(
-        "| pair | spheres | coverage A / B | poses | packing volume ÷ exact, p5 / p50 / p95 (min–max) | weighted volume ÷ exact, p5 / p50 / p95 (min–max) |"
+        "| pair | spheres | coverage A / B | poses | packing volume ÷ exact, p5 / p50 / p95 (min–max) | weighted volume ÷ exact, p5 / p50 / p95 (min–max) | A's tree against B's distance grid ÷ exact, p5 / p50 / p95 (min–max) |"
     );
-    println!("|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|");
     for pair in &args.pairs {
         let (na, nb) = pair.split_once('-').ok_or_else(|| format!("pair {pair:?} is not A-B"))?;
         let (ma, mb) = (mesh(na)?, mesh(nb)?);
@@ -200,6 +204,15 @@ fn run(args: &Args) -> Result<(), String> {
             let (ta, tb) = (tree(&ma, counts.a)?, tree(&mb, counts.b)?);
             let (ua, ub) = (ta.unweighted(), tb.unweighted());
             let mut ws = QueryWorkspace::new();
+            // B's distance grid at the resolution of B's packing grid.
+            let grid = SignedDistanceGrid::new(&mb, options(counts.b).resolution()).map_err(|e| e.to_string())?;
+            let mut field: Vec<f64> = poses
+                .iter()
+                .map(|(pose, exact)| {
+                    overlap_field_volume(&ta, pose, &tb, &grid, &Pose::IDENTITY, &mut ws).total_volume as f64 / exact
+                })
+                .collect();
+            field.sort_by(f64::total_cmp);
             let mut ratios = |a: &InnerSphereTree, b: &InnerSphereTree| {
                 let mut r: Vec<f64> = poses
                     .iter()
@@ -225,12 +238,13 @@ fn run(args: &Args) -> Result<(), String> {
                 return Err(format!("{pair}: no pose overlaps by {} of the smaller volume", args.min_overlap));
             }
             println!(
-                "| {pair} | {counts} | {:.3} / {:.3} | {} | {} | {} |",
+                "| {pair} | {counts} | {:.3} / {:.3} | {} | {} | {} | {} |",
                 ta.coverage(),
                 tb.coverage(),
                 packed.len(),
                 show(&packed),
-                show(&weighted)
+                show(&weighted),
+                show(&field)
             );
         }
     }
