@@ -62,8 +62,11 @@ fn descend(
     let margin = 2.0 * b.interpolation_error();
     let (nodes, spheres, weights) = (a.nodes(), a.spheres(), a.weights());
     let mut result = OverlapResult { complete: true, ..OverlapResult::default() };
-    let mut push = |point: Vec3, into_b: Vec3, volume: f32, depth: f32| {
+    // The direction into B: given for a cut sphere, else the distance's gradient at `at` (computed only
+    // when contacts are wanted).
+    let mut push = |point: Vec3, into_b: Option<Vec3>, at: Vec3, volume: f32, depth: f32| {
         if let Some((set, to_world)) = out.as_mut() {
+            let into_b = into_b.unwrap_or_else(|| b.gradient(at));
             let normal = -into_b.try_normalize().unwrap_or(Vec3::Y);
             set.push(Contact {
                 point: to_world.transform_point(point),
@@ -90,7 +93,7 @@ fn descend(
         if f >= r + margin {
             result.total_volume += node.mesh_share;
             result.aggregated_pairs += 1;
-            push(center, b.gradient(center), node.mesh_share, f + r);
+            push(center, None, center, node.mesh_share, f + r);
             continue;
         }
         if !node.leaf {
@@ -104,7 +107,7 @@ fn descend(
                 let volume = part.volume * weights[s];
                 result.total_volume += volume;
                 result.leaf_pairs += 1;
-                push(part.centroid, part.into_b, volume, part.depth);
+                push(part.centroid, part.into_b, c, volume, part.depth);
             }
         }
     }
@@ -117,8 +120,9 @@ struct Part {
     volume: f32,
     /// Its centroid, B's frame.
     centroid: Vec3,
-    /// The direction into the object there (not normalized).
-    into_b: Vec3,
+    /// The direction into the object where a cut sphere straddles the surface (not normalized); `None`
+    /// for a sphere wholly inside.
+    into_b: Option<Vec3>,
     /// How deep the sphere reaches into the object: radius + the centre's distance.
     depth: f32,
 }
@@ -137,7 +141,7 @@ impl Part {
             return None;
         }
         if f >= r {
-            return Some(Self { volume: sphere_volume(r), centroid: c, into_b: b.gradient(c), depth: f + r });
+            return Some(Self { volume: sphere_volume(r), centroid: c, into_b: None, depth: f + r });
         }
         let cut = Cut::of(b, c, r, f);
         let h = r + cut.distance;
@@ -152,7 +156,7 @@ impl Part {
         let rest = 2.0 * r - h;
         let offset = if h > 0.0 { 3.0 * rest * rest / (4.0 * (3.0 * r - h)) } else { r };
         let into_b = cut.into_b;
-        Some(Self { volume, centroid: c + into_b.normalize_or_zero() * offset, into_b, depth: f + r })
+        Some(Self { volume, centroid: c + into_b.normalize_or_zero() * offset, into_b: Some(into_b), depth: f + r })
     }
 }
 

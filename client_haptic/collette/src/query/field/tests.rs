@@ -145,3 +145,46 @@ fn the_volume_changes_smoothly_along_a_sweep() {
     assert!(volumes.iter().any(|&v| v > 0.0), "the sweep overlaps");
     assert!(worst <= bound, "largest step {worst} over the bound {bound}");
 }
+
+#[test]
+fn the_penalty_force_changes_smoothly_along_a_sweep_and_jumps_no_more_than_the_two_tree_querys() {
+    // The volumetric penalty force is along Σ volume × normal. Its normals must not jump where the
+    // interpolant's slope does (the cells' faces). Where a node starts counting whole near the ball's
+    // centre (its leaves' normals point every way, the node's one way) the force steps, as it does in
+    // the aggregated query of two trees; not by more.
+    let torus = tree_of(torus_buffers(0.3, 0.1, 64, 32), 1500);
+    let (ball, ball_grid) = solid(uv_sphere_buffers(0.25, 32, 64), 500, 24);
+    let (mut ws, mut set) = (QueryWorkspace::new(), ContactSet::new());
+    let mut sweep = |field: bool| -> (f32, f32, f32) {
+        let forces: Vec<Vec3> = (0..=2000)
+            .map(|i| {
+                let pose = Pose::new(Vec3::new(-0.6 + 0.0006 * i as f32, 0.03, 0.01), Quat::from_rotation_y(0.2));
+                if field {
+                    overlap_field(&torus, &pose, &ball, &ball_grid, &Pose::IDENTITY, &mut ws, &mut set);
+                } else {
+                    crate::overlap_budgeted(
+                        &torus,
+                        &pose,
+                        &ball,
+                        &Pose::IDENTITY,
+                        crate::Budget::Unlimited,
+                        &mut ws,
+                        &mut set,
+                    );
+                }
+                set.as_slice().iter().map(|c| c.normal * c.volume).sum()
+            })
+            .collect();
+        let largest = forces.iter().map(|f| f.length()).fold(0.0f32, f32::max);
+        let mut steps: Vec<f32> = forces.windows(2).map(|w| (w[1] - w[0]).length()).collect();
+        steps.sort_by(f32::total_cmp);
+        (largest, steps[steps.len() * 99 / 100], steps[steps.len() - 1])
+    };
+    let (largest, p99, worst) = sweep(true);
+    let (two_largest, _, two_worst) = sweep(false);
+    assert!(largest > 0.0 && p99 <= 0.01 * largest, "99 % of the steps under 1 % of the force: {p99} of {largest}");
+    assert!(
+        worst / largest <= 1.5 * two_worst / two_largest,
+        "largest step {worst} of {largest}; two trees: {two_worst} of {two_largest}"
+    );
+}
