@@ -2,13 +2,16 @@
 //!
 //! You need this module when the overlap volume must follow the touched object's real surface: two
 //! packings meet with an error set by the coarser packing's hollows (a 1 cm gem against the 10k-sphere
-//! bunny: 0.94–1.05 of the true volume from p5 to p95), while the tool's spheres measured against the
+//! bunny: 0.94–1.07 of the true volume from p5 to p95), while the tool's spheres measured against the
 //! object's distance give 0.99–1.01 (docs/collette.md, *Volume accuracy*). Each inner sphere of the
 //! tool counts the part of it on the inner side of the surface: the cap cut by the tangent plane at the
 //! interpolated distance, corrected for the surface's curvature by the distance's Laplacian over the
 //! sphere (six more samples), times the sphere's weight. A node whose bound lies inside (or outside)
 //! the object by more than the interpolation's error counts whole (or not at all) without descending;
 //! its leaves would give the same, so the volume stays continuous as the tool moves.
+//!
+//! It suits a tool much smaller than the object it touches; for objects of similar size two trees
+//! ([`overlap_budgeted`](crate::overlap_budgeted)) are closer, and faster.
 
 use crate::partitioning::InnerSphereTree;
 use crate::query::QueryWorkspace;
