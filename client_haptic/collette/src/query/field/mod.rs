@@ -21,9 +21,11 @@ use glam::Vec3;
 use haptic_common::{Contact, ContactSet, Pose};
 use std::f32::consts::PI;
 
-/// Overlap of tree `a` at `pose_a` with the object of grid `b` at `pose_b`: the volume (exact up to the
-/// grid's interpolation and the caps' curvature term) and one world-frame contact per inner sphere or
-/// node of `a` inside `b` (normals from B towards A: the direction that pushes the tool out).
+/// Overlap of tree `a` at `pose_a` with the object B at `pose_b` — its tree `b` and its distance grid
+/// `b_grid`, built from the same mesh: the volume (exact up to the grid's interpolation and the caps'
+/// curvature term; B's packing stands in where B's surface bends within one of A's spheres) and one
+/// world-frame contact per node or sphere of `a` inside B (normals from B towards A: the direction that
+/// pushes the tool out).
 ///
 /// Contacts beyond `out`'s capacity still count in the volume; `out.truncated` is then set.
 pub fn overlap_field(
@@ -88,7 +90,8 @@ fn descend(
         let f = b.distance(center);
         let r = node.bound.radius;
         // Either bound keeps every leaf on the same side as its node (so the volume is the leaves'):
-        // the interpolation's error twice, or the interpolant's own slope (at most √3) across the node.
+        // the interpolation's error twice, or the interpolant's own slope (at most √3 within the grid,
+        // whose outer two voxels no node inside B can reach) across the node.
         let margin = margin.min((SLOPE - 1.0) * r);
         if f <= -r - margin {
             continue;
