@@ -27,7 +27,9 @@ use std::f32::consts::PI;
 /// world-frame contact per node or sphere of `a` inside B (normals from B towards A: the direction that
 /// pushes the tool out).
 ///
-/// Contacts beyond `out`'s capacity still count in the volume; `out.truncated` is then set.
+/// In the result `leaf_pairs` counts A's spheres reaching into B, `aggregated_pairs` A's nodes counted
+/// whole and `node_pairs` A's nodes visited. Contacts beyond `out`'s capacity still count in the
+/// volume; `out.truncated` is then set.
 pub fn overlap_field(
     a: &InnerSphereTree,
     pose_a: &Pose,
