@@ -36,7 +36,7 @@ pub use partitioning::{InnerSphereTree, Node};
 pub use pipeline::{CollisionConfig, CollisionHandle, CollisionThread, ContactReader, ObjectId, PoseWriter, WatcherId};
 pub use query::{
     Budget, CoherenceStats, CoherentOverlap, OverlapResult, ProbeHit, QueryWorkspace, Separation, overlap,
-    overlap_budgeted, overlap_field, overlap_field_volume, overlap_volume, probe, separation,
+    overlap_budgeted, overlap_field, overlap_field_budgeted, overlap_field_volume, overlap_volume, probe, separation,
 };
 pub use shape::{SignedDistanceGrid, Sphere, TriMesh};
 

@@ -5,7 +5,8 @@ use collette::pipeline::{CollisionConfig, CollisionWorld, Command, ObjectId, Tim
 use collette::shape::box_buffers;
 use collette::{
     Budget, BuildOptions, CoherentOverlap, ContactSet, Pose, QueryWorkspace, SignedDistanceGrid, TriMesh, build,
-    overlap, overlap_budgeted, overlap_field, overlap_field_volume, overlap_volume, probe, separation,
+    overlap, overlap_budgeted, overlap_field, overlap_field_budgeted, overlap_field_volume, overlap_volume, probe,
+    separation,
 };
 use glam::{Quat, Vec3};
 use std::sync::Arc;
@@ -32,6 +33,7 @@ fn queries_and_collision_steps_do_not_allocate_once_warmed_up() {
         overlap_budgeted(&tree, &pa, &tree, &pb, Budget::Deadline(Instant::now() + Duration::from_micros(30)), ws, set);
         overlap_volume(&tree, &pa, &tree, &pb, ws);
         assert!(overlap_field(&tree, &pa, &tree, &grid, &pb, ws, set).total_volume > 0.0);
+        overlap_field_budgeted(&tree, &pa, &tree, &grid, &pb, Budget::NodePairs(20), ws, set);
         overlap_field_volume(&tree, &pa, &tree, &grid, &pb, ws);
         probe(&tree, &pb, Vec3::new(0.3, 0.1, 0.0), 0.05, ws, Some(set));
         separation(&tree, &pa, &tree, &Pose::from_translation(Vec3::X * 3.0), ws);

@@ -13,7 +13,7 @@ pub mod probe;
 mod workspace;
 
 pub use distance::{Separation, separation};
-pub use field::{overlap_field, overlap_field_volume};
+pub use field::{overlap_field, overlap_field_budgeted, overlap_field_volume};
 pub use overlap::{Budget, CoherenceStats, CoherentOverlap, OverlapResult, overlap, overlap_budgeted, overlap_volume};
 pub use probe::{ProbeHit, probe, spheres_near};
 pub use workspace::QueryWorkspace;

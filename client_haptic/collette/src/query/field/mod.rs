@@ -15,11 +15,12 @@
 
 use crate::partitioning::InnerSphereTree;
 use crate::query::QueryWorkspace;
-use crate::query::overlap::OverlapResult;
+use crate::query::overlap::{Budget, OverlapResult};
 use crate::shape::{SignedDistanceGrid, lens_volume, sphere_volume};
 use glam::Vec3;
 use haptic_common::{Contact, ContactSet, Pose};
 use std::f32::consts::PI;
+use std::time::Instant;
 
 /// Overlap of tree `a` at `pose_a` with the object B at `pose_b` — its tree `b` and its distance grid
 /// `b_grid`, built from the same mesh: the volume (exact up to the grid's interpolation and the caps'
@@ -39,9 +40,29 @@ pub fn overlap_field(
     ws: &mut QueryWorkspace,
     out: &mut ContactSet,
 ) -> OverlapResult {
+    overlap_field_budgeted(a, pose_a, b, b_grid, pose_b, Budget::Unlimited, ws, out)
+}
+
+/// [`overlap_field`] that stops descending when `budget` runs out and estimates each node it has not
+/// visited from its bound: the node's mesh share times the part of its bounding sphere inside B (the cap
+/// of the tangent plane at its centre's distance), reported as a contact too so forces stay continuous.
+/// The estimate is in `estimated_volume`; `complete` is false.
+#[allow(clippy::too_many_arguments)]
+pub fn overlap_field_budgeted(
+    a: &InnerSphereTree,
+    pose_a: &Pose,
+    b: &InnerSphereTree,
+    b_grid: &SignedDistanceGrid,
+    pose_b: &Pose,
+    budget: Budget,
+    ws: &mut QueryWorkspace,
+    out: &mut ContactSet,
+) -> OverlapResult {
     out.clear();
-    let result = descend(a, pose_a, (b, b_grid), pose_b, ws, Some((out, pose_b)));
+    let result = descend(a, pose_a, (b, b_grid), pose_b, budget, ws, Some((out, pose_b)));
     out.total_volume = result.total_volume;
+    out.estimated_volume = result.estimated_volume;
+    out.truncated |= !result.complete;
     result
 }
 
@@ -54,14 +75,18 @@ pub fn overlap_field_volume(
     pose_b: &Pose,
     ws: &mut QueryWorkspace,
 ) -> OverlapResult {
-    descend(a, pose_a, (b, b_grid), pose_b, ws, None)
+    descend(a, pose_a, (b, b_grid), pose_b, Budget::Unlimited, ws, None)
 }
+
+/// Nodes visited between two looks at the clock.
+const CLOCK_STRIDE: u32 = 16;
 
 fn descend(
     a: &InnerSphereTree,
     pose_a: &Pose,
     (b_tree, b): (&InnerSphereTree, &SignedDistanceGrid),
     pose_b: &Pose,
+    budget: Budget,
     ws: &mut QueryWorkspace,
     mut out: Option<(&mut ContactSet, &Pose)>,
 ) -> OverlapResult {
@@ -83,10 +108,44 @@ fn descend(
             });
         }
     };
-    ws.nodes.clear();
-    ws.nodes.push(0);
-    while let Some(n) = ws.nodes.pop() {
+    // Unlimited: depth-first on a stack. Budgeted: breadth-first through the ring while it has room (so
+    // a budget leaves the tree evenly refined), depth-first beyond.
+    let QueryWorkspace { nodes: stack, ring, stack: b_stack, .. } = ws;
+    let breadth_first = !matches!(budget, Budget::Unlimited);
+    stack.clear();
+    let mut frontier = Frontier { ring, head: 0, queued: 0, breadth_first };
+    frontier.push(0, stack);
+    let mut until_clock = 0;
+    while let Some(n) = frontier.pop(stack) {
         let node = &nodes[n as usize];
+        let spent = match budget {
+            Budget::Unlimited => false,
+            Budget::NodePairs(max) => result.node_pairs >= max,
+            Budget::Deadline(deadline) => {
+                until_clock = if until_clock == 0 { CLOCK_STRIDE } else { until_clock - 1 };
+                until_clock == CLOCK_STRIDE && Instant::now() >= deadline
+            }
+        };
+        if spent {
+            // This node and every one still queued: estimated from its bound.
+            result.complete = false;
+            let waiting = (0..frontier.queued).map(|i| frontier.ring[(frontier.head + i) % frontier.ring.len()].0);
+            for n in std::iter::once(n).chain(waiting).chain(stack.drain(..)) {
+                let node = &nodes[n as usize];
+                let center = a_in_b.transform_point(node.bound.center);
+                let r = node.bound.radius;
+                let h = (r + b.distance(center)).clamp(0.0, 2.0 * r);
+                let volume =
+                    node.mesh_share * (PI * h * h * (3.0 * r - h) / 3.0) / sphere_volume(r).max(f32::MIN_POSITIVE);
+                if volume > 0.0 {
+                    result.total_volume += volume;
+                    result.estimated_volume += volume;
+                    result.estimated_pairs += 1;
+                    push(center, None, center, volume, h);
+                }
+            }
+            break;
+        }
         result.node_pairs += 1;
         let center = a_in_b.transform_point(node.bound.center);
         let f = b.distance(center);
@@ -105,13 +164,15 @@ fn descend(
             continue;
         }
         if !node.leaf {
-            ws.nodes.extend(node.range().map(|c| c as u32));
+            for child in node.range() {
+                frontier.push(child as u32, stack);
+            }
             continue;
         }
         for s in node.range() {
             let sphere = spheres[s];
             let c = a_in_b.transform_point(sphere.center);
-            if let Some(part) = Part::of((b_tree, b), c, sphere.radius, &mut ws.stack) {
+            if let Some(part) = Part::of((b_tree, b), c, sphere.radius, b_stack) {
                 let volume = part.volume * weights[s];
                 result.total_volume += volume;
                 result.leaf_pairs += 1;
@@ -120,6 +181,37 @@ fn descend(
         }
     }
     result
+}
+
+/// The nodes still to visit: in the ring first (first in, first out), on the stack when the ring is
+/// full or the query is depth-first.
+struct Frontier<'w> {
+    ring: &'w mut [(u32, u32)],
+    head: usize,
+    queued: usize,
+    breadth_first: bool,
+}
+
+impl Frontier<'_> {
+    #[inline]
+    fn push(&mut self, n: u32, stack: &mut Vec<u32>) {
+        if self.breadth_first && self.queued < self.ring.len() {
+            self.ring[(self.head + self.queued) % self.ring.len()] = (n, 0);
+            self.queued += 1;
+        } else {
+            stack.push(n);
+        }
+    }
+
+    #[inline]
+    fn pop(&mut self, stack: &mut Vec<u32>) -> Option<u32> {
+        if self.queued == 0 {
+            return stack.pop();
+        }
+        let n = self.ring[self.head].0;
+        (self.head, self.queued) = ((self.head + 1) % self.ring.len(), self.queued - 1);
+        Some(n)
+    }
 }
 
 /// The part of one inner sphere inside the object.

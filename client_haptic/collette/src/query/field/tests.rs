@@ -1,4 +1,5 @@
 use super::*;
+use crate::Budget;
 use crate::shape::{Sphere, TriMesh, box_buffers, torus_buffers, uv_sphere_buffers};
 use crate::{BuildOptions, build};
 use glam::Quat;
@@ -187,4 +188,56 @@ fn the_penalty_force_changes_smoothly_along_a_sweep_and_jumps_no_more_than_the_t
         worst / largest <= 1.5 * two_worst / two_largest,
         "largest step {worst} of {largest}; two trees: {two_worst} of {two_largest}"
     );
+}
+
+#[test]
+fn a_budget_stops_the_descent_and_estimates_the_rest_from_the_nodes_bounds() {
+    let torus = tree_of(torus_buffers(0.3, 0.1, 64, 32), 1500);
+    let ball = solid(uv_sphere_buffers(0.25, 32, 64), 500, 48);
+    let (mut ws, mut set) = (QueryWorkspace::new(), ContactSet::new());
+    let pose = Pose::new(Vec3::new(-0.2, 0.03, 0.01), Quat::from_rotation_y(0.2));
+    let exact = overlap_field(&torus, &pose, &ball.0, &ball.1, &Pose::IDENTITY, &mut ws, &mut set);
+    assert!(exact.complete && exact.estimated_volume == 0.0 && exact.total_volume > 0.0);
+    let ample = overlap_field_budgeted(
+        &torus,
+        &pose,
+        &ball.0,
+        &ball.1,
+        &Pose::IDENTITY,
+        Budget::NodePairs(u32::MAX),
+        &mut ws,
+        &mut set,
+    );
+    assert_eq!(ample, exact, "a budget never reached changes nothing");
+    let mut errors = Vec::new();
+    for nodes in [1, 10, 100, 400] {
+        let cut = overlap_field_budgeted(
+            &torus,
+            &pose,
+            &ball.0,
+            &ball.1,
+            &Pose::IDENTITY,
+            Budget::NodePairs(nodes),
+            &mut ws,
+            &mut set,
+        );
+        assert!(!cut.complete && set.truncated && cut.estimated_volume > 0.0, "{nodes} nodes: {cut:?}");
+        assert_eq!(cut.node_pairs, nodes);
+        let summed: f32 = set.as_slice().iter().map(|c| c.volume).sum();
+        assert!((summed - cut.total_volume).abs() <= 1e-5 * cut.total_volume, "the estimate is reported as contacts");
+        errors.push((cut.total_volume / exact.total_volume - 1.0).abs());
+    }
+    // Breadth-first, so a cut leaves the tree evenly refined: within 5 % from ten nodes on (of 583).
+    assert!(errors[1..].iter().all(|&e| e < 0.05) && errors[3] < 0.01, "{errors:?}");
+    let late = overlap_field_budgeted(
+        &torus,
+        &pose,
+        &ball.0,
+        &ball.1,
+        &Pose::IDENTITY,
+        Budget::Deadline(std::time::Instant::now()),
+        &mut ws,
+        &mut set,
+    );
+    assert!(!late.complete && late.node_pairs <= CLOCK_STRIDE && late.total_volume > 0.0, "{late:?}");
 }
