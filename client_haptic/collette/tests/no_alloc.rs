@@ -70,4 +70,11 @@ fn queries_and_collision_steps_do_not_allocate_once_warmed_up() {
     });
     let latest = contacts_out.read();
     assert!(latest.total_volume > 0.0 && latest.sequence == 3 && latest.timestamp_us == 0);
+    // The target measured against its surface grid.
+    world.apply(Command::SetSurface(ObjectId(1), Some(Arc::new(grid.clone()))), &mut |r| retired.push(r));
+    assert_no_alloc(|| {
+        world.step(None);
+        world.step(Some(Instant::now() + Duration::from_micros(100)));
+    });
+    assert!(contacts_out.read().total_volume > 0.0 && contacts_out.read().sequence == 5);
 }

@@ -11,6 +11,7 @@ use super::world::{
 };
 use crate::bounding_volume::Aabb;
 use crate::partitioning::InnerSphereTree;
+use crate::shape::SignedDistanceGrid;
 use haptic_common::{ContactSet, Delegator, OnCollision, Pose};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -276,6 +277,15 @@ impl CollisionHandle {
         self.commands.push(Command::SetTree(id, tree)).is_ok()
     }
 
+    /// Gives object `id` a distance grid of its surface, built from the mesh its tree was built from
+    /// (`None` takes it away): from the next step, pairs watching it as B measure A's spheres against
+    /// its surface (`overlap_field_budgeted`: for a tool much smaller than the object, see
+    /// docs/collette.md). False when the command ring is full.
+    pub fn set_surface(&mut self, id: ObjectId, surface: Option<Arc<SignedDistanceGrid>>) -> bool {
+        self.collect_retired();
+        self.commands.push(Command::SetSurface(id, surface)).is_ok()
+    }
+
     /// Removes an object (its watchers then publish empty sets). False when the command ring is full.
     ///
     /// Its slot is reused by the next `add_object`: remove the object's watchers first.
@@ -386,7 +396,7 @@ impl Drop for CollisionHandle {
 mod tests {
     use super::*;
     use crate::shape::box_buffers;
-    use crate::{BuildOptions, TriMesh, build};
+    use crate::{BuildOptions, QueryWorkspace, TriMesh, build};
     use glam::Vec3;
     use std::time::Duration;
 
@@ -489,6 +499,51 @@ mod tests {
         let starts: Vec<_> = timings.iter().map(|t| (t.start_us, t.period_us, t.work_us)).collect();
         assert_eq!(starts, vec![(100, 0, 10), (200, 100, 30), (400, 200, 50)]);
         assert_eq!(handle.steps(), 3);
+    }
+
+    #[test]
+    fn a_pair_whose_b_has_a_surface_grid_is_measured_against_it_until_it_is_taken_away() {
+        let (v, t) = box_buffers(Vec3::new(1.0, 1.0, 0.5));
+        let slab_mesh = TriMesh::new(v, t).expect("valid");
+        let slab = Arc::new(build(&slab_mesh, &BuildOptions::spheres(300), &mut |_| {}).expect("builds").0);
+        let grid = Arc::new(crate::SignedDistanceGrid::new(&slab_mesh, 40).expect("grid"));
+        let (v, t) = box_buffers(Vec3::splat(0.1));
+        let block = Arc::new(
+            build(&TriMesh::new(v, t).expect("valid"), &BuildOptions::spheres(300), &mut |_| {}).expect("builds").0,
+        );
+        let (mut handle, mut stepper) = pipeline(&CollisionConfig::default(), Delegator::new());
+        let mut tool = handle.add_object(block.clone(), Pose::IDENTITY).expect("slot");
+        let still = TimedPose { pose: Pose::IDENTITY, timestamp_us: u64::MAX, reach: 0.0 };
+        let target = handle.add_object_at(slab.clone(), still).expect("slot");
+        let mut contacts = handle.add_watcher(tool.id(), target.id()).expect("slot");
+        // The block's lower 0.05 inside the slab's top face: 0.2 × 0.2 × 0.05 = 0.002.
+        let pose = Pose::from_translation(Vec3::new(0.2, 0.1, 0.55));
+        tool.set(pose, 10);
+        let (mut ws, mut direct) = (QueryWorkspace::new(), ContactSet::new());
+        let mut volume_at = |stepper: &mut CollisionStepper, start: u64| {
+            stepper.step(start, false, || start + 5);
+            contacts.latest().total_volume
+        };
+        let packed = volume_at(&mut stepper, 100);
+        assert_eq!(packed, crate::overlap(&block, &pose, &slab, &Pose::IDENTITY, &mut ws, &mut direct).total_volume);
+        assert!(handle.set_surface(target.id(), Some(grid.clone())));
+        let surface = volume_at(&mut stepper, 200);
+        let want = crate::overlap_field(&block, &pose, &slab, &grid, &Pose::IDENTITY, &mut ws, &mut direct);
+        assert_eq!(surface, want.total_volume, "measured against the grid");
+        assert!((surface / 0.002 - 1.0).abs() < 0.01, "the slice's true volume: {surface}");
+        assert!(handle.set_surface(target.id(), None));
+        assert_eq!(volume_at(&mut stepper, 300), packed, "back to two trees");
+        handle.collect_retired();
+        assert_eq!(handle.collected(), 1, "the grid came back to be freed");
+        assert_eq!(Arc::strong_count(&grid), 1, "held by the test alone");
+        // An object removed with its grid hands both back.
+        assert!(handle.set_surface(target.id(), Some(grid.clone())));
+        stepper.step(400, false, || 405);
+        assert!(handle.remove_watcher(contacts.id()) && handle.remove_object(target.id()));
+        stepper.step(500, false, || 505);
+        handle.collect_retired();
+        assert_eq!(Arc::strong_count(&grid), 1, "freed with its object");
+        assert_eq!(handle.leaked(), 0);
     }
 
     #[test]

@@ -2,7 +2,8 @@
 
 use crate::bounding_volume::Aabb;
 use crate::partitioning::InnerSphereTree;
-use crate::query::{Budget, QueryWorkspace, overlap_budgeted, spheres_near};
+use crate::query::{Budget, QueryWorkspace, overlap_budgeted, overlap_field_budgeted, spheres_near};
+use crate::shape::SignedDistanceGrid;
 use glam::Vec3;
 use haptic_common::{ContactSet, Delegator, OnCollision, Pose};
 use std::sync::Arc;
@@ -150,6 +151,9 @@ pub enum Command {
     AddObject(ObjectId, Arc<InnerSphereTree>, triple_buffer::Output<TimedPose>),
     /// Gives the object in slot `id` a new tree (its pose buffer stays).
     SetTree(ObjectId, Arc<InnerSphereTree>),
+    /// Gives the object in slot `id` a distance grid of its surface (`None`: takes it away): pairs that
+    /// watch it as B then measure A's spheres against its surface (`overlap_field_budgeted`).
+    SetSurface(ObjectId, Option<Arc<SignedDistanceGrid>>),
     /// Empties slot `id`.
     RemoveObject(ObjectId),
     /// Watches the pair (A, B) in slot `id`, publishing into the writing end of its buffer.
@@ -164,10 +168,12 @@ pub enum Command {
 
 /// What the world hands back to be freed off the real-time thread.
 pub enum Retired {
-    /// A removed object.
-    Object(Arc<InnerSphereTree>, triple_buffer::Output<TimedPose>),
+    /// A removed object (with its surface grid, if it had one).
+    Object(Arc<InnerSphereTree>, triple_buffer::Output<TimedPose>, Option<Arc<SignedDistanceGrid>>),
     /// A replaced tree.
     Tree(Arc<InnerSphereTree>),
+    /// A replaced or taken surface grid.
+    Surface(Arc<SignedDistanceGrid>),
     /// A removed watcher.
     Watcher(WatcherOutput),
 }
@@ -186,6 +192,7 @@ pub struct StepReport {
 struct ObjectSlot {
     tree: Arc<InnerSphereTree>,
     pose: triple_buffer::Output<TimedPose>,
+    surface: Option<Arc<SignedDistanceGrid>>,
 }
 
 struct WatcherSlot {
@@ -240,20 +247,32 @@ impl CollisionWorld {
         match command {
             Command::AddObject(id, tree, pose) => {
                 if let Some(slot) = self.objects.get_mut(id.0 as usize) {
-                    if let Some(old) = slot.replace(ObjectSlot { tree, pose }) {
-                        retire(Retired::Object(old.tree, old.pose));
+                    if let Some(old) = slot.replace(ObjectSlot { tree, pose, surface: None }) {
+                        retire(Retired::Object(old.tree, old.pose, old.surface));
                     }
                 } else {
-                    retire(Retired::Object(tree, pose));
+                    retire(Retired::Object(tree, pose, None));
                 }
             }
             Command::SetTree(id, tree) => match self.objects.get_mut(id.0 as usize).and_then(Option::as_mut) {
                 Some(slot) => retire(Retired::Tree(std::mem::replace(&mut slot.tree, tree))),
                 None => retire(Retired::Tree(tree)),
             },
+            Command::SetSurface(id, surface) => match self.objects.get_mut(id.0 as usize).and_then(Option::as_mut) {
+                Some(slot) => {
+                    if let Some(old) = std::mem::replace(&mut slot.surface, surface) {
+                        retire(Retired::Surface(old));
+                    }
+                }
+                None => {
+                    if let Some(surface) = surface {
+                        retire(Retired::Surface(surface));
+                    }
+                }
+            },
             Command::RemoveObject(id) => {
                 if let Some(old) = self.objects.get_mut(id.0 as usize).and_then(Option::take) {
-                    retire(Retired::Object(old.tree, old.pose));
+                    retire(Retired::Object(old.tree, old.pose, old.surface));
                 }
             }
             Command::AddWatcher(id, a, b, out) => {
@@ -305,9 +324,13 @@ impl CollisionWorld {
                 WatcherOutput::Contacts(out) => {
                     let set = out.input_buffer_mut();
                     set.clear();
-                    if let Some(Pair { a, pa, b, pb, inside: true, .. }) = pair {
+                    if let Some(Pair { a, pa, b, pb, b_surface, inside: true, .. }) = pair {
                         let budget = share.map_or(Budget::Unlimited, Budget::Deadline);
-                        let result = overlap_budgeted(a, &pa.pose, b, &pb.pose, budget, &mut self.workspace, set);
+                        let ws = &mut self.workspace;
+                        let result = match b_surface {
+                            Some(grid) => overlap_field_budgeted(a, &pa.pose, b, grid, &pb.pose, budget, ws, set),
+                            None => overlap_budgeted(a, &pa.pose, b, &pb.pose, budget, ws, set),
+                        };
                         report.budget_hit |= !result.complete;
                         report.queried += 1;
                     }
@@ -344,6 +367,7 @@ struct Pair<'a> {
     pa: TimedPose,
     b: &'a InnerSphereTree,
     pb: TimedPose,
+    b_surface: Option<&'a SignedDistanceGrid>,
     timestamp_us: u64,
     inside: bool,
 }
@@ -361,6 +385,7 @@ impl<'a> Pair<'a> {
             pa,
             b: &b.tree,
             pb,
+            b_surface: b.surface.as_deref(),
             timestamp_us: pa.timestamp_us.min(pb.timestamp_us),
             inside: inside(&a.tree, &pa.pose) && inside(&b.tree, &pb.pose),
         }
