@@ -15,6 +15,9 @@ pub enum RigError {
     /// No room for another object.
     #[error("at most {0} objects can be watched at once")]
     TooManyObjects(usize),
+    /// No watched object has this id.
+    #[error("no watched object has id {0}")]
+    UnknownObject(u32),
     /// The operating system refused to start the collision thread.
     #[error("cannot start the collision thread: {0}")]
     Spawn(std::io::Error),

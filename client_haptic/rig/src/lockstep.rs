@@ -64,6 +64,15 @@ impl<D: Device> Lockstep<D> {
         self.scene.remove_object(id)
     }
 
+    /// Measures the tool against watched object `id`'s surface grid (`None`: its tree again).
+    pub fn set_surface(
+        &mut self,
+        id: u32,
+        surface: Option<std::sync::Arc<collette::SignedDistanceGrid>>,
+    ) -> Result<()> {
+        self.scene.set_surface(id, surface)
+    }
+
     /// Replaces the tool.
     pub fn set_tool(&mut self, tool: ToolSpec) -> Result<()> {
         self.scene.set_tool(tool)

@@ -202,6 +202,13 @@ impl<D: Device + 'static> HapticRig<D> {
         self.with_scene(|s| s.remove_object(id))
     }
 
+    /// Measures the tool against watched object `id`'s surface — a distance grid built from the mesh its
+    /// tree came from — instead of its tree (`None`: its tree again): closer to the real overlap for a
+    /// tool much smaller than the object (docs/collette.md, *Volume accuracy*).
+    pub fn set_surface(&self, id: u32, surface: Option<std::sync::Arc<collette::SignedDistanceGrid>>) -> Result<()> {
+        self.with_scene(|s| s.set_surface(id, surface))
+    }
+
     /// Only checks the objects whose bounds touch `region`, scene frame (the paper's ColletteVolume;
     /// `None`: everywhere). Objects outside it give no contact.
     pub fn set_region(&self, region: Option<collette::bounding_volume::Aabb>) -> Result<()> {

@@ -120,6 +120,17 @@ impl Scene {
         self.forces.push(command).map_err(|_| RigError::QueueFull("haptic"))
     }
 
+    /// Measures the tool against object `id`'s surface grid (`None`: against its tree again).
+    pub(crate) fn set_surface(
+        &mut self,
+        id: u32,
+        surface: Option<std::sync::Arc<collette::SignedDistanceGrid>>,
+    ) -> Result<()> {
+        self.free_returned();
+        let entry = self.entries.iter().find(|e| e.id == id).ok_or(RigError::UnknownObject(id))?;
+        if self.collision.set_surface(entry.object, surface) { Ok(()) } else { Err(RigError::QueueFull("collision")) }
+    }
+
     /// Only checks objects whose bounds touch `region` (`None`: everywhere).
     pub(crate) fn set_region(&mut self, region: Option<collette::bounding_volume::Aabb>) -> Result<()> {
         if self.collision.set_region(region) { Ok(()) } else { Err(RigError::QueueFull("collision")) }

@@ -61,6 +61,11 @@ struct Args {
     /// or "proxy" (3-DOF god-object: the gemstone's centre as a point tip held on the bunny's spheres).
     #[arg(long, default_value = "volumetric")]
     rendering: String,
+    /// Measure the gemstone against the bunny's surface (a signed distance grid as fine as the bunny's
+    /// packing grid, `collette::overlap_field`) instead of the bunny's tree: the volume that follows
+    /// the real intersection for a tool this much smaller than the object (docs/collette.md).
+    #[arg(long)]
+    surface: bool,
     /// Print the summary as one JSON object, last.
     #[arg(long)]
     json: bool,
@@ -108,11 +113,21 @@ fn run() -> anyhow::Result<()> {
         .context("building the bunny's tree")?;
     let (gem, _) = collette::build(&gem_mesh, &collette::BuildOptions::spheres(args.tool_spheres), &mut |_| {})
         .context("building the gemstone's tree")?;
+    let surface = match args.surface {
+        true => {
+            let resolution = collette::BuildOptions::spheres(args.bunny_spheres).resolution();
+            let grid =
+                collette::SignedDistanceGrid::new(&bunny_mesh, resolution).context("the bunny's distance grid")?;
+            Some(Arc::new(grid))
+        }
+        false => None,
+    };
     eprintln!(
-        "haptic-bench: trees built in {:.1} s ({} bunny spheres, {} tool spheres)",
+        "haptic-bench: trees built in {:.1} s ({} bunny spheres, {} tool spheres{})",
         started.elapsed().as_secs_f64(),
         bunny.spheres().len(),
-        gem.spheres().len()
+        gem.spheres().len(),
+        if surface.is_some() { ", the bunny's distance grid" } else { "" }
     );
 
     // The hand follows the scripted tool path (or a recorded trace); the device frame is the scene
@@ -172,10 +187,13 @@ fn run() -> anyhow::Result<()> {
     let bunny_material = Material { stiffness_n_per_m3: 5e7, damping_ns_per_m: 4.0, friction: 0.3, texture: None };
     let bunny = ObjectSpec { id: 1, tree: Arc::new(bunny), pose: Pose::IDENTITY, material: bunny_material };
     if args.lockstep {
-        return lockstep(&args, device, tool, bunny, &config, replay.as_ref(), recording);
+        return lockstep(&args, device, tool, (bunny, surface), &config, replay.as_ref(), recording);
     }
     let rig = HapticRig::start(device, tool, config, HapticEvents::default(), Delegator::new())?;
     rig.add_object(bunny)?;
+    if surface.is_some() {
+        rig.set_surface(1, surface)?;
+    }
 
     let mut haptic = Vec::with_capacity(ticks);
     let mut collision = Vec::with_capacity(ticks);
@@ -272,6 +290,7 @@ fn run() -> anyhow::Result<()> {
             "windows": s.windows,
             "device": specs.name,
             "rendering": args.rendering,
+            "surface": args.surface,
             "realtime": haptic_telemetry.realtime,
             "memory_locked": locked,
             "windows_below_target_haptic": low_haptic,
@@ -293,7 +312,7 @@ fn lockstep(
     args: &Args,
     device: Box<dyn Device>,
     tool: ToolSpec,
-    bunny: ObjectSpec,
+    (bunny, surface): (ObjectSpec, Option<Arc<collette::SignedDistanceGrid>>),
     config: &RigConfig,
     replay: Option<&Trace>,
     recording: Option<TraceWriter>,
@@ -308,7 +327,11 @@ fn lockstep(
         None => (0..last_us / period_us).map(|i| i * period_us).collect(),
     };
     let mut rig = Lockstep::new(device, tool, config, 1, None)?;
+    let id = bunny.id;
     rig.add_object(bunny)?;
+    if surface.is_some() {
+        rig.set_surface(id, surface)?;
+    }
     let started = Instant::now();
     let forces: Vec<ForceTorque> = times.iter().map(|&t| rig.tick(t)).collect();
     let elapsed = started.elapsed();
@@ -343,6 +366,7 @@ fn lockstep(
         let json = serde_json::json!({
             "lockstep": true,
             "rendering": args.rendering,
+            "surface": args.surface,
             "ticks": forces.len(),
             "seconds_wall": elapsed.as_secs_f64(),
             "ticks_with_force": in_contact,
