@@ -4,7 +4,6 @@
 //! rather than its sphere packing: [`overlap_field`](crate::query::overlap_field) measures each of the
 //! tool's inner spheres against this grid (see docs/collette.md, *Volume accuracy*).
 
-use crate::bounding_volume::Aabb;
 use crate::error::BuildError;
 use crate::packing::{MAX_VOXELS, to_parry_oriented};
 use crate::shape::TriMesh;
@@ -25,8 +24,6 @@ pub struct SignedDistanceGrid {
     inv_voxel: f32,
     dims: [usize; 3],
     values: Vec<f32>,
-    bounds: Aabb,
-    mesh_volume: f32,
 }
 
 impl SignedDistanceGrid {
@@ -70,17 +67,7 @@ impl SignedDistanceGrid {
         });
         let last = origin + Vec3::new((dims[0] - 1) as f32, (dims[1] - 1) as f32, (dims[2] - 1) as f32) * voxel;
         let last_cell = Vec3::new((dims[0] - 2) as f32, (dims[1] - 2) as f32, (dims[2] - 2) as f32);
-        Ok(Self {
-            origin,
-            last,
-            last_cell,
-            voxel,
-            inv_voxel: 1.0 / voxel,
-            dims,
-            values,
-            bounds,
-            mesh_volume: mesh.volume(),
-        })
+        Ok(Self { origin, last, last_cell, voxel, inv_voxel: 1.0 / voxel, dims, values })
     }
 
     /// Edge length of a voxel (mesh units).
@@ -91,16 +78,6 @@ impl SignedDistanceGrid {
     /// Voxels along x, y, z.
     pub fn dims(&self) -> [usize; 3] {
         self.dims
-    }
-
-    /// The mesh's bounding box.
-    pub fn bounds(&self) -> Aabb {
-        self.bounds
-    }
-
-    /// The mesh's exact volume.
-    pub fn mesh_volume(&self) -> f32 {
-        self.mesh_volume
     }
 
     /// How far [`SignedDistanceGrid::distance`] may be from the true signed distance inside the grid:

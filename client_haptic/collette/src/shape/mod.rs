@@ -12,4 +12,4 @@ pub use distance_grid::SignedDistanceGrid;
 pub use mesh::TriMesh;
 pub use primitives::{box_buffers, torus_buffers, uv_sphere_buffers};
 pub use sphere::{Lens, Sphere, lens, lens_volume, sphere_volume};
-pub(crate) use sphere::{Lens4, lens_x4};
+pub(crate) use sphere::{Lens4, cap_moment, cap_volume, lens_x4};

@@ -59,14 +59,14 @@ pub fn lens_volume(r1: f32, r2: f32, d: f32) -> f32 {
 
 /// Volume of a spherical cap of height `h` (0..=2r) cut from a ball of radius `r`.
 #[inline(always)]
-fn cap_volume(r: f32, h: f32) -> f32 {
+pub(crate) fn cap_volume(r: f32, h: f32) -> f32 {
     PI * h * h * (3.0 * r - h) / 3.0
 }
 
 /// A cap's volume times the distance from the ball's centre to the cap's centroid (its first moment
 /// along the axis): `π h² (2r − h)² / 4` for a cap of height `h` cut from a ball of radius `r`.
 #[inline(always)]
-fn cap_moment(r: f32, h: f32) -> f32 {
+pub(crate) fn cap_moment(r: f32, h: f32) -> f32 {
     let a = h * (2.0 * r - h);
     PI * 0.25 * a * a
 }

@@ -190,9 +190,10 @@ fn run() -> anyhow::Result<()> {
         return lockstep(&args, device, tool, (bunny, surface), &config, replay.as_ref(), recording);
     }
     let rig = HapticRig::start(device, tool, config, HapticEvents::default(), Delegator::new())?;
+    let id = bunny.id;
     rig.add_object(bunny)?;
     if surface.is_some() {
-        rig.set_surface(1, surface)?;
+        rig.set_surface(id, surface)?;
     }
 
     let mut haptic = Vec::with_capacity(ticks);

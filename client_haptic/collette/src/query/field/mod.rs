@@ -16,10 +16,9 @@
 use crate::partitioning::InnerSphereTree;
 use crate::query::QueryWorkspace;
 use crate::query::overlap::{Budget, OverlapResult};
-use crate::shape::{SignedDistanceGrid, lens_volume, sphere_volume};
+use crate::shape::{SignedDistanceGrid, cap_moment, cap_volume, lens_volume, sphere_volume};
 use glam::Vec3;
 use haptic_common::{Contact, ContactSet, Pose};
-use std::f32::consts::PI;
 use std::time::Instant;
 
 /// Overlap of tree `a` at `pose_a` with the object B at `pose_b` — its tree `b` and its distance grid
@@ -135,8 +134,7 @@ fn descend(
                 let center = a_in_b.transform_point(node.bound.center);
                 let r = node.bound.radius;
                 let h = (r + b.distance(center)).clamp(0.0, 2.0 * r);
-                let volume =
-                    node.mesh_share * (PI * h * h * (3.0 * r - h) / 3.0) / sphere_volume(r).max(f32::MIN_POSITIVE);
+                let volume = node.mesh_share * cap_volume(r, h) / sphere_volume(r).max(f32::MIN_POSITIVE);
                 if volume > 0.0 {
                     result.total_volume += volume;
                     result.estimated_volume += volume;
@@ -245,7 +243,8 @@ impl Part {
         }
         let cut = Cut::of(b, c, r, f);
         let h = r + cut.distance;
-        let mut volume = PI * h * h * (3.0 * r - h) / 3.0;
+        let cap = cap_volume(r, h);
+        let mut volume = cap;
         let packed = cut.packed_share();
         if packed > 0.0 {
             volume += packed * (packed_part(tree, c, r, stack) - volume);
@@ -253,8 +252,8 @@ impl Part {
         if volume <= 0.0 {
             return None;
         }
-        let rest = 2.0 * r - h;
-        let offset = if h > 0.0 { 3.0 * rest * rest / (4.0 * (3.0 * r - h)) } else { r };
+        // The cap's centroid, towards B.
+        let offset = if cap > 0.0 { cap_moment(r, h) / cap } else { r };
         let into_b = cut.into_b;
         Some(Self { volume, centroid: c + into_b.normalize_or_zero() * offset, into_b: Some(into_b), depth: f + r })
     }

@@ -3,6 +3,7 @@ use crate::Budget;
 use crate::shape::{Sphere, TriMesh, box_buffers, torus_buffers, uv_sphere_buffers};
 use crate::{BuildOptions, build};
 use glam::Quat;
+use std::f32::consts::PI;
 
 /// A touched object: its tree and its distance grid.
 fn solid(
