@@ -51,8 +51,8 @@ pub struct RigTelemetry {
     pub contacts: u32,
     /// Newest collision step whose results were used (0: none yet, or nothing watched).
     pub collision_sequence: u64,
-    /// Age of the oldest tool pose those results rest on, µs (`u64::MAX` while a watcher has published
-    /// nothing; 0 with nothing watched).
+    /// Age of the oldest tool pose those results rest on, µs (for a watcher that has published nothing
+    /// yet, the time since its object was added; 0 with nothing watched).
     pub data_age_us: u64,
     /// Safety phase.
     pub safety_phase: SafetyPhase,
@@ -124,6 +124,9 @@ pub(crate) struct WatchedObject {
     pub(crate) reader: ObjectReader,
     pub(crate) material: Material,
     pub(crate) motion: BodyMotion,
+    /// Device time of the tick that started watching it (set by the haptic thread): until its watcher
+    /// first publishes, its data is as old as the time since then.
+    pub(crate) added_us: u64,
 }
 
 /// The reader of an object's watcher: overlaps (volumetric) or spheres near the tip (proxy).
@@ -170,7 +173,7 @@ impl ForceStage {
     /// One tick: adds the safe contact force to whatever earlier delegates added, then replaces the
     /// tick's total with the safety layer's output. Allocation-free.
     pub fn on_tick(&mut self, tick: &ForceOnHapticTick) {
-        self.apply_commands();
+        self.apply_commands(tick.device.timestamp_us);
         if self.rendering == Rendering::Proxy {
             return self.on_proxy_tick(tick);
         }
@@ -198,7 +201,7 @@ impl ForceStage {
         for object in self.objects.iter_mut() {
             let ObjectReader::Contacts(reader) = &mut object.reader else { continue };
             let set = reader.latest();
-            freshness.saw(set.sequence, set.timestamp_us, set.len());
+            freshness.saw(set.sequence, set.timestamp_us, set.len(), object.added_us);
             let ft =
                 volumetric_penalty(set, &tool_motion, &object.motion, &self.tool_material.combine(&object.material));
             contact.force += ft.force;
@@ -227,11 +230,13 @@ impl ForceStage {
         self.report(device, out, contact_device.force, tool_now.translation, tool_now, used);
     }
 
-    /// Applies the game thread's changes; what they replace goes back to be freed there.
-    fn apply_commands(&mut self) {
+    /// Applies the game thread's changes at device time `now_us`; what they replace goes back to be
+    /// freed there.
+    fn apply_commands(&mut self, now_us: u64) {
         while let Ok(command) = self.commands.pop() {
             match command {
-                ForceCommand::Add(object) => {
+                ForceCommand::Add(mut object) => {
+                    object.added_us = now_us;
                     if let Some(i) = self.objects.iter().position(|o| o.id == object.id) {
                         let old = std::mem::replace(&mut self.objects[i], object);
                         self.discard(old);
@@ -271,7 +276,7 @@ impl ForceStage {
         for (slot, object) in self.objects.iter_mut().enumerate() {
             let ObjectReader::Near(reader) = &mut object.reader else { continue };
             let set = reader.latest();
-            freshness.saw(set.sequence, set.timestamp_us, set.len());
+            freshness.saw(set.sequence, set.timestamp_us, set.len(), object.added_us);
             for s in set.as_slice().iter().take(self.balls.capacity() - self.balls.len()) {
                 self.balls.push(Ball { center: s.center, radius: s.radius });
                 self.ball_objects.push(slot as u8);
@@ -367,40 +372,43 @@ struct Freshness {
     objects: usize,
     sequence: u64,
     oldest_us: Option<u64>,
-    unread: bool,
     contacts: u32,
 }
 
 impl Freshness {
     fn new(objects: usize) -> Self {
-        Self { objects, sequence: 0, oldest_us: None, unread: false, contacts: 0 }
+        Self { objects, sequence: 0, oldest_us: None, contacts: 0 }
     }
 
-    /// Notes one watcher's result: its step, the timestamp of the pose it used, its size.
-    fn saw(&mut self, sequence: u64, timestamp_us: u64, len: usize) {
+    /// Notes one watcher's result: its step, the timestamp of the pose it used, its size; a watcher
+    /// that has published nothing yet counts as data from `added_us`, when the object was added (so
+    /// placing an object does not trip the watchdog unless the collision thread stays silent past it).
+    fn saw(&mut self, sequence: u64, timestamp_us: u64, len: usize, added_us: u64) {
         self.contacts += len as u32;
-        if sequence == 0 {
-            self.unread = true;
-            return;
-        }
-        self.sequence = self.sequence.max(sequence);
-        self.oldest_us = Some(self.oldest_us.map_or(timestamp_us, |t| t.min(timestamp_us)));
+        let from_us = if sequence == 0 {
+            added_us
+        } else {
+            self.sequence = self.sequence.max(sequence);
+            timestamp_us
+        };
+        self.oldest_us = Some(self.oldest_us.map_or(from_us, |t| t.min(from_us)));
     }
 
     /// The data used at `now_us`: its age is that of the oldest tool pose a watcher's result rests on
-    /// (`u64::MAX` while a watcher has published nothing yet; 0 with nothing watched: no data can be stale).
+    /// (for a watcher that has published nothing yet, the time since its object was added; 0 with
+    /// nothing watched: no data can be stale).
     fn used(&self, now_us: u64) -> Used {
-        let age_us = match (self.objects, self.unread, self.oldest_us) {
-            (0, _, _) => 0,
-            (_, true, _) | (_, _, None) => u64::MAX,
-            (_, false, Some(t)) => now_us.saturating_sub(t),
+        let age_us = match (self.objects, self.oldest_us) {
+            (0, _) => 0,
+            (_, None) => u64::MAX,
+            (_, Some(t)) => now_us.saturating_sub(t),
         };
         Used { contacts: self.contacts, sequence: self.sequence, age_us }
     }
 }
 
 /// The contact data a tick used: how many contacts (or spheres near the tip), the collision step's
-/// sequence, and its age in µs (`u64::MAX` before the first step).
+/// sequence, and its age in µs (`u64::MAX` when no watcher could be read).
 #[derive(Clone, Copy)]
 struct Used {
     contacts: u32,
@@ -409,7 +417,7 @@ struct Used {
 }
 
 impl Used {
-    /// The data's age for the safety layer's watchdog, seconds (infinite before the first step).
+    /// The data's age for the safety layer's watchdog, seconds (infinite when no watcher could be read).
     fn age_s(&self) -> f32 {
         if self.age_us == u64::MAX { f32::INFINITY } else { self.age_us as f32 * 1e-6 }
     }

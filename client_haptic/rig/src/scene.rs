@@ -80,7 +80,7 @@ impl Scene {
             orientation: spec.pose.rotation,
             ..BodyMotion::at_rest(spec.pose.transform_point(center_of_mass(&spec.tree)))
         };
-        let object = Box::new(WatchedObject { id: spec.id, reader, material: spec.material, motion });
+        let object = Box::new(WatchedObject { id: spec.id, reader, material: spec.material, motion, added_us: 0 });
         self.forces.push(ForceCommand::Add(object)).map_err(|_| RigError::QueueFull("haptic"))?;
         self.entries.push(Entry { id: spec.id, object: pose.id(), watcher, _pose: pose });
         Ok(())

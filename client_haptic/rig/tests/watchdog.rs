@@ -56,3 +56,46 @@ fn pausing_the_collision_thread_ramps_the_force_to_zero() {
     }
     assert!(rig.telemetry().output.force.length() > 0.3, "forces come back once data is fresh");
 }
+
+#[test]
+fn placing_an_object_keeps_the_force_whole_until_its_first_collision_step() {
+    let device = SimDevice::new(
+        SimConfig::new(presets::touch()),
+        TargetPath::line(Vec3::new(0.0, 0.02, 0.0), Vec3::new(0.0, -0.004, 0.0), 0.5),
+    );
+    let safety = SafetyConfig { ramp_in_s: 0.05, ..SafetyConfig::for_limits(3.3, 0.0) };
+    let config = RigConfig { safety: Some(safety), ..RigConfig::default() };
+    let tool = ToolSpec::new(utils::ball_tool(), Material::default());
+    // A collision step every 10 ticks: a watcher added just after one publishes 9 ticks later.
+    let mut rig = Lockstep::new(device, tool, &config, 10, None).expect("rig");
+    let slab = Material { stiffness_n_per_m3: 1e9, damping_ns_per_m: 1.0, friction: 0.0, texture: None };
+    let spec = |id, y| ObjectSpec {
+        id,
+        tree: utils::slab(),
+        pose: Pose::from_translation(Vec3::new(0.0, y, 0.0)),
+        material: slab,
+    };
+    rig.add_object(spec(7, -0.01)).expect("object");
+    let mut t = 0u64;
+    for _ in 0..1501 {
+        rig.tick(t);
+        t += 1000;
+    }
+    let pushing = rig.telemetry().output.force.length();
+    let stale_before = rig.telemetry().safety.stale;
+    assert!(pushing > 0.3, "in contact: {pushing} N");
+
+    // A second object, far below, placed while the tool presses on the first.
+    rig.add_object(spec(8, -0.5)).expect("object");
+    let forces: Vec<f32> = (0..300)
+        .map(|_| {
+            let f = rig.tick(t).force.length();
+            t += 1000;
+            f
+        })
+        .collect();
+    let weakest = forces.iter().copied().fold(f32::INFINITY, f32::min);
+    assert!(weakest > 0.9 * pushing, "the force dipped to {weakest} N of {pushing} N while the new watcher was silent");
+    let tel = rig.telemetry();
+    assert_eq!((tel.safety.stale, tel.safety_gain), (stale_before, 1.0), "the watchdog stayed quiet");
+}
