@@ -11,8 +11,10 @@
 //! 2. a light press on a plain part and a stroke down and up: the drag against the motion over the
 //!    normal force gives the friction, and a push along the stroke that repeats with the height gives the
 //!    ridges: a copy with ridges ([`RIDGES_ABOVE`]) that grips ([`ROUGH_ABOVE`]) is rough (ribbed).
-//!    A stroke that was mostly out of touch (the press met nothing) says nothing: the hand backs off
-//!    and presses again, a little deeper, up to [`ATTEMPTS`] times.
+//!    A stroke that was mostly out of touch (the press met nothing) says nothing, and says the pokes
+//!    went wrong where the press went (the surface was not where they found it): the exploration starts
+//!    over while another of its [`ATTEMPTS`] is allowed; on the last one the hand backs off and presses
+//!    again, a little deeper, up to [`ATTEMPTS`] times.
 //!
 //! A hand can only judge what it felt at full force: when the haptic loop stalls (the process was not
 //! scheduled) or the contact data goes stale, the safety layer fades the forces out and back in over two
@@ -125,15 +127,39 @@ pub struct Findings {
     pub ridges: Option<(f32, f32)>,
     /// The material class these make (ribbed when ridges were felt).
     pub material: MaterialClass,
-    /// Explorations it took (more than one when the haptic loop was disturbed during one).
+    /// Explorations it took (more than one when the haptic loop was disturbed during one, or when the
+    /// first stroke of one met nothing).
     pub attempts: u32,
+    /// Explorations started over because their first stroke met nothing where their pokes had found
+    /// the surface.
+    pub unconfirmed: u32,
     /// Presses in the last exploration (more than one when a stroke was mostly out of touch).
     pub presses: u32,
     /// Share of the last stroke's sliding samples that were in touch, 0–1.
     pub stroke_contact: f32,
     /// Whether the last exploration was disturbed too (after [`ATTEMPTS`]): the figures are suspect.
     pub disturbed: bool,
+    /// What disturbed the haptic loop during the explorations (the first few spells of each), for the log.
+    pub disturbances: Vec<Disturbance>,
 }
+
+/// A spell in which the forces were not whole: the haptic loop stalled or the contact data went stale
+/// (it spoils the exploration when a stage measured within 2.5 s of it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Disturbance {
+    /// Which exploration (1-based).
+    pub attempt: u32,
+    /// Seconds since the exploration of the copy began.
+    pub at_s: f32,
+    /// The gap between two haptic ticks (a stall) or the contact data's age (stale data), ms.
+    pub gap_ms: f32,
+    /// True for stale contact data, false for a stall.
+    pub stale: bool,
+    stage: Stage,
+}
+
+/// Spells of disturbance recorded per exploration.
+const MAX_DISTURBANCES: usize = 4;
 
 impl Findings {
     /// Whether the copy matches the briefing.
@@ -143,11 +169,22 @@ impl Findings {
 
     /// The figures, for the log.
     pub fn describe(&self) -> String {
-        let attempts = match (self.attempts, self.disturbed) {
-            (_, true) => format!(" (disturbed in all {} explorations)", self.attempts),
-            (1, false) => String::new(),
-            (n, false) => format!(" ({n} explorations: the earlier ones were disturbed)"),
+        let attempts = match (self.attempts, self.disturbed, self.unconfirmed) {
+            (_, true, _) => format!(" (disturbed in all {} explorations)", self.attempts),
+            (1, false, _) => String::new(),
+            (n, false, 0) => format!(" ({n} explorations: the earlier ones were disturbed)"),
+            (n, false, u) => format!(" ({n} explorations: {u} with a first stroke that met nothing)"),
         };
+        let why: Vec<String> = self
+            .disturbances
+            .iter()
+            .map(|d| {
+                let what = if d.stale { "stale contact data" } else { "a stall" };
+                let stage = format!("{:?}", d.stage).to_lowercase();
+                format!("{what} of {:.0} ms at {:.1} s ({stage}, exploration {})", d.gap_ms, d.at_s, d.attempt)
+            })
+            .collect();
+        let attempts = if why.is_empty() { attempts } else { format!("{attempts} [{}]", why.join("; ")) };
         let presses = match self.presses {
             0 | 1 => String::new(),
             n => format!(" ({n} presses: the earlier strokes met nothing)"),
@@ -243,7 +280,12 @@ pub struct Exploration {
     calm_from_us: u64,
     /// Whether this attempt measured before `calm_from_us`.
     disturbed: bool,
+    /// What disturbed the haptic loop (the first event of each spell).
+    disturbances: Vec<Disturbance>,
+    /// Haptic-clock time the exploration began.
+    began_us: u64,
     attempts: u32,
+    unconfirmed: u32,
     findings: Option<Findings>,
     /// With 3-DOF proxy rendering: resting force over depth (N/m) above which a copy feels hard.
     hard_above_n_per_m: Option<f32>,
@@ -278,7 +320,10 @@ impl Exploration {
             last: None,
             calm_from_us: 0,
             disturbed: false,
+            disturbances: Vec::with_capacity(2 * ATTEMPTS as usize),
+            began_us: now_us,
             attempts: 1,
+            unconfirmed: 0,
             findings: None,
             hard_above_n_per_m: None,
         }
@@ -313,10 +358,17 @@ impl Exploration {
             self.take(s);
         }
         // A disturbed attempt stops at once when another is allowed; the last one runs to its end.
-        let start_over = self.stage.measures() && self.disturbed && self.attempts < ATTEMPTS;
-        if (now_us < self.stage_end_us && !start_over) || self.stage == Stage::Done {
+        let disturbed = self.stage.measures() && self.disturbed && self.attempts < ATTEMPTS;
+        if (now_us < self.stage_end_us && !disturbed) || self.stage == Stage::Done {
             return false;
         }
+        // A first stroke that met nothing where the pokes found the surface says they went wrong there
+        // (one missed notch moves the plain part into it): explore again while another attempt is
+        // allowed; the last one presses deeper.
+        let unconfirmed =
+            self.stage == Stage::SlideUp && self.presses == 1 && self.stroke_missed() && self.attempts < ATTEMPTS;
+        self.unconfirmed += u32::from(unconfirmed && !disturbed);
+        let start_over = disturbed || unconfirmed;
         let (y, r_out, r_in, y_press) = ring(self.kind);
         let start = now_us + 10_000;
         let at = self.goal.sample(now_us).translation;
@@ -411,8 +463,20 @@ impl Exploration {
             Some((t, q)) if s.t_us > t => (p - q) / ((s.t_us - t) as f32 * 1e-6),
             _ => Vec3::ZERO,
         };
-        let stalled = self.last.is_some_and(|(t, _)| s.t_us > t + STALL_US);
+        let gap_us = self.last.map_or(0, |(t, _)| s.t_us.saturating_sub(t));
+        let stalled = gap_us > STALL_US;
         if stalled || s.data_age_us > STALE_US {
+            // The first event of each spell, a few per exploration.
+            let this_attempt = self.disturbances.iter().filter(|d| d.attempt == self.attempts).count();
+            if s.t_us >= self.calm_from_us && this_attempt < MAX_DISTURBANCES {
+                self.disturbances.push(Disturbance {
+                    attempt: self.attempts,
+                    at_s: s.t_us.saturating_sub(self.began_us) as f32 * 1e-6,
+                    gap_ms: if stalled { gap_us as f32 } else { s.data_age_us as f32 } * 1e-3,
+                    stale: !stalled,
+                    stage: self.stage,
+                });
+            }
             self.calm_from_us = s.t_us + RECOVER_US;
         }
         self.disturbed |= self.stage.measures() && s.t_us < self.calm_from_us;
@@ -565,9 +629,11 @@ impl Exploration {
             ridges,
             material,
             attempts: self.attempts,
+            unconfirmed: self.unconfirmed,
             presses: self.presses,
             stroke_contact: if self.stroke.0 > 0 { self.stroke.1 as f32 / self.stroke.0 as f32 } else { 0.0 },
             disturbed: self.disturbed,
+            disturbances: self.disturbances.clone(),
         }
     }
 }
@@ -846,13 +912,30 @@ mod tests {
     }
 
     #[test]
-    fn a_stroke_that_met_nothing_is_pressed_again_deeper() {
+    fn a_first_stroke_that_met_nothing_explores_again() {
+        let (_, r_out, ..) = ring(ArtifactKind::Idol);
+        // The stylus stays out through the first exploration's stroke.
+        let held = |ex: &Exploration, _| {
+            (matches!(ex.stage, Stage::SlideDown | Stage::SlideUp) && ex.attempts == 1)
+                .then_some(Vec3::new(r_out, 0.0, 0.0))
+        };
+        let (findings, stages, _) = run_held(|_| Some(1_000), held);
+        assert_eq!((findings.attempts, findings.unconfirmed, findings.presses), (2, 1, 1), "{stages:?}");
+        assert_eq!(stages.iter().filter(|(s, _)| *s == Stage::Taps).count(), 2, "poked again: {stages:?}");
+        assert_eq!(findings.feature_count, 1);
+        assert!(findings.stroke_contact > 0.9, "the second stroke touched: {findings:?}");
+        assert!(findings.describe().contains("1 with a first stroke that met nothing"), "{}", findings.describe());
+    }
+
+    #[test]
+    fn on_the_last_exploration_a_stroke_that_met_nothing_is_pressed_again_deeper() {
         let (_, r_out, ..) = ring(ArtifactKind::Idol);
         let radial = |p: Vec3| Vec3::new(p.x, 0.0, p.z).length();
-        // The stylus stays out through the first stroke; how deep each press reaches for is noted.
+        // The stylus stays out through each exploration's first stroke; how deep each press of the last
+        // exploration reaches for is noted.
         let deepest = std::cell::RefCell::new([f32::INFINITY; ATTEMPTS as usize]);
         let held = |ex: &Exploration, t| {
-            if ex.stage == Stage::Press {
+            if ex.stage == Stage::Press && ex.attempts == ATTEMPTS {
                 let d = &mut deepest.borrow_mut()[ex.presses as usize - 1];
                 *d = d.min(radial(ex.goal.sample(t).translation));
             }
@@ -863,8 +946,8 @@ mod tests {
         let deepest = deepest.into_inner();
         assert!((deepest[0] - (ex.surface - REACH_M)).abs() < 1e-4, "{deepest:?}");
         assert!((deepest[0] - deepest[1] - DEEPER_M).abs() < 1e-4, "the second press reaches 2 mm deeper: {deepest:?}");
-        assert_eq!(findings.presses, 2, "{stages:?}");
-        assert_eq!(stages.iter().filter(|(s, _)| *s == Stage::Press).count(), 2, "{stages:?}");
+        assert_eq!((findings.attempts, findings.unconfirmed, findings.presses), (ATTEMPTS, ATTEMPTS - 1, 2));
+        assert_eq!(stages.iter().filter(|(s, _)| *s == Stage::Press).count(), ATTEMPTS as usize + 1, "{stages:?}");
         assert!(findings.stroke_contact > 0.9, "the second stroke touched: {findings:?}");
         assert!(findings.describe().contains("2 presses"), "{}", findings.describe());
         let press = ex.goal.sample(u64::MAX);
@@ -905,6 +988,15 @@ mod tests {
         assert_eq!(taps.len(), 2, "{stages:?}");
         assert!(taps[1] >= 6_500_000 + RECOVER_US, "the new taps wait for the forces: {stages:?}");
         assert_eq!(at(Stage::Return).len(), 1, "{stages:?}");
+        // The log says what disturbed it, when and where.
+        assert_eq!(findings.disturbances.len(), 1, "{:?}", findings.disturbances);
+        let d = findings.disturbances[0];
+        assert!((d.attempt, d.stale, d.stage) == (1, false, Stage::Taps) && (d.gap_ms - 1_501.0).abs() < 10.0, "{d:?}");
+        assert!(
+            findings.describe().contains("a stall of 1501 ms at 6.5 s (taps, exploration 1)"),
+            "{}",
+            findings.describe()
+        );
     }
 
     #[test]

@@ -35,6 +35,8 @@ fn every_copy_is_told_right(rendering: RenderingChoice, expect: Rendering) {
             let f = feel(&mut h, &copy, kind).expect("the copy is explored");
             println!("{kind:?} {} {:?}: felt {}", traits.feature_count, traits.material, f.describe());
             if f.feature_count != traits.feature_count || f.material != traits.material {
+                let mm: Vec<String> = f.profile.iter().map(|r| format!("{:.1}", r * 1e3)).collect();
+                println!("  misjudged; its profile (mm from the axis, poke by poke): {}", mm.join(" "));
                 wrong.push((kind, traits.feature_count, traits.material, f.feature_count, f.material));
             }
         }
