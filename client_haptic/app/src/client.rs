@@ -535,7 +535,7 @@ fn touch_bot(
         && haptics.on_bench.as_ref().is_some_and(|o| o.item == item)
         && state.judged != Some(item)
     {
-        let ex = Exploration::new(kind, now).judging_springs(haptics.hard_above_n_per_m());
+        let ex = Exploration::new(kind, now, haptics.stylus()).judging_springs(haptics.hard_above_n_per_m());
         if let Some(hand) = haptics.hand.as_mut() {
             hand.set(to_device(&map, ex.goal()));
         }

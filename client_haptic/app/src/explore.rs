@@ -218,6 +218,12 @@ impl Findings {
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Stage {
+    /// From wherever the hand is, straight out from the copy's axis to the ring of pokes' radius (or
+    /// stays out where it is farther).
+    Arrive,
+    /// Round the copy at that radius and height to where the pokes start.
+    Circle,
+    /// In (or down) to where the pokes start.
     Settle,
     /// After a disturbance: out to the ring of pokes, waiting there for the forces to come back.
     Retreat,
@@ -292,20 +298,28 @@ pub struct Exploration {
 }
 
 impl Exploration {
-    /// Starts exploring a copy of `kind` at haptic-clock time `now_us`.
-    pub fn new(kind: ArtifactKind, now_us: u64) -> Self {
-        let (y, r_out, ..) = ring(kind);
+    /// Starts exploring a copy of `kind` at haptic-clock time `now_us`, with the stylus at `hand`
+    /// (workbench frame: [`crate::haptics::Haptics::stylus`]). The hand first goes out from the
+    /// copy's axis and round it to where the pokes start, never across the copy: a hand that jumped
+    /// straight there from the far side (where the last exploration ended) pulled the stylus through
+    /// the copy, and the 3-DOF proxy, which lets go only once the way back is free, held it inside,
+    /// 3 mm deep, for half the ring of pokes (a whole side of an idol read as one flat run).
+    pub fn new(kind: ArtifactKind, now_us: u64, hand: Vec3) -> Self {
+        let (_, r_out, ..) = ring(kind);
+        let hand = if hand.is_finite() { hand } else { Vec3::new(r_out, 0.0, 0.0) };
+        let out = Vec3::new(hand.x, 0.0, hand.z).try_normalize().unwrap_or(Vec3::X);
+        let radius = Vec3::new(hand.x, 0.0, hand.z).length().max(r_out);
         Self {
             kind,
-            stage: Stage::Settle,
+            stage: Stage::Arrive,
             goal: HandGoal::Line {
-                from: Vec3::new(r_out, y + 0.05, 0.0),
-                to: Vec3::new(r_out, y, 0.0),
-                duration_s: 0.6,
+                from: hand,
+                to: Vec3::new(0.0, hand.y, 0.0) + out * radius,
+                duration_s: 0.3,
                 start_us: now_us,
             },
             stage_start_us: now_us,
-            stage_end_us: now_us + 1_000_000,
+            stage_end_us: now_us + 350_000,
             taps_start_us: 0,
             tap_touch: vec![None; taps(kind)],
             tap_min: vec![f32::INFINITY; taps(kind)],
@@ -376,6 +390,14 @@ impl Exploration {
         let axis = Vec3::new(0.0, y_press, 0.0);
         let centre = Vec3::new(0.0, y, 0.0);
         let (next, goal, seconds) = match self.stage {
+            Stage::Arrive => {
+                let (radius, start_rad) = (Vec3::new(at.x, 0.0, at.z).length(), (-at.z).atan2(at.x));
+                let turns = ((-start_rad) / TAU + 0.5).rem_euclid(1.0) - 0.5;
+                let centre = Vec3::new(0.0, at.y, 0.0);
+                let round = HandGoal::Orbit { centre, radius, start_rad, period_s: 3.0, turns, start_us: start };
+                (Stage::Circle, round, 3.0 * turns.abs() + 0.05)
+            }
+            Stage::Circle => (Stage::Settle, line(at, Vec3::new(r_out, y, 0.0), 0.6), 1.0),
             _ if start_over => {
                 // Straight out from the axis (never across the copy) to the ring, and wait there.
                 self.attempts += 1;
@@ -721,7 +743,7 @@ pub fn feel(
         }
         std::thread::sleep(Duration::from_millis(5));
     }
-    let mut ex = Exploration::new(kind, h.now_us()).judging_springs(h.hard_above_n_per_m());
+    let mut ex = Exploration::new(kind, h.now_us(), h.stylus()).judging_springs(h.hard_above_n_per_m());
     let map = h.map;
     let hand = |h: &mut crate::haptics::Haptics, goal| {
         h.hand.as_mut().map(|c| c.set(to_device(&map, goal))).ok_or("the device has no steerable hand")
@@ -831,6 +853,12 @@ mod tests {
         if (angle - std::f32::consts::PI).abs() < 0.55 { 0.005 } else { 0.0 }
     }
 
+    /// Where the tests' hand starts: above where the pokes start.
+    fn start() -> Vec3 {
+        let (y, r_out, ..) = ring(ArtifactKind::Idol);
+        Vec3::new(r_out, y + 0.05, 0.0)
+    }
+
     /// Runs an exploration of an idol (a cylinder of [`body_radius`] with a [`notch`], 200 N/m) on a hand that follows
     /// its goal exactly, with frames every 8 ms; `tick(t_us)` says whether the haptic loop ticks at
     /// `t_us` and how old its contact data is. Returns the findings and the stages seen, with the time
@@ -843,10 +871,19 @@ mod tests {
     /// [`run`], with the tool held at `held(exploration, t_us)` instead of the goal when that says so;
     /// also returns the exploration.
     fn run_held(
+        tick: impl FnMut(u64) -> Option<u32>,
+        held: impl Fn(&Exploration, u64) -> Option<Vec3>,
+    ) -> (Findings, Vec<(Stage, u64)>, Exploration) {
+        run_from(start(), tick, held)
+    }
+
+    /// [`run_held`] with the hand starting at `hand`.
+    fn run_from(
+        hand: Vec3,
         mut tick: impl FnMut(u64) -> Option<u32>,
         held: impl Fn(&Exploration, u64) -> Option<Vec3>,
     ) -> (Findings, Vec<(Stage, u64)>, Exploration) {
-        let mut ex = Exploration::new(ArtifactKind::Idol, 0);
+        let mut ex = Exploration::new(ArtifactKind::Idol, 0, hand);
         let mut stages = vec![(ex.stage, 0)];
         let mut samples = Vec::new();
         for frame in 1..40_000u64 {
@@ -912,6 +949,35 @@ mod tests {
     }
 
     #[test]
+    fn the_hand_goes_round_the_copy_to_the_first_poke_never_across_it() {
+        let (y, r_out, ..) = ring(ArtifactKind::Idol);
+        let radial = |p: Vec3| Vec3::new(p.x, 0.0, p.z).length();
+        // Where the last exploration ended: out from a press on the far side, a little lower.
+        let far = Vec3::new(-(r_out + 0.02), y - 0.01, 0.003);
+        let nearest = std::cell::Cell::new(f32::INFINITY);
+        let first = std::cell::Cell::new(None);
+        let held = |ex: &Exploration, t| {
+            if matches!(ex.stage, Stage::Arrive | Stage::Circle | Stage::Settle) {
+                let p = ex.goal.sample(t).translation;
+                first.set(first.get().or(Some(p)));
+                nearest.set(nearest.get().min(radial(p)));
+            }
+            None
+        };
+        let (findings, stages, _) = run_from(far, |_| Some(1_000), held);
+        assert!(first.get().is_some_and(|p| p.distance(far) < 1e-4), "starts where the hand is: {:?}", first.get());
+        assert!(nearest.get() > r_out - 1e-4, "{} m from the axis, the ring is at {r_out} m", nearest.get());
+        let order: Vec<Stage> = stages.iter().map(|(s, _)| *s).take(4).collect();
+        assert_eq!(order, [Stage::Arrive, Stage::Circle, Stage::Settle, Stage::Taps]);
+        assert_eq!((findings.feature_count, findings.attempts), (1, 1), "{findings:?}");
+        // A hand inside the ring goes straight out first.
+        let near = Vec3::new(0.0, y, 0.02);
+        let ex = Exploration::new(ArtifactKind::Idol, 0, near);
+        let out = ex.goal.sample(1_000_000).translation;
+        assert!((radial(out) - r_out).abs() < 1e-5 && out.x.abs() < 1e-6 && out.y == y, "{out:?}");
+    }
+
+    #[test]
     fn a_first_stroke_that_met_nothing_explores_again() {
         let (_, r_out, ..) = ring(ArtifactKind::Idol);
         // The stylus stays out through the first exploration's stroke.
@@ -965,10 +1031,11 @@ mod tests {
     fn a_missed_poke_where_the_press_goes_takes_the_surface_from_the_poke_before() {
         let (_, r_out, ..) = ring(ArtifactKind::Idol);
         // The press goes to the first poke's angle, opposite the notch; the stylus stays out through
-        // that poke (the taps start 1.01 s in).
-        let poke = 1_010_000..1_010_000 + (TAP_S * 1e6) as u64;
-        let held =
-            |ex: &Exploration, t| (ex.stage == Stage::Taps && poke.contains(&t)).then_some(Vec3::new(r_out, 0.0, 0.0));
+        // that poke.
+        let poke = |ex: &Exploration| ex.taps_start_us..ex.taps_start_us + (TAP_S * 1e6) as u64;
+        let held = |ex: &Exploration, t| {
+            (ex.stage == Stage::Taps && poke(ex).contains(&t)).then_some(Vec3::new(r_out, 0.0, 0.0))
+        };
         let (findings, _, ex) = run_held(|_| Some(1_000), held);
         assert!(ex.touches()[0].is_none() && ex.press_angle == 0.0, "{findings:?}");
         assert!((ex.surface - body_radius()).abs() < 0.001, "the surface where the cylinder is: {}", ex.surface);
@@ -1002,17 +1069,20 @@ mod tests {
     #[test]
     fn a_poke_the_stylus_did_not_follow_reads_as_the_one_before() {
         let (_, r_out, ..) = ring(ArtifactKind::Idol);
-        // The stylus stays out through the eighth poke (the taps start 1.01 s in).
-        let poke = 1_010_000 + (7.0 * TAP_S * 1e6) as u64..1_010_000 + (8.0 * TAP_S * 1e6) as u64;
-        let held =
-            |ex: &Exploration, t| (ex.stage == Stage::Taps && poke.contains(&t)).then_some(Vec3::new(r_out, 0.0, 0.0));
+        // The stylus stays out through the eighth poke.
+        let poke = |ex: &Exploration| {
+            ex.taps_start_us + (7.0 * TAP_S * 1e6) as u64..ex.taps_start_us + (8.0 * TAP_S * 1e6) as u64
+        };
+        let held = |ex: &Exploration, t| {
+            (ex.stage == Stage::Taps && poke(ex).contains(&t)).then_some(Vec3::new(r_out, 0.0, 0.0))
+        };
         let (findings, stages, _) = run_held(|_| Some(1_000), held);
         assert_eq!(stages.iter().filter(|(s, _)| *s == Stage::Taps).count(), 1, "{stages:?}");
         assert_eq!((findings.attempts, findings.disturbed), (1, false), "{stages:?}");
         assert_eq!(findings.profile[7], findings.profile[6], "{:?}", findings.profile);
         assert!(findings.profile[7] < r_out - 0.01, "{:?}", findings.profile);
         // A missed poke reads as the one before it, the first as the last.
-        let mut ex = Exploration::new(ArtifactKind::Idol, 0);
+        let mut ex = Exploration::new(ArtifactKind::Idol, 0, start());
         ex.tap_min.fill(0.02);
         ex.tap_min[7] = r_out;
         ex.tap_min[3] = 0.025;
@@ -1057,7 +1127,7 @@ mod tests {
              32.2 37.0 37.1 37.1",
         ];
         for (i, profile) in felt.iter().enumerate() {
-            let mut ex = Exploration::new(ArtifactKind::Idol, 0);
+            let mut ex = Exploration::new(ArtifactKind::Idol, 0, start());
             let mm: Vec<f32> = profile.split_whitespace().map(|v| v.parse::<f32>().unwrap() * 1e-3).collect();
             assert_eq!(mm.len(), 48);
             (ex.tap_touch, ex.tap_min) = (vec![None; 48], vec![f32::INFINITY; 48]);

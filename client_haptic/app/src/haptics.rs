@@ -241,6 +241,11 @@ impl Haptics {
         self.rig.telemetry()
     }
 
+    /// Where the stylus's tip is now, in the scene (the workbench's) frame.
+    pub fn stylus(&self) -> Vec3 {
+        self.map.to_scene(&self.telemetry().device.pose).translation
+    }
+
     /// Whether 6-DOF torques reach the device.
     pub fn renders_torque(&self) -> bool {
         self.specs.renders_torque() && self.rendering != Rendering::Proxy
