@@ -10,8 +10,9 @@ use haptic_rig::{ObjectSpec, RigConfig, ToolSpec};
 use haptico::presets;
 use haptico::sim::{SimConfig, SimDevice, TargetPath};
 
-#[test]
-fn pausing_the_collision_thread_ramps_the_force_to_zero() {
+/// A lockstep rig (a collision step every `collision_every` ticks) whose ball tool moves down onto a
+/// stiff slab (object 7, its top at y = 0), with a 50 ms ramp-in; and a slab `id` whose top is at `y`.
+fn pressing(collision_every: u64) -> (Lockstep<SimDevice>, impl Fn(u32, f32) -> ObjectSpec) {
     let device = SimDevice::new(
         SimConfig::new(presets::touch()),
         TargetPath::line(Vec3::new(0.0, 0.02, 0.0), Vec3::new(0.0, -0.004, 0.0), 0.5),
@@ -19,15 +20,21 @@ fn pausing_the_collision_thread_ramps_the_force_to_zero() {
     let safety = SafetyConfig { ramp_in_s: 0.05, ..SafetyConfig::for_limits(3.3, 0.0) };
     let config = RigConfig { safety: Some(safety), ..RigConfig::default() };
     let tool = ToolSpec::new(utils::ball_tool(), Material::default());
-    let mut rig = Lockstep::new(device, tool, &config, 1, None).expect("rig");
+    let mut rig = Lockstep::new(device, tool, &config, collision_every, None).expect("rig");
     let slab = Material { stiffness_n_per_m3: 1e9, damping_ns_per_m: 1.0, friction: 0.0, texture: None };
-    rig.add_object(ObjectSpec {
-        id: 7,
+    let spec = move |id, y| ObjectSpec {
+        id,
         tree: utils::slab(),
-        pose: Pose::from_translation(Vec3::new(0.0, -0.01, 0.0)),
+        pose: Pose::from_translation(Vec3::new(0.0, y - 0.01, 0.0)),
         material: slab,
-    })
-    .expect("object");
+    };
+    rig.add_object(spec(7, 0.0)).expect("object");
+    (rig, spec)
+}
+
+#[test]
+fn pausing_the_collision_thread_ramps_the_force_to_zero() {
+    let (mut rig, _) = pressing(1);
     let mut t = 0u64;
     for _ in 0..1500 {
         rig.tick(t);
@@ -59,23 +66,8 @@ fn pausing_the_collision_thread_ramps_the_force_to_zero() {
 
 #[test]
 fn placing_an_object_keeps_the_force_whole_until_its_first_collision_step() {
-    let device = SimDevice::new(
-        SimConfig::new(presets::touch()),
-        TargetPath::line(Vec3::new(0.0, 0.02, 0.0), Vec3::new(0.0, -0.004, 0.0), 0.5),
-    );
-    let safety = SafetyConfig { ramp_in_s: 0.05, ..SafetyConfig::for_limits(3.3, 0.0) };
-    let config = RigConfig { safety: Some(safety), ..RigConfig::default() };
-    let tool = ToolSpec::new(utils::ball_tool(), Material::default());
     // A collision step every 10 ticks: a watcher added just after one publishes 9 ticks later.
-    let mut rig = Lockstep::new(device, tool, &config, 10, None).expect("rig");
-    let slab = Material { stiffness_n_per_m3: 1e9, damping_ns_per_m: 1.0, friction: 0.0, texture: None };
-    let spec = |id, y| ObjectSpec {
-        id,
-        tree: utils::slab(),
-        pose: Pose::from_translation(Vec3::new(0.0, y, 0.0)),
-        material: slab,
-    };
-    rig.add_object(spec(7, -0.01)).expect("object");
+    let (mut rig, spec) = pressing(10);
     let mut t = 0u64;
     for _ in 0..1501 {
         rig.tick(t);
@@ -86,7 +78,7 @@ fn placing_an_object_keeps_the_force_whole_until_its_first_collision_step() {
     assert!(pushing > 0.3, "in contact: {pushing} N");
 
     // A second object, far below, placed while the tool presses on the first.
-    rig.add_object(spec(8, -0.5)).expect("object");
+    rig.add_object(spec(8, -0.49)).expect("object");
     let forces: Vec<f32> = (0..300)
         .map(|_| {
             let f = rig.tick(t).force.length();
