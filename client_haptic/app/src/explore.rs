@@ -73,7 +73,7 @@ const RECOVER_US: u64 = 2_500_000;
 pub fn hard_above_n_per_m2(kind: ArtifactKind, rough: bool) -> f32 {
     match (kind, rough) {
         (ArtifactKind::Crown, false) => 30_000.0,
-        (ArtifactKind::Crown, true) => 140_000.0,
+        (ArtifactKind::Crown, true) => 300_000.0,
         (ArtifactKind::Amphora, _) => 550_000.0,
         (ArtifactKind::Idol, false) => 60_000.0,
         (ArtifactKind::Idol, true) => 190_000.0,
