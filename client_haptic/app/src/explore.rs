@@ -393,11 +393,10 @@ impl Exploration {
         let centre = Vec3::new(0.0, y, 0.0);
         let (next, goal, seconds) = match self.stage {
             Stage::Arrive => {
-                let (radius, start_rad) = (Vec3::new(at.x, 0.0, at.z).length(), (-at.z).atan2(at.x));
-                let turns = ((-start_rad) / TAU + 0.5).rem_euclid(1.0) - 0.5;
-                let centre = Vec3::new(0.0, at.y, 0.0);
-                let round = HandGoal::Orbit { centre, radius, start_rad, period_s: 3.0, turns, start_us: start };
-                (Stage::Circle, round, 3.0 * turns.abs() + 0.05)
+                // At the height and distance from the axis where the hand now is.
+                let radius = Vec3::new(at.x, 0.0, at.z).length();
+                let (round, seconds) = short_way_round(at, Vec3::new(0.0, at.y, 0.0), radius, 0.0, start);
+                (Stage::Circle, round, seconds)
             }
             Stage::Circle => (Stage::Settle, line(at, Vec3::new(r_out, y, 0.0), 0.6), 1.0),
             _ if start_over => {
@@ -430,10 +429,8 @@ impl Exploration {
                 let touches = self.touches();
                 let near = (n + k - PRESS_SPAN..=n + k + PRESS_SPAN).filter_map(|i| touches[i % n]).collect();
                 self.surface = median(near).unwrap_or(r_in + 0.007);
-                let start_rad = (-at.z).atan2(at.x);
-                let turns = ((self.press_angle - start_rad) / TAU + 0.5).rem_euclid(1.0) - 0.5;
-                let round = HandGoal::Orbit { centre, radius: r_out, start_rad, period_s: 3.0, turns, start_us: start };
-                (Stage::Round, round, 3.0 * turns.abs() + 0.05)
+                let (round, seconds) = short_way_round(at, centre, r_out, self.press_angle, start);
+                (Stage::Round, round, seconds)
             }
             Stage::Round => (Stage::Approach, line(at, axis + self.press_normal * r_out, 0.4), 0.5),
             Stage::Approach => {
@@ -660,6 +657,14 @@ impl Exploration {
             disturbances: self.disturbances.clone(),
         }
     }
+}
+
+/// Round the copy's axis from `at`'s angle to `to_rad`, the short way, on a circle of `radius` about
+/// `centre` (one turn in 3 s), starting at `start_us`; and how long the stage lasts, s.
+fn short_way_round(at: Vec3, centre: Vec3, radius: f32, to_rad: f32, start_us: u64) -> (HandGoal, f32) {
+    let start_rad = (-at.z).atan2(at.x);
+    let turns = ((to_rad - start_rad) / TAU + 0.5).rem_euclid(1.0) - 0.5;
+    (HandGoal::Orbit { centre, radius, start_rad, period_s: 3.0, turns, start_us }, 3.0 * turns.abs() + 0.05)
 }
 
 /// One in-touch sample of a stroke: the stylus's height, the contact force along the stroke and into
