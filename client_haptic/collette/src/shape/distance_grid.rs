@@ -7,12 +7,14 @@
 use crate::error::BuildError;
 use crate::packing::{MAX_VOXELS, to_parry_oriented};
 use crate::shape::TriMesh;
-use glam::Vec3;
+use glam::{Vec3, Vec4, Vec4Swizzles};
 use parry3d::query::PointQuery;
 use rayon::prelude::*;
 
 /// Signed distance to a closed mesh's surface (positive inside, metres of the mesh) at the centres of
-/// a regular grid that reaches [`SignedDistanceGrid::MARGIN_VOXELS`] past the mesh's box.
+/// a regular grid that reaches [`SignedDistanceGrid::MARGIN_VOXELS`] past the mesh's box, each with
+/// the distance's gradient there (central differences of the neighbouring values), so that one
+/// interpolation gives both.
 #[derive(Clone, Debug)]
 pub struct SignedDistanceGrid {
     origin: Vec3,
@@ -23,7 +25,8 @@ pub struct SignedDistanceGrid {
     voxel: f32,
     inv_voxel: f32,
     dims: [usize; 3],
-    values: Vec<f32>,
+    /// Per grid point: the distance, then its gradient (x, y, z).
+    values: Vec<Vec4>,
 }
 
 impl SignedDistanceGrid {
@@ -54,8 +57,8 @@ impl SignedDistanceGrid {
         }
         let origin = bounds.min - Vec3::splat(margin);
         let parry = to_parry_oriented(mesh);
-        let mut values = vec![0.0f32; dims[0] * dims[1] * dims[2]];
-        values.par_chunks_mut(dims[0]).enumerate().for_each(|(row, out)| {
+        let mut distances = vec![0.0f32; dims[0] * dims[1] * dims[2]];
+        distances.par_chunks_mut(dims[0]).enumerate().for_each(|(row, out)| {
             let (j, k) = (row % dims[1], row / dims[1]);
             for (i, v) in out.iter_mut().enumerate() {
                 let p = origin + Vec3::new(i as f32, j as f32, k as f32) * voxel;
@@ -65,6 +68,7 @@ impl SignedDistanceGrid {
                 *v = if proj.is_inside { d } else { -d };
             }
         });
+        let values = gradients(&distances, dims, voxel);
         let last = origin + Vec3::new((dims[0] - 1) as f32, (dims[1] - 1) as f32, (dims[2] - 1) as f32) * voxel;
         let last_cell = Vec3::new((dims[0] - 2) as f32, (dims[1] - 2) as f32, (dims[2] - 2) as f32);
         Ok(Self { origin, last, last_cell, voxel, inv_voxel: 1.0 / voxel, dims, values })
@@ -80,6 +84,11 @@ impl SignedDistanceGrid {
         self.dims
     }
 
+    /// Bytes the grid holds (16 per grid point).
+    pub fn memory_bytes(&self) -> usize {
+        self.values.len() * std::mem::size_of::<Vec4>()
+    }
+
     /// How far [`SignedDistanceGrid::distance`] may be from the true signed distance inside the grid:
     /// the interpolation is a convex combination of exact values at corners at most half a voxel
     /// diagonal away, and the distance changes by at most the distance moved.
@@ -91,60 +100,77 @@ impl SignedDistanceGrid {
     /// at the nearest point of the grid minus the distance to it.
     #[inline]
     pub fn distance(&self, p: Vec3) -> f32 {
-        let (cell, t, outside) = self.locate(p);
-        let [c000, c100, c010, c110, c001, c101, c011, c111] = self.corners(cell);
+        self.distance_and_gradient(p).0
+    }
+
+    /// Gradient of the distance at `p`, interpolated from the grid points' central differences: it
+    /// points into the mesh (length about 1 near the surface; outside the grid, towards it) and, unlike
+    /// the interpolant's own gradient, changes continuously across the cells' faces, so normals built on
+    /// it do not jump.
+    #[inline]
+    pub fn gradient(&self, p: Vec3) -> Vec3 {
+        self.distance_and_gradient(p).1
+    }
+
+    /// [`distance`](Self::distance) and [`gradient`](Self::gradient) at `p`, from one interpolation.
+    #[inline]
+    pub fn distance_and_gradient(&self, p: Vec3) -> (f32, Vec3) {
+        let q = p.clamp(self.origin, self.last);
+        let g = (q - self.origin) * self.inv_voxel;
+        // The last cell also takes the grid's far faces.
+        let cell = Vec3::new(whole(g.x), whole(g.y), whole(g.z)).min(self.last_cell);
+        let t = (g - cell).clamp(Vec3::ZERO, Vec3::ONE);
+        let (i, j, k) = (cell.x as usize, cell.y as usize, cell.z as usize);
+        let [c000, c100, c010, c110, c001, c101, c011, c111] = self.corners((k * self.dims[1] + j) * self.dims[0] + i);
         let x00 = c000 + (c100 - c000) * t.x;
         let x10 = c010 + (c110 - c010) * t.x;
         let x01 = c001 + (c101 - c001) * t.x;
         let x11 = c011 + (c111 - c011) * t.x;
         let y0 = x00 + (x10 - x00) * t.y;
         let y1 = x01 + (x11 - x01) * t.y;
-        y0 + (y1 - y0) * t.z - outside
-    }
-
-    /// Gradient of the distance at `p` by central differences half a voxel either side: it points into
-    /// the mesh (length about 1 near the surface; outside the grid, towards it) and, unlike the
-    /// interpolant's own gradient, changes continuously across the cells' faces, so normals built on it
-    /// do not jump.
-    #[inline]
-    pub fn gradient(&self, p: Vec3) -> Vec3 {
-        let h = 0.5 * self.voxel;
-        Vec3::new(
-            self.distance(p + Vec3::X * h) - self.distance(p - Vec3::X * h),
-            self.distance(p + Vec3::Y * h) - self.distance(p - Vec3::Y * h),
-            self.distance(p + Vec3::Z * h) - self.distance(p - Vec3::Z * h),
-        ) * self.inv_voxel
-    }
-
-    /// The cell holding `p` (clamped into the grid), `p`'s position in it (0..1 per axis) and how far
-    /// `p` lies outside the grid.
-    #[inline]
-    fn locate(&self, p: Vec3) -> (usize, Vec3, f32) {
-        let q = p.clamp(self.origin, self.last);
-        let outside = if q == p { 0.0 } else { p.distance(q) };
-        let g = (q - self.origin) * self.inv_voxel;
-        // The last cell also takes the grid's far faces.
-        let cell = Vec3::new(whole(g.x), whole(g.y), whole(g.z)).min(self.last_cell);
-        let t = (g - cell).clamp(Vec3::ZERO, Vec3::ONE);
-        let (i, j, k) = (cell.x as usize, cell.y as usize, cell.z as usize);
-        ((k * self.dims[1] + j) * self.dims[0] + i, t, outside)
+        let v = y0 + (y1 - y0) * t.z;
+        if q == p {
+            return (v.x, v.yzw());
+        }
+        // Outside: the distance falls by the way to the grid; along each axis `p` was clamped on, the
+        // gradient is that way's, along the others the grid's.
+        let out = q - p;
+        let away = out.length();
+        let towards = out / away;
+        let clamped = out.cmpne(Vec3::ZERO);
+        (v.x - away, Vec3::select(clamped, towards, v.yzw()))
     }
 
     #[inline]
-    fn corners(&self, cell: usize) -> [f32; 8] {
+    fn corners(&self, cell: usize) -> [Vec4; 8] {
         let (sx, sy) = (self.dims[0], self.dims[0] * self.dims[1]);
-        let v = &self.values;
-        [
-            v[cell],
-            v[cell + 1],
-            v[cell + sx],
-            v[cell + sx + 1],
-            v[cell + sy],
-            v[cell + sy + 1],
-            v[cell + sy + sx],
-            v[cell + sy + sx + 1],
-        ]
+        // One bounds check for the eight corners.
+        let v = &self.values[cell..cell + sy + sx + 2];
+        [v[0], v[1], v[sx], v[sx + 1], v[sy], v[sy + 1], v[sy + sx], v[sy + sx + 1]]
     }
+}
+
+/// Each grid point's distance with its gradient: central differences one voxel either side, one-sided
+/// on the grid's faces.
+fn gradients(distances: &[f32], dims: [usize; 3], voxel: f32) -> Vec<Vec4> {
+    let strides = [1, dims[0], dims[0] * dims[1]];
+    let mut values = vec![Vec4::ZERO; distances.len()];
+    values.par_chunks_mut(dims[0]).enumerate().for_each(|(row, out)| {
+        let (j, k) = (row % dims[1], row / dims[1]);
+        for (i, v) in out.iter_mut().enumerate() {
+            let at = [i, j, k];
+            let index = row * dims[0] + i;
+            let slope = |axis: usize| {
+                let (below, above) = (at[axis] > 0, at[axis] + 1 < dims[axis]);
+                let lo = if below { distances[index - strides[axis]] } else { distances[index] };
+                let hi = if above { distances[index + strides[axis]] } else { distances[index] };
+                let span = (below as u32 + above as u32).max(1) as f32 * voxel;
+                (hi - lo) / span
+            };
+            *v = Vec4::new(distances[index], slope(0), slope(1), slope(2));
+        }
+    });
+    values
 }
 
 /// The whole part of a non-negative `x`, without libm's `floorf` (which the baseline x86-64 calls: it

@@ -93,11 +93,9 @@ fn descend(
     let margin = 2.0 * b.interpolation_error();
     let (nodes, spheres, weights) = (a.nodes(), a.spheres(), a.weights());
     let mut result = OverlapResult { complete: true, ..OverlapResult::default() };
-    // The direction into B: given for a cut sphere, else the distance's gradient at `at` (computed only
-    // when contacts are wanted).
-    let mut push = |point: Vec3, into_b: Option<Vec3>, at: Vec3, volume: f32, depth: f32| {
+    // `into_b`: the direction into B (the distance's gradient, or a cut sphere's own direction).
+    let mut push = |point: Vec3, into_b: Vec3, volume: f32, depth: f32| {
         if let Some((set, to_world)) = out.as_mut() {
-            let into_b = into_b.unwrap_or_else(|| b.gradient(at));
             let normal = -into_b.try_normalize().unwrap_or(Vec3::Y);
             set.push(Contact {
                 point: to_world.transform_point(point),
@@ -133,20 +131,21 @@ fn descend(
                 let node = &nodes[n as usize];
                 let center = a_in_b.transform_point(node.bound.center);
                 let r = node.bound.radius;
-                let h = (r + b.distance(center)).clamp(0.0, 2.0 * r);
+                let (f, into_b) = b.distance_and_gradient(center);
+                let h = (r + f).clamp(0.0, 2.0 * r);
                 let volume = node.mesh_share * cap_volume(r, h) / sphere_volume(r).max(f32::MIN_POSITIVE);
                 if volume > 0.0 {
                     result.total_volume += volume;
                     result.estimated_volume += volume;
                     result.estimated_pairs += 1;
-                    push(center, None, center, volume, h);
+                    push(center, into_b, volume, h);
                 }
             }
             break;
         }
         result.node_pairs += 1;
         let center = a_in_b.transform_point(node.bound.center);
-        let f = b.distance(center);
+        let (f, into_b) = b.distance_and_gradient(center);
         let r = node.bound.radius;
         // Either bound keeps every leaf on the same side as its node (so the volume is the leaves'):
         // the interpolation's error twice, or the interpolant's own slope (at most √3 within the grid,
@@ -158,7 +157,7 @@ fn descend(
         if f >= r + margin {
             result.total_volume += node.mesh_share;
             result.aggregated_pairs += 1;
-            push(center, None, center, node.mesh_share, f + r);
+            push(center, into_b, node.mesh_share, f + r);
             continue;
         }
         if !node.leaf {
@@ -174,7 +173,7 @@ fn descend(
                 let volume = part.volume * weights[s];
                 result.total_volume += volume;
                 result.leaf_pairs += 1;
-                push(part.centroid, part.into_b, c, volume, part.depth);
+                push(part.centroid, part.into_b, volume, part.depth);
             }
         }
     }
@@ -218,9 +217,9 @@ struct Part {
     volume: f32,
     /// Its centroid, B's frame.
     centroid: Vec3,
-    /// The direction into the object where a cut sphere straddles the surface (not normalized); `None`
-    /// for a sphere wholly inside.
-    into_b: Option<Vec3>,
+    /// The direction into the object (not normalized): where the surface cuts the sphere, or the
+    /// distance's gradient at the centre of a sphere wholly inside.
+    into_b: Vec3,
     /// How deep the sphere reaches into the object: radius + the centre's distance.
     depth: f32,
 }
@@ -234,14 +233,14 @@ impl Part {
         r: f32,
         stack: &mut Vec<(u32, u32)>,
     ) -> Option<Self> {
-        let f = b.distance(c);
+        let (f, gradient) = b.distance_and_gradient(c);
         if f <= -r {
             return None;
         }
         if f >= r {
-            return Some(Self { volume: sphere_volume(r), centroid: c, into_b: None, depth: f + r });
+            return Some(Self { volume: sphere_volume(r), centroid: c, into_b: gradient, depth: f + r });
         }
-        let cut = Cut::of(b, c, r, f);
+        let cut = Cut::of(b, c, r, (f, gradient));
         let h = r + cut.distance;
         let cap = cap_volume(r, h);
         let mut volume = cap;
@@ -255,7 +254,7 @@ impl Part {
         // The cap's centroid, towards B.
         let offset = if cap > 0.0 { cap_moment(r, h) / cap } else { r };
         let into_b = cut.into_b;
-        Some(Self { volume, centroid: c + into_b.normalize_or_zero() * offset, into_b: Some(into_b), depth: f + r })
+        Some(Self { volume, centroid: c + into_b.normalize_or_zero() * offset, into_b, depth: f + r })
     }
 }
 
@@ -274,9 +273,9 @@ struct Cut {
 }
 
 impl Cut {
-    /// Where the surface cuts the sphere whose centre lies at interpolated distance `f` (|f| < r): the
-    /// cutting plane's signed distance from the centre (positive with the centre inside), corrected for
-    /// curvature, and the direction into the object.
+    /// Where the surface cuts the sphere whose centre lies at interpolated distance `f` (|f| < r), with
+    /// the distance's `gradient` there: the cutting plane's signed distance from the centre (positive
+    /// with the centre inside), corrected for curvature, and the direction into the object.
     ///
     /// Six samples at `±a` along the axes give the gradient and the Laplacian of the distance. A
     /// ball's part on one side of a surface of mean curvature `κ` is, to first order in `κ`, the cap of
@@ -284,7 +283,7 @@ impl Cut {
     /// samples is `f + a²/6 × Δφ`. The correction fades as `(1 − (f/r)²)²`, so a sphere's volume meets
     /// its whole volume (and zero) with a zero slope where it enters (leaves) the object.
     #[inline]
-    fn of(b: &SignedDistanceGrid, c: Vec3, r: f32, f: f32) -> Self {
+    fn of(b: &SignedDistanceGrid, c: Vec3, r: f32, (f, gradient): (f32, Vec3)) -> Self {
         let a = 0.866 * r;
         let px = b.distance(c + Vec3::X * a);
         let nx = b.distance(c - Vec3::X * a);
@@ -297,7 +296,7 @@ impl Cut {
         let fade = (1.0 - t * t) * (1.0 - t * t);
         let mut into_b = Vec3::new(px - nx, py - ny, pz - nz);
         if into_b == Vec3::ZERO {
-            into_b = b.gradient(c);
+            into_b = gradient;
         }
         let correction = r * r * 0.125 * laplacian;
         Self { distance: (f + correction * fade).clamp(-r, r), into_b, bend: correction.abs() / r, fade }
