@@ -247,10 +247,11 @@ fn poll_haptics(
     match haptics.poll() {
         Some(Ok(on)) => {
             log::info!(
-                "copy {} on the bench: {} spheres{}",
+                "copy {} on the bench: {} spheres{}{}",
                 on.item.0,
                 on.spheres,
-                if on.cached { " (cached)" } else { "" }
+                if on.cached { " (cached)" } else { "" },
+                on.surface_bytes.map_or(String::new(), |b| format!(", its surface grid {:.1} MB", b as f64 / 1e6))
             );
             audio.earcon(Earcon::ReadyToFeel);
             if !settings.bot {

@@ -64,21 +64,13 @@ const STALE_US: u32 = 32_000;
 /// margin, µs.
 const RECOVER_US: u64 = 2_500_000;
 
-/// Resting force over depth² (see [`Findings::pressure_n_per_m2`]) above which a copy of `kind` feels
-/// hard, N/m². Learnt per kind, like a player learns how a hard crown feels: the crown's thin points give
-/// way more than the solid amphora or idol, and on the crown's points and the idol's narrow body a smooth
-/// surface lets the stylus slip aside, so those two have one threshold for smooth and one for rough
-/// copies (the ridges are told apart first). Set from the copies of seeds 3, 5 and 11
-/// (docs/phantom-client.md); the tests use other seeds.
-pub fn hard_above_n_per_m2(kind: ArtifactKind, rough: bool) -> f32 {
-    match (kind, rough) {
-        (ArtifactKind::Crown, false) => 30_000.0,
-        (ArtifactKind::Crown, true) => 300_000.0,
-        (ArtifactKind::Amphora, _) => 550_000.0,
-        (ArtifactKind::Idol, false) => 60_000.0,
-        (ArtifactKind::Idol, true) => 190_000.0,
-    }
-}
+/// Resting force over depth² (see [`Findings::pressure_n_per_m2`]) above which a copy feels hard through
+/// the volumetric rendering, N/m², whatever its kind and roughness: the gemstone is measured against the
+/// copy's surface grid, so a copy pushes back as its briefing says wherever the stylus rests (felt on the
+/// copies of seeds 3, 5 and 11: soft 192–310, hard 646–1,430 kN/m²; docs/phantom-client.md). Until the
+/// copy had a surface grid (2026-12-05) it was learnt per kind and roughness, 30–550 kN/m²: the packing's
+/// hollows gave way under a smooth crown's points or a narrow idol's body.
+pub const HARD_ABOVE_N_PER_M2: f32 = 450_000.0;
 
 /// Contact force that counts as touching, N.
 const TOUCH_N: f32 = 0.05;
@@ -633,7 +625,7 @@ impl Exploration {
         let rough = ridges.is_some_and(|(_, strength)| strength > RIDGES_ABOVE) && friction > ROUGH_ABOVE;
         let hard = match self.hard_above_n_per_m {
             Some(threshold) => stiffness_n_per_m > threshold,
-            None => pressure_n_per_m2 > hard_above_n_per_m2(self.kind, rough),
+            None => pressure_n_per_m2 > HARD_ABOVE_N_PER_M2,
         };
         let material = match (hard, rough) {
             (true, false) => MaterialClass::HardSmooth,

@@ -54,3 +54,29 @@ fn the_touch_bot_tells_every_copy_of_each_kind_by_touch_through_the_3dof_proxy()
 fn the_touch_bot_tells_every_copy_of_each_kind_by_touch_through_volumetric_rendering() {
     every_copy_is_told_right(RenderingChoice::Volumetric, Rendering::Coupled);
 }
+
+#[test]
+fn a_copy_gets_its_surface_grid_with_volumetric_rendering_and_none_through_the_proxy() {
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|p| p.into_inner());
+    let (copies, _) = generate_copies(ArtifactKind::Idol, 3, 3);
+    let copy =
+        WorkbenchCopy { item: ItemId(1), mesh: build_mesh(&copies[0], 3), material: copies[0].material.material() };
+    for (rendering, with_surface) in [(RenderingChoice::Volumetric, true), (RenderingChoice::Proxy, false)] {
+        let mut h = Haptics::start(HapticsSettings { rendering, ..HapticsSettings::default() }).expect("starts");
+        h.place(&copy);
+        let on = (0..600)
+            .find_map(|_| {
+                std::thread::sleep(Duration::from_millis(50));
+                h.poll()
+            })
+            .expect("the copy reaches the bench within 30 s")
+            .expect("the copy is built");
+        h.stop();
+        assert_eq!(on.surface_bytes.is_some(), with_surface, "{rendering:?}: {on:?}");
+        // An idol of about 9 cm at 100 voxels along its longest side: a few megabytes.
+        println!("{rendering:?}: {on:?}");
+        if let Some(bytes) = on.surface_bytes {
+            assert!((1_000_000..50_000_000).contains(&bytes), "{bytes} bytes");
+        }
+    }
+}
