@@ -27,6 +27,16 @@ pub struct SignedDistanceGrid {
     dims: [usize; 3],
     /// Per grid point: the distance, then its gradient (x, y, z).
     values: Vec<Vec4>,
+    /// The interpolant's steepest slope, per cell (level 0) and over blocks of 2ᵏ cells a side (level
+    /// k), in hundredths rounded up.
+    slopes: Vec<SlopeLevel>,
+}
+
+/// The steepest slopes over blocks of one size.
+#[derive(Clone, Debug)]
+struct SlopeLevel {
+    dims: [usize; 3],
+    hundredths: Vec<u8>,
 }
 
 impl SignedDistanceGrid {
@@ -69,9 +79,10 @@ impl SignedDistanceGrid {
             }
         });
         let values = gradients(&distances, dims, voxel);
+        let slopes = slope_pyramid(&distances, dims, voxel);
         let last = origin + Vec3::new((dims[0] - 1) as f32, (dims[1] - 1) as f32, (dims[2] - 1) as f32) * voxel;
         let last_cell = Vec3::new((dims[0] - 2) as f32, (dims[1] - 2) as f32, (dims[2] - 2) as f32);
-        Ok(Self { origin, last, last_cell, voxel, inv_voxel: 1.0 / voxel, dims, values })
+        Ok(Self { origin, last, last_cell, voxel, inv_voxel: 1.0 / voxel, dims, values, slopes })
     }
 
     /// Edge length of a voxel (mesh units).
@@ -84,10 +95,48 @@ impl SignedDistanceGrid {
         self.dims
     }
 
-    /// Bytes the grid holds (16 per grid point).
+    /// Bytes the grid holds (16 per grid point and about 1.15 per cell for the slopes).
     pub fn memory_bytes(&self) -> usize {
-        self.values.len() * std::mem::size_of::<Vec4>()
+        self.values.len() * std::mem::size_of::<Vec4>() + self.slopes.iter().map(|l| l.hundredths.len()).sum::<usize>()
     }
+
+    /// An upper bound of the interpolated distance's slope (`|∇ distance|`) anywhere within `radius` of
+    /// `center`: the steepest of the cells that box covers, from the slope pyramid (at most eight
+    /// blocks). Where the box leaves the grid, [`SignedDistanceGrid::STEEPEST`]. About 1 near a smooth
+    /// surface; up to √3 where the nearest part of the surface changes (the medial axis).
+    pub fn steepest_slope(&self, center: Vec3, radius: f32) -> f32 {
+        let (lo, hi) = (center - Vec3::splat(radius), center + Vec3::splat(radius));
+        if !(lo.cmpge(self.origin).all() && hi.cmple(self.last).all()) {
+            return Self::STEEPEST;
+        }
+        let cell = |p: Vec3| {
+            let g = ((p - self.origin) * self.inv_voxel).min(self.last_cell);
+            [g.x as usize, g.y as usize, g.z as usize]
+        };
+        let (lo, hi) = (cell(lo), cell(hi));
+        let span = (0..3).map(|a| hi[a] - lo[a]).max().unwrap_or(0);
+        // The smallest level at which the box spans at most two blocks a side.
+        let mut level = 0;
+        while (span >> level) > 1 && level + 1 < self.slopes.len() {
+            level += 1;
+        }
+        let l = &self.slopes[level];
+        let (lo, hi) = (lo.map(|c| c >> level), hi.map(|c| c >> level));
+        let mut steepest = 0u8;
+        for k in lo[2]..=hi[2].min(l.dims[2] - 1) {
+            for j in lo[1]..=hi[1].min(l.dims[1] - 1) {
+                for i in lo[0]..=hi[0].min(l.dims[0] - 1) {
+                    steepest = steepest.max(l.hundredths[(k * l.dims[1] + j) * l.dims[0] + i]);
+                }
+            }
+        }
+        steepest as f32 * 0.01
+    }
+
+    /// The steepest slope the interpolated distance can have: each axis's difference of two exact
+    /// distances one voxel apart is at most a voxel (and outside the grid the distance falls by 1 per
+    /// unit away, beside the grid's own slope along its faces).
+    pub const STEEPEST: f32 = 1.732_050_8;
 
     /// How far [`SignedDistanceGrid::distance`] may be from the true signed distance inside the grid:
     /// the interpolation is a convex combination of exact values at corners at most half a voxel
@@ -148,6 +197,47 @@ impl SignedDistanceGrid {
         let v = &self.values[cell..cell + sy + sx + 2];
         [v[0], v[1], v[sx], v[sx + 1], v[sy], v[sy + 1], v[sy + sx], v[sy + sx + 1]]
     }
+}
+
+/// The slope pyramid: per cell, the largest of the trilinear interpolant's gradient lengths at its eight
+/// corners, which is the largest anywhere in it (each partial derivative is bilinear in the other two
+/// coordinates and constant along its own, so `|∇f|²` is convex along every axis and peaks at a
+/// corner); each level above keeps the largest of 2 × 2 × 2 blocks below, up to one block.
+fn slope_pyramid(distances: &[f32], dims: [usize; 3], voxel: f32) -> Vec<SlopeLevel> {
+    let cells = dims.map(|d| d - 1);
+    let at = |i: usize, j: usize, k: usize| distances[(k * dims[1] + j) * dims[0] + i];
+    let mut base = vec![0u8; cells[0] * cells[1] * cells[2]];
+    base.par_chunks_mut(cells[0]).enumerate().for_each(|(row, out)| {
+        let (j, k) = (row % cells[1], row / cells[1]);
+        for (i, slope) in out.iter_mut().enumerate() {
+            // The gradient at the cell's corner (a, b, c): each axis's edge difference through it.
+            let corner = |a: usize, b: usize, c: usize| {
+                let (x, y, z) = (i + a, j + b, k + c);
+                Vec3::new(at(i + 1, y, z) - at(i, y, z), at(x, j + 1, z) - at(x, j, z), at(x, y, k + 1) - at(x, y, k))
+                    .length()
+            };
+            let corners = [(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1, 0), (0, 0, 1), (1, 0, 1), (0, 1, 1), (1, 1, 1)];
+            let norm = corners.iter().map(|&(a, b, c)| corner(a, b, c)).fold(0.0, f32::max) / voxel;
+            // Rounded up, so the bound stays a bound.
+            *slope = (norm * 100.0).ceil().min(255.0) as u8;
+        }
+    });
+    let mut levels = vec![SlopeLevel { dims: cells, hundredths: base }];
+    while levels.last().is_some_and(|l| l.dims.iter().any(|&d| d > 1)) {
+        let below = levels.last().expect("a level");
+        let dims = below.dims.map(|d| d.div_ceil(2));
+        let mut hundredths = vec![0u8; dims[0] * dims[1] * dims[2]];
+        for k in 0..below.dims[2] {
+            for j in 0..below.dims[1] {
+                for i in 0..below.dims[0] {
+                    let up = &mut hundredths[((k / 2) * dims[1] + j / 2) * dims[0] + i / 2];
+                    *up = (*up).max(below.hundredths[(k * below.dims[1] + j) * below.dims[0] + i]);
+                }
+            }
+        }
+        levels.push(SlopeLevel { dims, hundredths });
+    }
+    levels
 }
 
 /// Each grid point's distance with its gradient: central differences one voxel either side, one-sided
@@ -220,6 +310,39 @@ mod tests {
             let d = grid.distance(dir * r);
             assert!((d - (1.0 - r)).abs() < 0.004, "at radius {r}: {d}");
         }
+    }
+
+    #[test]
+    fn the_slope_pyramid_bounds_the_interpolants_slope_and_is_about_one_near_a_face() {
+        let (v, t) = uv_sphere_buffers(1.0, 32, 64);
+        let grid = SignedDistanceGrid::new(&TriMesh::new(v, t).expect("valid"), 24).expect("builds");
+        let h = 1e-3 * grid.voxel_size();
+        let mut worst = 0.0f32;
+        for i in 0..4000 {
+            let u = i as f32;
+            let center = Vec3::new((u * 0.37).sin(), (u * 0.61).cos(), (u * 0.13).sin()) * 1.1;
+            let radius = grid.voxel_size() * (0.2 + 3.0 * (u * 0.71).sin().abs());
+            let bound = grid.steepest_slope(center, radius);
+            // The interpolant's own slope by differences much finer than a cell, at a point in the box.
+            let p = center + Vec3::new((u * 1.3).sin(), (u * 1.7).cos(), (u * 2.9).sin()) * radius * 0.57;
+            let slope = Vec3::new(
+                grid.distance(p + Vec3::X * h) - grid.distance(p - Vec3::X * h),
+                grid.distance(p + Vec3::Y * h) - grid.distance(p - Vec3::Y * h),
+                grid.distance(p + Vec3::Z * h) - grid.distance(p - Vec3::Z * h),
+            )
+            .length()
+                / (2.0 * h);
+            assert!(slope <= bound + 0.02, "at {p}: slope {slope} above the bound {bound}");
+            worst = worst.max(bound);
+        }
+        assert!(worst <= SignedDistanceGrid::STEEPEST + 1e-6, "{worst}");
+        // By a face of a box, one cell across: the distance is a plane's, slope 1.
+        let (v, t) = box_buffers(Vec3::ONE);
+        let grid = SignedDistanceGrid::new(&TriMesh::new(v, t).expect("valid"), 40).expect("builds");
+        let by_face = grid.steepest_slope(Vec3::new(0.0, 0.0, 0.99), 0.5 * grid.voxel_size());
+        assert!((1.0..=1.011).contains(&by_face), "{by_face}");
+        // Leaving the grid: the bound for anywhere.
+        assert_eq!(grid.steepest_slope(Vec3::new(0.0, 0.0, 0.99), 10.0), SignedDistanceGrid::STEEPEST);
     }
 
     #[test]

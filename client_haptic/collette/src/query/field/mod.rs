@@ -148,9 +148,14 @@ fn descend(
         let (f, into_b) = b.distance_and_gradient(center);
         let r = node.bound.radius;
         // Either bound keeps every leaf on the same side as its node (so the volume is the leaves'):
-        // the interpolation's error twice, or the interpolant's own slope (at most √3 within the grid,
-        // whose outer two voxels no node inside B can reach) across the node.
-        let margin = margin.min((SLOPE - 1.0) * r);
+        // the interpolation's error twice, or the interpolant's steepest slope `L` across the node (a
+        // leaf sphere of radius `s` lies within `r − s` of the centre, so `|f| ≥ max(L, 1) r` keeps it
+        // whole or out). `L` is at most √3; where `|f|` falls between, the grid's slope pyramid tells
+        // the node's own, about 1 near a smooth surface.
+        let mut margin = margin.min((SignedDistanceGrid::STEEPEST - 1.0) * r);
+        if f.abs() >= r && f.abs() < r + margin {
+            margin = margin.min((b.steepest_slope(center, r) - 1.0).max(0.0) * r);
+        }
         if f <= -r - margin {
             continue;
         }
@@ -312,10 +317,6 @@ impl Cut {
         t * t * (3.0 - 2.0 * t) * self.fade
     }
 }
-
-/// The steepest slope of the interpolated distance: each axis's difference of two exact distances one
-/// voxel apart is at most a voxel.
-const SLOPE: f32 = 1.732_050_8;
 
 /// Below this curvature term (over the radius) a sphere's part inside B is its curved cap alone.
 const BEND_FLAT: f32 = 0.1;

@@ -209,7 +209,10 @@ fn a_budget_stops_the_descent_and_estimates_the_rest_from_the_nodes_bounds() {
         &mut ws,
         &mut set,
     );
-    assert_eq!(ample, exact, "a budget never reached changes nothing");
+    // A budget never reached changes nothing but the order of the sum (breadth-first).
+    let same_volume = (ample.total_volume / exact.total_volume - 1.0).abs() < 1e-5;
+    assert_eq!(OverlapResult { total_volume: exact.total_volume, ..ample }, exact, "a budget never reached");
+    assert!(same_volume, "{} against {}", ample.total_volume, exact.total_volume);
     let mut errors = Vec::new();
     for nodes in [1, 10, 100, 400] {
         let cut = overlap_field_budgeted(
