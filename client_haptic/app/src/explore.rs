@@ -51,7 +51,8 @@ pub fn taps(kind: ArtifactKind) -> usize {
 pub const TAP_S: f32 = 0.4;
 /// Friction above which a copy grips like a rough one (briefed: smooth 0.1, rough 0.6; felt through
 /// the packed skin's bumps a little higher). A ribbed copy must grip too: on a narrow soft idol the
-/// packing's bumps alone repeated as strongly as ridges (0.24, volumetric rendering, seed 24).
+/// packing's bumps alone repeated as strongly as ridges (0.24, volumetric rendering, seed 24, before the
+/// copy had a surface grid; since, smooth copies repeat at most 0.02 through it).
 pub const ROUGH_ABOVE: f32 = 0.45;
 /// Explorations of one copy at most, when the first ones were disturbed.
 pub const ATTEMPTS: u32 = 3;
@@ -674,7 +675,8 @@ const RIDGE_SPACINGS_M: (f32, f32) = (0.0015, SLIDE_M / 3.0);
 /// A push along the stroke that repeats with the stylus's height, this strong against the normal force
 /// (its Fourier amplitude over each way of the stroke), means ridges. Ribbed copies gave 0.25–0.48 and
 /// the packing's bumps on smooth ones at most 0.12 through the proxy, 0.24 once through the volumetric
-/// rendering (seeds 21–24, docs/phantom-client.md).
+/// rendering (seeds 21–24, docs/phantom-client.md) before the copy had a surface grid, at most 0.02 since
+/// (seeds 3, 5, 11).
 pub const RIDGES_ABOVE: f32 = 0.18;
 
 /// The spacing at which the push along the stroke (less its mean on each way: the friction) repeats
