@@ -535,13 +535,12 @@ mod tests {
         let (copies, _) = generate_copies(ArtifactKind::Idol, 3, 3);
         let mesh = build_mesh(&copies[0], 3);
         let grid = surface_grid(&mesh, 3000).expect("builds");
-        let lo = mesh.vertices.iter().fold(Vec3::splat(f32::MAX), |m, v| m.min(Vec3::from_array(*v)));
-        let hi = mesh.vertices.iter().fold(Vec3::splat(f32::MIN), |m, v| m.max(Vec3::from_array(*v)));
-        let longest = (hi - lo).max_element();
+        let bounds = tri_mesh(&mesh).expect("a closed mesh").aabb();
+        let longest = bounds.extents().max_element();
         assert_eq!(BuildOptions::spheres(3000).resolution(), 100);
         assert!((grid.voxel_size() * 100.0 / longest - 1.0).abs() < 1e-4, "voxel {}", grid.voxel_size());
         // The idol stands on its base, centred on its axis: its middle is inside, beside it is not.
-        let middle = 0.5 * (lo + hi);
+        let middle = bounds.center();
         assert!(grid.distance(middle) > 0.0, "inside: {}", grid.distance(middle));
         let beside = middle + Vec3::X * longest;
         assert!(grid.distance(beside) < -0.5 * longest, "outside: {}", grid.distance(beside));

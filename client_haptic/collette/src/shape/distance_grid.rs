@@ -121,11 +121,12 @@ impl SignedDistanceGrid {
             level += 1;
         }
         let l = &self.slopes[level];
+        // Within the level: a cell index below `cells` shifted by `level` is below `ceil(cells / 2ᵏ)`.
         let (lo, hi) = (lo.map(|c| c >> level), hi.map(|c| c >> level));
         let mut steepest = 0u8;
-        for k in lo[2]..=hi[2].min(l.dims[2] - 1) {
-            for j in lo[1]..=hi[1].min(l.dims[1] - 1) {
-                for i in lo[0]..=hi[0].min(l.dims[0] - 1) {
+        for k in lo[2]..=hi[2] {
+            for j in lo[1]..=hi[1] {
+                for i in lo[0]..=hi[0] {
                     steepest = steepest.max(l.hundredths[(k * l.dims[1] + j) * l.dims[0] + i]);
                 }
             }
