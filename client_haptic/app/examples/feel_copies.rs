@@ -5,11 +5,15 @@
 //!     cargo run --release -p client_haptic --no-default-features --example feel_copies -- 3 5 7
 //!     cargo run --release -p client_haptic --no-default-features --example feel_copies -- \
 //!         --heist --kind idol --real --repeat 16 10
+//!
+//! `--lockstep` steps the same rig in simulated time on one thread (as the touch tests do for most
+//! copies): as fast as the machine computes it, the same on every run, no real-time rates.
 
 use clap::Parser;
 use client_haptic::cli::KindArg;
 use client_haptic::explore::feel;
 use client_haptic::haptics::{Haptics, HapticsSettings, RenderingChoice};
+use client_haptic::touch_bench::{LockstepHaptics, TouchBench};
 use heist_shared::artifact::{ArtifactKind, build_mesh, copy_mesh_seed, generate_copies, target_seed};
 use heist_shared::level::Level;
 use heist_shared::protocol::{ItemId, WorkbenchCopy};
@@ -32,6 +36,9 @@ struct Args {
     /// Device preset the sim device copies (default the Phantom Desktop).
     #[arg(long)]
     preset: Option<String>,
+    /// Step the rig in simulated time on one thread instead of running it in real time.
+    #[arg(long)]
+    lockstep: bool,
     /// Feel each copy this many times.
     #[arg(long, default_value_t = 1)]
     repeat: u32,
@@ -42,13 +49,21 @@ struct Args {
 
 fn main() -> anyhow::Result<()> {
     let args = Args::parse();
+    let settings =
+        HapticsSettings { rendering: args.rendering, preset: args.preset.clone(), ..HapticsSettings::default() };
+    if args.lockstep {
+        return feel_all(&mut LockstepHaptics::start(settings)?, &args);
+    }
+    let mut h = Haptics::start(settings)?;
+    std::thread::sleep(std::time::Duration::from_millis(2500)); // the safety layer ramps forces in
+    let felt = feel_all(&mut h, &args);
+    h.stop();
+    felt
+}
+
+/// Feels the copies `args` name on `bench`, printing a CSV row each.
+fn feel_all(bench: &mut impl TouchBench, args: &Args) -> anyhow::Result<()> {
     let museum = Level::museum();
-    let mut h = Haptics::start(HapticsSettings {
-        rendering: args.rendering,
-        preset: args.preset.clone(),
-        ..HapticsSettings::default()
-    })?;
-    std::thread::sleep(std::time::Duration::from_millis(2500));
     println!(
         "kind,seed,count,material,felt_count,felt_material,stiffness_n_per_m,pressure_n_per_m2,friction,\
          ridge_mm,ridge_strength,stroke_contact,attempts,presses,right"
@@ -71,7 +86,7 @@ fn main() -> anyhow::Result<()> {
                     item += 1;
                     let copy =
                         WorkbenchCopy { item: ItemId(item), mesh: mesh.clone(), material: t.material.material() };
-                    let f = feel(&mut h, &copy, kind).map_err(anyhow::Error::msg)?;
+                    let f = feel(bench, &copy, kind).map_err(anyhow::Error::msg)?;
                     let right = f.feature_count == t.feature_count && f.material == t.material;
                     (felt, wrong) = (felt + 1, wrong + u32::from(!right));
                     if !right || f.presses > 1 || f.attempts > 1 {
@@ -97,7 +112,6 @@ fn main() -> anyhow::Result<()> {
             }
         }
     }
-    h.stop();
     eprintln!("{wrong} of {felt} explorations misjudged their copy");
     Ok(())
 }

@@ -34,6 +34,7 @@ use heist_shared::artifact::{self, ArtifactKind, Briefing, MaterialClass};
 
 use crate::device::HandGoal;
 use crate::haptics::TOOL_DIAMETER_M;
+use crate::touch_bench::TouchBench;
 
 /// Pokes around an amphora.
 pub const TAPS: usize = 48;
@@ -724,42 +725,29 @@ fn strongest_repeat(strokes: &[StrokeSample]) -> Option<(f32, f32)> {
         .max_by(|a, b| a.1.total_cmp(&b.1))
 }
 
-/// Places `copy` on the bench of a running [`crate::haptics::Haptics`] (sim device) and explores it;
-/// gives up after a minute for the build and a minute for each exploration. Used by the tests and the
-/// `feel_copies` example; the client runs the same steps from its systems.
+/// Places `copy` on `bench` (the client's running loop, or the same loop in lockstep: see
+/// [`crate::touch_bench`]) and explores it; gives up after a minute for the build and a minute of haptic
+/// time for each exploration. Used by the tests and the `feel_copies` example; the client runs the same
+/// steps from its systems.
 pub fn feel(
-    h: &mut crate::haptics::Haptics,
+    bench: &mut impl TouchBench,
     copy: &heist_shared::protocol::WorkbenchCopy,
     kind: ArtifactKind,
 ) -> Result<Findings, String> {
-    use std::time::{Duration, Instant};
-    h.place(copy);
-    let deadline = Instant::now() + Duration::from_secs(60);
-    while h.on_bench.is_none() {
-        if Instant::now() > deadline {
-            return Err("the tree was not built within a minute".into());
-        }
-        if let Some(Err(e)) = h.poll() {
-            return Err(e.to_string());
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    let mut ex = Exploration::new(kind, h.now_us(), h.stylus()).judging_springs(h.hard_above_n_per_m());
-    let map = h.map;
-    let hand = |h: &mut crate::haptics::Haptics, goal| {
-        h.hand.as_mut().map(|c| c.set(to_device(&map, goal))).ok_or("the device has no steerable hand")
-    };
-    hand(h, ex.goal())?;
-    let deadline = Instant::now() + Duration::from_secs(60) * ATTEMPTS;
+    /// The client's frame, about: how often the bot looks at what the hand felt, ms.
+    const FRAME_MS: u64 = 8;
+    bench.place_and_wait(copy)?;
+    let mut ex = Exploration::new(kind, bench.now_us(), bench.stylus()).judging_springs(bench.hard_above_n_per_m());
+    let map = bench.map();
+    bench.steer(to_device(&map, ex.goal()))?;
+    let deadline_us = bench.now_us() + 60_000_000 * u64::from(ATTEMPTS);
     while !ex.done() {
-        if Instant::now() > deadline {
+        if bench.now_us() > deadline_us {
             return Err(format!("the exploration did not end within {ATTEMPTS} minutes"));
         }
-        std::thread::sleep(Duration::from_millis(8));
-        h.poll();
-        let now = h.now_us();
-        if ex.step(now, &h.samples) {
-            hand(h, ex.goal())?;
+        bench.wait(FRAME_MS);
+        if ex.step(bench.now_us(), bench.samples()) {
+            bench.steer(to_device(&map, ex.goal()))?;
         }
     }
     ex.findings().cloned().ok_or_else(|| "no findings".into())

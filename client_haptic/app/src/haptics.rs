@@ -37,7 +37,7 @@ pub const REFERENCE_DEPTH_M: f32 = 0.002;
 /// The gem's sphere count.
 const TOOL_SPHERES: usize = 200;
 /// Id of the copy on the collision thread.
-const COPY_OBJECT: u32 = 1;
+pub(crate) const COPY_OBJECT: u32 = 1;
 /// Length of a rate window, µs.
 const WINDOW_US: u64 = 1_000_000;
 
@@ -50,6 +50,11 @@ pub const STIFFEST_COPY_N_PER_M: f32 = 1000.0;
 pub fn hard_above_n_per_m() -> f32 {
     let stiffness = |c: artifact::MaterialClass| c.material().stiffness_n_per_m;
     0.5 * (stiffness(artifact::MaterialClass::SoftSmooth) + stiffness(artifact::MaterialClass::HardSmooth))
+}
+
+/// [`hard_above_n_per_m`] scaled to the device when the proxy renders, else `None`.
+pub(crate) fn proxy_hard_above(rendering: Rendering, stiffness_scale: f32) -> Option<f32> {
+    (rendering == Rendering::Proxy).then(|| hard_above_n_per_m() * stiffness_scale)
 }
 
 /// How forces are rendered.
@@ -126,16 +131,28 @@ pub struct RateWindow {
 }
 
 /// What the worker sends back for a copy, or why it could not.
-struct BuiltCopy {
-    tree: InnerSphereTree,
+pub(crate) struct BuiltCopy {
+    pub tree: InnerSphereTree,
     /// Whether the tree came from the cache.
-    cached: bool,
+    pub cached: bool,
     /// The copy's surface, with volumetric rendering.
-    surface: Option<SignedDistanceGrid>,
+    pub surface: Option<SignedDistanceGrid>,
 }
 
 /// What the worker sends back: the copy built, or why not.
-type Built = Result<BuiltCopy, String>;
+pub(crate) type Built = Result<BuiltCopy, String>;
+
+/// Builds (or loads) the tree of `mesh`, and its surface grid when `with_surface`.
+pub(crate) fn build_copy(
+    mesh: &HapticMesh,
+    spheres: usize,
+    cache: Option<&std::path::Path>,
+    with_surface: bool,
+) -> Built {
+    let (tree, cached) = build_tree(mesh, spheres, cache)?;
+    let surface = with_surface.then(|| surface_grid(mesh, spheres)).transpose()?;
+    Ok(BuiltCopy { tree, cached, surface })
+}
 
 /// The running rig and what it renders (a non-send resource: the device lives on the haptic thread, this
 /// is the game thread's handle).
@@ -188,35 +205,8 @@ impl Haptics {
             None => (device, None),
         };
         let specs = device.specs().clone();
-        let gem = collette::scene::brilliant_cut(TOOL_DIAMETER_M);
-        let (tree, _) = collette::build(&gem, &BuildOptions::spheres(TOOL_SPHERES), &mut |_| {})
-            .map_err(|e| ClientError::Device(format!("building the gemstone's tree: {e}")))?;
-        let tool_reference_volume_m3 =
-            immersed_volume(tree.spheres(), tree.weights(), glam::Vec3::X, REFERENCE_DEPTH_M);
-        // The gem is far stiffer than any copy, and its friction is 1 so the copy's own coefficient decides
-        // (see `haptic_material`).
-        let tool = ToolSpec::new(
-            Arc::new(tree),
-            Material { stiffness_n_per_m3: 1e12, damping_ns_per_m: 1e6, friction: 1.0, texture: None },
-        );
-        let scale = if specs.workspace_radius_m > 0.0 { (0.08 / specs.workspace_radius_m).max(1.0) } else { 1.0 };
-        let map = WorkspaceMap { origin: Pose::IDENTITY, scale };
-        let rendering = match settings.rendering {
-            RenderingChoice::Volumetric => Rendering::Coupled,
-            RenderingChoice::Proxy => Rendering::Proxy,
-            RenderingChoice::Auto if specs.renders_torque() => Rendering::Coupled,
-            RenderingChoice::Auto => Rendering::Proxy,
-        };
-        let stiffness_scale = (specs.max_stiffness_n_per_m / STIFFEST_COPY_N_PER_M).clamp(f32::MIN_POSITIVE, 1.0);
-        // The proxy's spring is ε_c × this: the briefed stiffness (see `haptic_material`), scaled to the device.
-        let proxy = ProxyRendering {
-            volume_per_depth_m2: tool_reference_volume_m3 / REFERENCE_DEPTH_M * stiffness_scale,
-            ..ProxyRendering::default()
-        };
-        let workspace = health.workspace(&specs);
-        let mut config = RigConfig { map, rendering, proxy, workspace, ..RigConfig::default() };
-        config.haptic.realtime_priority = settings.realtime_priority;
-        config.collision.realtime_priority = settings.realtime_priority.map(|p| (p - 1).max(1));
+        let RigSetup { tool, config, rendering, stiffness_scale, map, tool_reference_volume_m3 } =
+            RigSetup::new(&specs, &settings, health.workspace(&specs))?;
         let rig = HapticRig::start(device, tool, config, HapticEvents::default(), haptic_common::Delegator::new())?;
         Ok(Self {
             rig,
@@ -268,7 +258,7 @@ impl Haptics {
     /// With proxy rendering, the resting force over depth (N/m) above which a copy feels hard; `None`
     /// with volumetric rendering (the touch bot then judges by force over depth²).
     pub fn hard_above_n_per_m(&self) -> Option<f32> {
-        (self.rendering == Rendering::Proxy).then(|| hard_above_n_per_m() * self.stiffness_scale)
+        proxy_hard_above(self.rendering, self.stiffness_scale)
     }
 
     /// Starts building the tree of `copy` (replacing whatever was on the bench), and its surface grid
@@ -283,11 +273,7 @@ impl Haptics {
         std::thread::Builder::new()
             .name("ist-build".into())
             .spawn(move || {
-                let built = build_tree(&mesh, spheres, cache.as_deref()).and_then(|(tree, cached)| {
-                    let surface = with_surface.then(|| surface_grid(&mesh, spheres)).transpose()?;
-                    Ok(BuiltCopy { tree, cached, surface })
-                });
-                let _ = tx.send(built);
+                let _ = tx.send(build_copy(&mesh, spheres, cache.as_deref(), with_surface));
             })
             .map_or_else(|e| log::error!("could not start building copy {}: {e}", item.0), drop);
         self.building = Some((copy.item, rx, haptic_material(&copy.material, self.tool_reference_volume_m3)));
@@ -380,6 +366,63 @@ impl Haptics {
     /// Stops both threads.
     pub fn stop(self) {
         self.rig.stop();
+    }
+}
+
+/// The gemstone tool and the rig's configuration for a device: what the threaded rig ([`Haptics`]) and
+/// the lockstep one ([`crate::touch_bench::LockstepHaptics`]) both start from.
+pub(crate) struct RigSetup {
+    /// The gemstone.
+    pub tool: ToolSpec,
+    /// The rig's configuration.
+    pub config: RigConfig,
+    /// How forces are rendered (the choice resolved for the device).
+    pub rendering: Rendering,
+    /// With proxy rendering, what every copy's stiffness is scaled by to fit the device.
+    pub stiffness_scale: f32,
+    /// Device frame to scene.
+    pub map: WorkspaceMap,
+    /// The gem's packed volume [`REFERENCE_DEPTH_M`] deep in a flat face, m³.
+    pub tool_reference_volume_m3: f32,
+}
+
+impl RigSetup {
+    /// The gemstone's tree, the rendering the settings choose for `specs`, the proxy's spring scaled to
+    /// the device, and `workspace` (where the grip must be read for forces to engage).
+    pub fn new(
+        specs: &DeviceSpecs,
+        settings: &HapticsSettings,
+        workspace: Option<forcecomp::Workspace>,
+    ) -> Result<Self, ClientError> {
+        let gem = collette::scene::brilliant_cut(TOOL_DIAMETER_M);
+        let (tree, _) = collette::build(&gem, &BuildOptions::spheres(TOOL_SPHERES), &mut |_| {})
+            .map_err(|e| ClientError::Device(format!("building the gemstone's tree: {e}")))?;
+        let tool_reference_volume_m3 =
+            immersed_volume(tree.spheres(), tree.weights(), glam::Vec3::X, REFERENCE_DEPTH_M);
+        // The gem is far stiffer than any copy, and its friction is 1 so the copy's own coefficient decides
+        // (see `haptic_material`).
+        let tool = ToolSpec::new(
+            Arc::new(tree),
+            Material { stiffness_n_per_m3: 1e12, damping_ns_per_m: 1e6, friction: 1.0, texture: None },
+        );
+        let scale = if specs.workspace_radius_m > 0.0 { (0.08 / specs.workspace_radius_m).max(1.0) } else { 1.0 };
+        let map = WorkspaceMap { origin: Pose::IDENTITY, scale };
+        let rendering = match settings.rendering {
+            RenderingChoice::Volumetric => Rendering::Coupled,
+            RenderingChoice::Proxy => Rendering::Proxy,
+            RenderingChoice::Auto if specs.renders_torque() => Rendering::Coupled,
+            RenderingChoice::Auto => Rendering::Proxy,
+        };
+        let stiffness_scale = (specs.max_stiffness_n_per_m / STIFFEST_COPY_N_PER_M).clamp(f32::MIN_POSITIVE, 1.0);
+        // The proxy's spring is ε_c × this: the briefed stiffness (see `haptic_material`), scaled to the device.
+        let proxy = ProxyRendering {
+            volume_per_depth_m2: tool_reference_volume_m3 / REFERENCE_DEPTH_M * stiffness_scale,
+            ..ProxyRendering::default()
+        };
+        let mut config = RigConfig { map, rendering, proxy, workspace, ..RigConfig::default() };
+        config.haptic.realtime_priority = settings.realtime_priority;
+        config.collision.realtime_priority = settings.realtime_priority.map(|p| (p - 1).max(1));
+        Ok(Self { tool, config, rendering, stiffness_scale, map, tool_reference_volume_m3 })
     }
 }
 

@@ -1,7 +1,8 @@
 //! The Phantom client: join a heist as the blind player and play by touch and sound alone.
 //!
 //! The tree: [`device`] (which device, the steerable simulated hand), [`haptics`] (the 1 kHz rig and the
-//! copy on the workbench as a sphere tree), [`explore`] (the touch bot), [`audio`] (kira, binaural voices,
+//! copy on the workbench as a sphere tree), [`explore`] (the touch bot), [`touch_bench`] (where it feels a copy: the running loop or the same loop in
+//! lockstep), [`audio`] (kira, binaural voices,
 //! synthesized sounds), [`speech`] (espeak-ng), [`status`] (the sentences), [`client`] (the Bevy app that
 //! ties them to the session), [`cli`] (the command line) and, with the `spectator` feature, [`spectator`]
 //! (a window for sighted onlookers).
@@ -22,6 +23,7 @@ pub mod spectator;
 pub mod speech;
 pub mod status;
 pub mod terminal;
+pub mod touch_bench;
 pub mod walkie;
 
 pub use client::{PhantomClientPlugin, PhantomSettings, PhantomState, start};
