@@ -580,6 +580,20 @@ fn yaml_number(lines: &[&str], key: &str) -> f64 {
         .unwrap_or_else(|| panic!("{key} in {lines:?}"))
 }
 
+/// Every `.rs` file under `dir`.
+fn rust_files(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display())) {
+        let path = entry.expect("a directory entry").path();
+        if path.is_dir() {
+            files.extend(rust_files(&path));
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            files.push(path);
+        }
+    }
+    files
+}
+
 /// The server container's arguments in deploy/fleet.yaml.
 fn fleet_args(fleet: &str) -> Vec<String> {
     yaml_block(fleet, "args:")
@@ -593,18 +607,29 @@ fn arg_after(args: &[String], flag: &str) -> f64 {
     args[at + 1].parse().unwrap()
 }
 
+/// The Dockerfile's build stage installs what `scripts/deps.sh` installs for CI and builds the server in
+/// release. CI builds the same code in the test profile (`scripts/test.sh`) and no longer builds it again
+/// in release (docs/performance.md): the two profiles compile the same sources the same way as long as
+/// none of the server's crates branches on `debug_assertions`, which this test also holds.
 #[test]
-fn the_dockerfile_builds_with_the_commands_ci_runs_and_ships_only_the_server_as_a_user() {
+fn the_dockerfiles_build_stage_runs_what_ci_checks_and_ships_only_the_server_as_a_user() {
     let dockerfile = include_str!("../../deploy/Dockerfile");
-    let ci = include_str!("../../.ci/run");
+    let deps = include_str!("../../scripts/deps.sh");
     let stages: Vec<&str> = dockerfile.split("\nFROM ").skip(1).collect();
     assert_eq!(stages.len(), 2, "two stages: build and runtime");
     let runs: Vec<&str> = stages[0].lines().filter_map(|l| l.strip_prefix("RUN ")).collect();
-    assert!(!runs.is_empty());
-    for run in &runs {
-        assert!(ci.lines().any(|l| l.trim() == *run), "the build stage's `{run}` is not a line of .ci/run");
+    assert_eq!(runs, ["bash scripts/server-deps.sh", "cargo build --release --locked -p heist_server"]);
+    assert!(
+        deps.lines().any(|l| l.trim_start().starts_with("bash ") && l.trim_end().ends_with("/server-deps.sh\"")),
+        "scripts/deps.sh, which CI runs, runs server-deps.sh"
+    );
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    for krate in ["server", "shared/core", "shared/client", "shared/bots", "shared/transport"] {
+        for file in rust_files(&root.join(krate).join("src")) {
+            let text = std::fs::read_to_string(&file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+            assert!(!text.contains("debug_assertions"), "{} branches on debug_assertions", file.display());
+        }
     }
-    assert!(runs.iter().any(|r| r.contains("cargo build --release --locked -p heist_server")), "{runs:?}");
     let runtime = stages[1];
     let copies: Vec<&str> = runtime.lines().filter(|l| l.starts_with("COPY")).collect();
     assert_eq!(copies.len(), 2, "the binary and the levels: {copies:?}");
