@@ -1,30 +1,4 @@
-//! haptico: the haptic device layer (paper §3.3).
-//!
-//! A [`Device`] trait with simulated ([`sim`]), recorded ([`trace`]), mock ([`mock`]), HID (`hid`), Novint
-//! Falcon ([`falcon`]) and Haply Inverse3 (`haply`) backends, an I/O thread for devices whose I/O blocks ([`io`]), and the 1 kHz haptic thread ([`thread`]) that reads the device, broadcasts `OnTransform`,
-//! gathers forces through `ForceOnHapticTick` and commands the device. It depends only on
-//! `haptic_common`; force computation and collision detection plug in through the events.
-//!
-//! ```no_run
-//! use haptico::{HapticClock, HapticConfig, HapticEvents, HapticHandle, presets};
-//! use haptico::sim::{SimConfig, SimDevice, TargetPath};
-//! use haptic_common::{ForceOnHapticTick, ForceTorque, Pose};
-//!
-//! let device = SimDevice::new(SimConfig::new(presets::touch()), TargetPath::Hold(Pose::IDENTITY));
-//! let mut events = HapticEvents::default();
-//! events.force_on_haptic_tick.add_delegate(|tick: &ForceOnHapticTick| {
-//!     // A soft floor at y = 0: 300 N/m.
-//!     let y = tick.device.pose.translation.y;
-//!     if y < 0.0 {
-//!         tick.add(ForceTorque { force: glam::Vec3::Y * (-300.0 * y), torque: glam::Vec3::ZERO });
-//!     }
-//! });
-//! let handle = HapticHandle::spawn(device, events, HapticConfig::default(), HapticClock::new())?;
-//! std::thread::sleep(std::time::Duration::from_millis(100));
-//! println!("{:?}", handle.telemetry());
-//! handle.stop();
-//! # Ok::<(), haptico::HapticoError>(())
-//! ```
+#![doc = include_str!("../README.md")]
 #![warn(missing_docs)]
 
 #[cfg(test)]
@@ -43,6 +17,7 @@ pub mod io;
 pub mod mock;
 pub mod presets;
 pub mod sim;
+pub mod steer;
 pub mod thread;
 pub mod timing;
 pub mod trace;
