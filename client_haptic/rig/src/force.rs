@@ -15,6 +15,7 @@ use glam::Vec3;
 use haptic_common::{DeviceState, ForceOnHapticTick, ForceTorque, Pose};
 
 use crate::WorkspaceMap;
+use crate::spec::MAX_OBJECTS;
 
 /// One tick's forces, recorded for plots (preallocated ring; lost when full).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -36,6 +37,24 @@ pub struct ForceSample {
     pub data_age_us: u32,
     /// Sequence number of the collision step whose contacts were used.
     pub collision_sequence: u64,
+}
+
+/// What the tool felt of one watched object on the last tick.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ObjectContact {
+    /// The object's id (as given in its [`ObjectSpec`](crate::ObjectSpec)).
+    pub id: u32,
+    /// Whether the tool touches it: their trees overlap (volumetric), or the proxy rests on it (3-DOF).
+    pub touching: bool,
+    /// Overlapping sphere pairs (volumetric) or its spheres near the tip (3-DOF proxy).
+    pub contacts: u32,
+    /// Overlap volume of the tool and the object, scene units³ (0 with the 3-DOF proxy).
+    pub volume: f32,
+    /// Force the object puts on the tool, scene frame, N (before coupling and safety; 0 with
+    /// [`Rendering::Off`]).
+    pub force: Vec3,
+    /// Torque the object puts on the tool about the tool's centre of mass, scene frame, N·m.
+    pub torque: Vec3,
 }
 
 /// Latest state of the force stage, for the game thread.
@@ -62,6 +81,18 @@ pub struct RigTelemetry {
     pub outside_workspace: bool,
     /// Safety counters.
     pub safety: SafetyStats,
+    /// Each watched object's contact with the tool, the first [`RigTelemetry::object_count`] in use
+    /// (see [`RigTelemetry::objects`]).
+    pub object_contacts: [ObjectContact; MAX_OBJECTS],
+    /// How many of `object_contacts` are in use.
+    pub object_count: u32,
+}
+
+impl RigTelemetry {
+    /// Each watched object's contact with the tool on the last tick.
+    pub fn objects(&self) -> &[ObjectContact] {
+        &self.object_contacts[..(self.object_count as usize).min(MAX_OBJECTS)]
+    }
 }
 
 impl Default for RigTelemetry {
@@ -77,6 +108,8 @@ impl Default for RigTelemetry {
             safety_gain: 0.0,
             outside_workspace: false,
             safety: SafetyStats::default(),
+            object_contacts: [ObjectContact::default(); MAX_OBJECTS],
+            object_count: 0,
         }
     }
 }
@@ -91,6 +124,10 @@ pub enum Rendering {
     /// 3-DOF god-object: the tool is its tip (the device point), held outside the objects' inner
     /// spheres by a proxy on their surface; force only, no torque (`forcecomp::proxy`).
     Proxy,
+    /// No contact force: contacts are detected and reported (telemetry, [`ObjectContact`]) and the tool
+    /// is the device itself, but only your own `ForceOnHapticTick` delegates push the device (the safety
+    /// layer still covers them). The paper's set-up without ForceComp.
+    Off,
 }
 
 /// How the 3-DOF proxy feels a material.
@@ -139,7 +176,16 @@ pub(crate) enum ObjectReader {
 pub(crate) enum ForceCommand {
     Add(Box<WatchedObject>),
     Remove(u32),
-    SetTool { center_of_mass: Vec3, material: Material },
+    SetTool {
+        center_of_mass: Vec3,
+        material: Material,
+    },
+    /// An object the game moved: its new centre of mass and orientation (scene frame).
+    Move {
+        id: u32,
+        center_of_mass: Vec3,
+        orientation: glam::Quat,
+    },
 }
 
 /// The force stage's state (lives on the haptic thread).
@@ -167,6 +213,8 @@ pub struct ForceStage {
     pub(crate) ball_objects: Vec<u8>,
     pub(crate) telemetry: triple_buffer::Input<RigTelemetry>,
     pub(crate) samples: rtrb::Producer<ForceSample>,
+    /// This tick's contact with each watched object (in the order of `objects`).
+    pub(crate) object_contacts: [ObjectContact; MAX_OBJECTS],
 }
 
 impl ForceStage {
@@ -182,11 +230,11 @@ impl ForceStage {
         // The tool as the force law sees it: the simulated tool (or the device itself when direct).
         let tool_device = match self.rendering {
             Rendering::Coupled => self.coupling.tool_pose(),
-            Rendering::Direct | Rendering::Proxy => device.pose,
+            Rendering::Direct | Rendering::Proxy | Rendering::Off => device.pose,
         };
         let (v, w) = match self.rendering {
             Rendering::Coupled => (self.coupling.tool_velocity(), self.coupling.tool_angular_velocity()),
-            Rendering::Direct | Rendering::Proxy => (device.linear_velocity, device.angular_velocity),
+            Rendering::Direct | Rendering::Proxy | Rendering::Off => (device.linear_velocity, device.angular_velocity),
         };
         let tool_scene = self.map.to_scene(&tool_device);
         let com = tool_scene.transform_point(self.tool_center_of_mass);
@@ -198,14 +246,25 @@ impl ForceStage {
         };
         let mut contact = ForceTorque::ZERO;
         let mut freshness = Freshness::new(self.objects.len());
-        for object in self.objects.iter_mut() {
+        for (slot, object) in self.objects.iter_mut().enumerate() {
             let ObjectReader::Contacts(reader) = &mut object.reader else { continue };
             let set = reader.latest();
             freshness.saw(set.sequence, set.timestamp_us, set.len(), object.added_us);
-            let ft =
-                volumetric_penalty(set, &tool_motion, &object.motion, &self.tool_material.combine(&object.material));
+            let ft = if self.rendering == Rendering::Off {
+                ForceTorque::ZERO
+            } else {
+                volumetric_penalty(set, &tool_motion, &object.motion, &self.tool_material.combine(&object.material))
+            };
             contact.force += ft.force;
             contact.torque += ft.torque;
+            self.object_contacts[slot] = ObjectContact {
+                id: object.id,
+                touching: !set.is_empty(),
+                contacts: set.len() as u32,
+                volume: set.total_volume,
+                force: ft.force,
+                torque: ft.torque,
+            };
         }
         let used = freshness.used(device.timestamp_us);
         // Torque about the tool frame's origin (where the coupling acts) instead of the centre of mass.
@@ -215,7 +274,7 @@ impl ForceStage {
         let dt = tick.dt_s;
         let wanted = match self.rendering {
             Rendering::Coupled => self.coupling.step(&device, contact_device, dt),
-            Rendering::Direct | Rendering::Proxy => contact_device,
+            Rendering::Direct | Rendering::Proxy | Rendering::Off => contact_device,
         };
         let before = tick.total();
         let requested = ForceTorque { force: before.force + wanted.force, torque: before.torque + wanted.torque };
@@ -224,7 +283,7 @@ impl ForceStage {
 
         let tool_now = match self.rendering {
             Rendering::Coupled => self.map.to_scene(&self.coupling.tool_pose()),
-            Rendering::Direct | Rendering::Proxy => self.map.to_scene(&device.pose),
+            Rendering::Direct | Rendering::Proxy | Rendering::Off => self.map.to_scene(&device.pose),
         };
         self.tool.set(tool_now, device.timestamp_us);
         self.report(device, out, contact_device.force, tool_now.translation, tool_now, used);
@@ -256,6 +315,12 @@ impl ForceStage {
                     self.tool_center_of_mass = center_of_mass;
                     self.tool_material = material;
                 }
+                ForceCommand::Move { id, center_of_mass, orientation } => {
+                    if let Some(o) = self.objects.iter_mut().find(|o| o.id == id) {
+                        o.motion.center_of_mass = center_of_mass;
+                        o.motion.orientation = orientation;
+                    }
+                }
             }
         }
     }
@@ -277,6 +342,8 @@ impl ForceStage {
             let ObjectReader::Near(reader) = &mut object.reader else { continue };
             let set = reader.latest();
             freshness.saw(set.sequence, set.timestamp_us, set.len(), object.added_us);
+            self.object_contacts[slot] =
+                ObjectContact { id: object.id, contacts: set.len() as u32, ..Default::default() };
             for s in set.as_slice().iter().take(self.balls.capacity() - self.balls.len()) {
                 self.balls.push(Ball { center: s.center, radius: s.radius });
                 self.ball_objects.push(slot as u8);
@@ -291,7 +358,9 @@ impl ForceStage {
             .min_by(|a, b| {
                 (a.1.center.distance(near) - a.1.radius).total_cmp(&(b.1.center.distance(near) - b.1.radius))
             })
-            .map(|(i, _)| &self.objects[usize::from(self.ball_objects[i])]);
+            .map(|(i, _)| usize::from(self.ball_objects[i]));
+        let nearest_slot = nearest;
+        let nearest = nearest.map(|slot| &self.objects[slot]);
         let material = nearest.map(|o| self.tool_material.combine(&o.material));
         let config = ProxyConfig {
             stiffness_n_per_m: material
@@ -318,6 +387,10 @@ impl ForceStage {
                 config.stiffness_n_per_m / scale,
             );
             force_scene += ridged - push;
+        }
+        if let Some(slot) = nearest_slot.filter(|_| self.god.in_contact()) {
+            self.object_contacts[slot].touching = true;
+            self.object_contacts[slot].force = force_scene;
         }
         let contact_device = self.map.wrench_to_device(ForceTorque { force: force_scene, torque: Vec3::ZERO });
         let used = freshness.used(device.timestamp_us);
@@ -352,7 +425,10 @@ impl ForceStage {
             data_age_us: age_us.min(u32::MAX as u64) as u32,
             collision_sequence: sequence,
         });
+        let object_count = self.objects.len().min(MAX_OBJECTS);
         self.telemetry.write(RigTelemetry {
+            object_contacts: self.object_contacts,
+            object_count: object_count as u32,
             device,
             tool_pose,
             output: out,

@@ -59,6 +59,11 @@ impl<D: Device> Lockstep<D> {
         self.scene.add_object(object)
     }
 
+    /// Moves watched object `id` to `pose` (see [`HapticRig::set_object_pose`](crate::HapticRig::set_object_pose)).
+    pub fn set_object_pose(&mut self, id: u32, pose: haptic_common::Pose) -> Result<()> {
+        self.scene.move_object(id, pose)
+    }
+
     /// Stops watching object `id`.
     pub fn remove_object(&mut self, id: u32) -> Result<()> {
         self.scene.remove_object(id)

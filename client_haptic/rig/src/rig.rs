@@ -118,6 +118,7 @@ impl Parts {
             ball_objects: Vec::with_capacity(balls),
             telemetry: telemetry_in,
             samples: samples_tx,
+            object_contacts: [crate::force::ObjectContact::default(); MAX_OBJECTS],
         };
         Ok(Self { stage, scene, outputs: Outputs { samples: samples_rx, telemetry: telemetry_out } })
     }
@@ -195,6 +196,13 @@ impl<D: Device + 'static> HapticRig<D> {
     /// Watches an object (replaces the one with the same id).
     pub fn add_object(&self, object: ObjectSpec) -> Result<()> {
         self.with_scene(|s| s.add_object(object))
+    }
+
+    /// Moves watched object `id` to `pose` (scene frame): the collision thread measures it there from its
+    /// next step, the force stage takes its new centre of mass and orientation. The pose is the game's
+    /// placement, not a sample of a moving body: it does not age (the data's age stays the tool's).
+    pub fn set_object_pose(&self, id: u32, pose: Pose) -> Result<()> {
+        self.with_scene(|s| s.move_object(id, pose))
     }
 
     /// Stops watching object `id`.

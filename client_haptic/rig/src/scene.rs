@@ -9,6 +9,7 @@
 
 use collette::pipeline::{CollisionHandle, ObjectId, PoseWriter, TimedPose, WatcherId};
 use forcecomp::BodyMotion;
+use haptic_common::Pose;
 
 use crate::force::{ForceCommand, ObjectReader, WatchedObject};
 use crate::spec::{MAX_OBJECTS, ObjectSpec, ToolSpec, center_of_mass};
@@ -22,8 +23,10 @@ struct Entry {
     id: u32,
     object: ObjectId,
     watcher: WatcherId,
-    // Held so that the object's pose buffer lives (the object does not move).
-    _pose: PoseWriter,
+    /// Moves the object on the collision thread.
+    pose: PoseWriter,
+    /// Its centre of mass in its own frame.
+    center_of_mass: glam::Vec3,
 }
 
 /// What the rig watches, and the ends of the rings that change it.
@@ -76,13 +79,29 @@ impl Scene {
             let r = self.collision.add_watcher(self.tool, pose.id()).ok_or_else(full)?;
             (r.id(), ObjectReader::Contacts(r))
         };
+        let local_center = center_of_mass(&spec.tree);
         let motion = BodyMotion {
             orientation: spec.pose.rotation,
-            ..BodyMotion::at_rest(spec.pose.transform_point(center_of_mass(&spec.tree)))
+            ..BodyMotion::at_rest(spec.pose.transform_point(local_center))
         };
         let object = Box::new(WatchedObject { id: spec.id, reader, material: spec.material, motion, added_us: 0 });
         self.forces.push(ForceCommand::Add(object)).map_err(|_| RigError::QueueFull("haptic"))?;
-        self.entries.push(Entry { id: spec.id, object: pose.id(), watcher, _pose: pose });
+        self.entries.push(Entry { id: spec.id, object: pose.id(), watcher, pose, center_of_mass: local_center });
+        Ok(())
+    }
+
+    /// Moves object `id` to `pose`: its pose buffer on the collision thread, its motion in the force stage.
+    pub(crate) fn move_object(&mut self, id: u32, pose: Pose) -> Result<()> {
+        self.free_returned();
+        let entry = self.entries.iter_mut().find(|e| e.id == id).ok_or(RigError::UnknownObject(id))?;
+        let command = ForceCommand::Move {
+            id,
+            center_of_mass: pose.transform_point(entry.center_of_mass),
+            orientation: pose.rotation,
+        };
+        self.forces.push(command).map_err(|_| RigError::QueueFull("haptic"))?;
+        // A placement, not a sample: it never ages (see `TimedPose`).
+        entry.pose.set(pose, u64::MAX);
         Ok(())
     }
 

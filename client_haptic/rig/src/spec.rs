@@ -9,8 +9,8 @@ use forcecomp::Material;
 use glam::Vec3;
 use haptic_common::Pose;
 
-/// Most objects watched at once.
-pub const MAX_OBJECTS: usize = 4;
+/// Most objects watched at once (each against the tool).
+pub const MAX_OBJECTS: usize = 16;
 
 /// The tool: its Inner Sphere Tree, centre of mass and material.
 #[derive(Clone, Debug)]

@@ -107,11 +107,12 @@ fn objects_come_and_go_in_the_one_pipeline(rendering: Rendering) {
     rig.set_region(None).expect("region");
     let s = now();
     assert!(eventually(|| touching(s)), "the region lifted");
-    for id in [5, 6] {
+    for id in 5..5 + haptic_rig::MAX_OBJECTS as u32 - 2 {
         rig.add_object(ObjectSpec { pose: Pose::from_translation(Vec3::X * id as f32), ..utils::slab_object(id) })
-            .expect("room for four");
+            .expect("room for MAX_OBJECTS");
     }
-    assert!(matches!(rig.add_object(utils::slab_object(7)), Err(haptic_rig::RigError::TooManyObjects(4))));
+    let full = rig.add_object(utils::slab_object(99));
+    assert!(matches!(full, Err(haptic_rig::RigError::TooManyObjects(haptic_rig::MAX_OBJECTS))), "{full:?}");
     rig.remove_object(4).expect("remove");
     let s = now();
     assert!(eventually(|| apart(s)), "the removed slab is no longer felt");
@@ -126,5 +127,71 @@ fn objects_come_and_go_in_the_one_pipeline(rendering: Rendering) {
     let mut steps = Vec::new();
     assert!(rig.drain_collision_timings(&mut steps) > 10, "the pipeline records its steps");
     assert!(steps.windows(2).all(|w| w[1].sequence > w[0].sequence), "in order");
+    assert!(rig.stop().is_some());
+}
+
+#[test]
+fn a_moved_object_is_felt_where_it_went_and_the_telemetry_names_the_object_touched() {
+    objects_move_and_are_named(Rendering::Coupled);
+}
+
+#[test]
+fn a_moved_object_is_felt_where_it_went_with_proxy_rendering() {
+    objects_move_and_are_named(Rendering::Proxy);
+}
+
+#[test]
+fn without_a_force_stage_contacts_are_reported_and_only_the_delegates_push() {
+    let device = SimDevice::new(
+        SimConfig::new(presets::touch()),
+        TargetPath::line(Vec3::new(0.0, -0.002, 0.0), Vec3::new(0.0, -0.002, 0.0), 0.1),
+    );
+    let tool = ToolSpec::new(utils::ball_tool(), Material::default());
+    let config = RigConfig { rendering: Rendering::Off, ..RigConfig::default() };
+    // A delegate's constant 0.1 N upwards (below the safety layer's engagement threshold): the only force.
+    let mut events = HapticEvents::default();
+    events.force_on_haptic_tick.add_delegate(|t: &haptic_common::ForceOnHapticTick| {
+        t.add(haptic_common::ForceTorque { force: Vec3::Y * 0.1, torque: Vec3::ZERO })
+    });
+    let rig = HapticRig::start(device, tool, config, events, Delegator::new()).expect("rig");
+    rig.add_object(utils::slab_object(3)).expect("add");
+    let touched = |t: &haptic_rig::RigTelemetry| t.objects().iter().any(|c| c.id == 3 && c.touching && c.volume > 0.0);
+    assert!(eventually(|| touched(&rig.telemetry())), "the slab's contact is reported: {:?}", rig.telemetry());
+    // Past the safety layer's fade-in, the output is the delegate's force alone: no contact force.
+    assert!(eventually(|| (rig.telemetry().output.force - Vec3::Y * 0.1).length() < 1e-4), "{:?}", rig.telemetry());
+    let t = rig.telemetry();
+    assert!(touched(&t));
+    assert_eq!(t.objects()[0].force, Vec3::ZERO, "no contact force without a force stage");
+    assert!(rig.stop().is_some());
+}
+
+/// The tool rests 2 mm below y = 0 at x = 0; two slabs start far apart from it; moving the second one
+/// under the tool makes it (and only it) touched, moving it away again ends the contact.
+fn objects_move_and_are_named(rendering: Rendering) {
+    let device = SimDevice::new(
+        SimConfig::new(presets::touch()),
+        TargetPath::line(Vec3::new(0.0, -0.002, 0.0), Vec3::new(0.0, -0.002, 0.0), 0.1),
+    );
+    let tool = ToolSpec::new(utils::ball_tool(), Material::default());
+    let config = RigConfig { rendering, ..RigConfig::default() };
+    let rig = HapticRig::start(device, tool, config, HapticEvents::default(), Delegator::new()).expect("rig");
+    let away = |x: f32| Pose::from_translation(Vec3::new(x, -0.01, 0.0));
+    rig.add_object(ObjectSpec { pose: away(0.5), ..utils::slab_object(1) }).expect("add");
+    rig.add_object(ObjectSpec { pose: away(-0.5), ..utils::slab_object(2) }).expect("add");
+    let touching = |id: u32| {
+        let t = rig.telemetry();
+        let ids: Vec<u32> = t.objects().iter().filter(|c| c.touching).map(|c| c.id).collect();
+        ids == [id] && t.objects().iter().any(|c| c.id == id && c.force.y > 0.0)
+    };
+    let nothing = || {
+        let t = rig.telemetry();
+        t.objects().len() == 2 && t.objects().iter().all(|c| !c.touching)
+    };
+    assert!(eventually(nothing), "both slabs far away: {:?}", rig.telemetry().objects());
+    rig.set_object_pose(2, away(0.0)).expect("move");
+    assert!(eventually(|| touching(2)), "the moved slab is under the tool: {:?}", rig.telemetry().objects());
+    rig.set_object_pose(2, away(-0.5)).expect("move");
+    assert!(eventually(nothing), "moved away again: {:?}", rig.telemetry().objects());
+    assert!(matches!(rig.set_object_pose(9, away(0.0)), Err(haptic_rig::RigError::UnknownObject(9))));
     assert!(rig.stop().is_some());
 }
