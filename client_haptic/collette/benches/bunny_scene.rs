@@ -1,7 +1,7 @@
 //! The paper's benchmark scene: a 1 cm brilliant-cut gem exploring the 10 cm Stanford bunny along the
 //! scripted 35 s / 1 kHz trajectory, against parry3d's triangle-mesh contact query on the same poses.
 //!
-//! `cargo bench -p collette --bench bunny_scene` first prints (and writes to
+//! `cargo bench -p collette_ist --bench bunny_scene` first prints (and writes to
 //! `target/collette-bench/`) the table of build time, coverage and query time percentiles for each
 //! sphere count (the exact aggregated query also with temporal coherence, `CoherentOverlap`, in a pass
 //! of its own that takes every pose once, in order), then runs a few criterion micro-benchmarks.

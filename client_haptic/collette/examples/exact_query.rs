@@ -2,7 +2,7 @@
 //! loop for working on the query, where the full `bunny_scene` bench also runs every other query.
 //!
 //! ```text
-//! cargo run --release -p collette --example exact_query -- --spheres 10000
+//! cargo run --release -p collette_ist --example exact_query -- --spheres 10000
 //! ```
 //!
 //! Prints the query time's p50 / p99 / p99.9 / max (least of `--runs` runs per pose, which filters out

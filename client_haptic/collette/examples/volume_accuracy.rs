@@ -9,8 +9,8 @@
 //! trees, or `A:B` to pack the two meshes differently and see whose packing the error comes from).
 //!
 //! ```text
-//! cargo run --release -p collette --example volume_accuracy -- --poses 300 --samples 1000000
-//! cargo run --release -p collette --example volume_accuracy -- --pairs gem-bunny --spheres 10000,40000:10000,10000:40000
+//! cargo run --release -p collette_ist --example volume_accuracy -- --poses 300 --samples 1000000
+//! cargo run --release -p collette_ist --example volume_accuracy -- --pairs gem-bunny --spheres 10000,40000:10000,10000:40000
 //! ```
 //!
 //! Prints, per pair and sphere count, the ratio's p5 / p50 / p95 (and min / max): the packing's own

@@ -7,7 +7,6 @@
 //! exactly `rate × window` starts in each.
 
 use std::io::Write;
-use std::path::Path;
 
 use haptico::TickTiming;
 use haptico::timing::{TimingSummary, summarize};
@@ -224,7 +223,8 @@ pub fn write_csv(out: &mut impl Write, windows: &[Window]) -> std::io::Result<()
 }
 
 /// Draws the Fig. 9-style plot: window rates on top, force and torque magnitudes below.
-pub fn plot(path: &Path, windows: &[Window], title: &str) -> Result<(), Box<dyn std::error::Error>> {
+#[cfg(feature = "bench")]
+pub fn plot(path: &std::path::Path, windows: &[Window], title: &str) -> Result<(), Box<dyn std::error::Error>> {
     use plotters::prelude::*;
     let root = BitMapBackend::new(path, (1000, 620)).into_drawing_area();
     root.fill(&WHITE)?;

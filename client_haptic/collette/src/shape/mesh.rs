@@ -48,8 +48,23 @@ impl TriMesh {
         let options = tobj::LoadOptions { single_index: true, triangulate: true, ..Default::default() };
         let (models, _) = tobj::load_obj(path, &options)
             .map_err(|e| MeshError::Obj { path: path.to_owned(), message: e.to_string() })?;
+        Self::merged(&models)
+    }
+
+    /// Reads an OBJ file's contents, as [`TriMesh::from_obj`] (materials are not read); `path` names the
+    /// file in errors.
+    pub fn from_obj_bytes(bytes: &[u8], path: &Path) -> Result<Self, MeshError> {
+        let options = tobj::LoadOptions { single_index: true, triangulate: true, ..Default::default() };
+        let (models, _) =
+            tobj::load_obj_buf(&mut std::io::BufReader::new(bytes), &options, |_| Err(tobj::LoadError::OpenFileFailed))
+                .map_err(|e| MeshError::Obj { path: path.to_owned(), message: e.to_string() })?;
+        Self::merged(&models)
+    }
+
+    /// Every model's triangles in one mesh, validated.
+    fn merged(models: &[tobj::Model]) -> Result<Self, MeshError> {
         let (mut positions, mut indices) = (Vec::new(), Vec::new());
-        for model in &models {
+        for model in models {
             let base = (positions.len() / 3) as u32;
             positions.extend_from_slice(&model.mesh.positions);
             indices.extend(model.mesh.indices.iter().map(|i| i + base));

@@ -1,0 +1,158 @@
+//! What every example shares: `--headless --seconds N` (no window; the simulated device follows the
+//! example's scripted path; one JSON line of the loop's figures at the end), or a window
+//! (`--screenshot PNG`: save the window after 120 frames and quit).
+
+use std::time::Duration;
+
+use bevy::app::ScheduleRunnerPlugin;
+use bevy::prelude::*;
+use bevy_haptics::prelude::*;
+
+/// How the example runs.
+#[derive(Resource, Clone, Copy, Debug)]
+pub struct Run {
+    /// The example's name.
+    pub name: &'static str,
+    /// No window.
+    pub headless: bool,
+    /// Stop after this long, s (`None`: when the window closes).
+    pub seconds: Option<f32>,
+    /// Save the window to this PNG after 120 frames, then quit.
+    pub screenshot: Option<&'static str>,
+}
+
+impl Run {
+    /// Reads the command line; a bad argument ends the program with one line saying what is accepted.
+    pub fn from_args(name: &'static str) -> Self {
+        let mut run = Self { name, headless: false, seconds: None, screenshot: None };
+        let mut args = std::env::args().skip(1);
+        while let Some(arg) = args.next() {
+            match arg.as_str() {
+                "--headless" => run.headless = true,
+                "--seconds" => match args.next().and_then(|s| s.parse::<f32>().ok()).filter(|s| *s > 0.0) {
+                    Some(s) => run.seconds = Some(s),
+                    None => fail("--seconds takes a positive number of seconds"),
+                },
+                "--screenshot" => match args.next() {
+                    Some(path) => run.screenshot = Some(Box::leak(path.into_boxed_str())),
+                    None => fail("--screenshot takes the path of a PNG to write"),
+                },
+                other => {
+                    fail(&format!("unknown argument {other:?}: use [--headless] [--seconds N] [--screenshot PNG]"))
+                }
+            }
+        }
+        if run.headless && run.seconds.is_none() {
+            run.seconds = Some(5.0);
+        }
+        run
+    }
+
+    /// An app with a window (or none, headless), the assets of the repository, and the example's end.
+    pub fn app(self) -> App {
+        let assets =
+            AssetPlugin { file_path: concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets").into(), ..default() };
+        let mut app = App::new();
+        if self.headless {
+            let frame = Duration::from_secs_f64(1.0 / 60.0);
+            app.add_plugins((MinimalPlugins.set(ScheduleRunnerPlugin::run_loop(frame)), assets)).init_asset::<Mesh>();
+        } else {
+            // Pipelines compiled before the first frame: on a software renderer (lavapipe) the first
+            // frames are black otherwise.
+            let render = bevy::render::RenderPlugin { synchronous_pipeline_compilation: true, ..default() };
+            app.add_plugins(DefaultPlugins.set(assets).set(render)).add_systems(Update, screenshot);
+        }
+        app.insert_resource(self).add_systems(Update, end);
+        app
+    }
+}
+
+fn fail(message: &str) -> ! {
+    eprintln!("error: {message}");
+    std::process::exit(2)
+}
+
+/// Seconds since the example started.
+pub fn elapsed(time: &Time<Real>) -> f32 {
+    time.elapsed_secs()
+}
+
+/// After `--seconds`, prints the loop's figures as one JSON line and exits.
+fn end(
+    run: Res<Run>,
+    time: Res<Time<Real>>,
+    stats: Res<HapticStats>,
+    status: Res<HapticStatus>,
+    mut exit: MessageWriter<AppExit>,
+) {
+    let Some(seconds) = run.seconds else { return };
+    if elapsed(&time) < seconds {
+        return;
+    }
+    if let HapticStatus::Failed(why) = &*status {
+        fail(&format!("haptics did not start: {why}"));
+    }
+    let line = serde_json::json!({
+        "example": run.name,
+        "seconds": seconds,
+        "haptic_hz_min": stats.haptic.min_hz(),
+        "collision_hz_min": stats.collision.min_hz(),
+        "contacts": stats.contacts_started,
+        "max_force_n": stats.max_force_n,
+        "max_force_step_n": stats.max_force_step_n,
+        "max_torque_nm": stats.max_torque_nm,
+        "ticks": stats.ticks,
+        "non_finite": stats.non_finite,
+    });
+    println!("{line}");
+    exit.write(AppExit::Success);
+}
+
+/// Saves the window after 120 frames, then quits once the file is written (`--screenshot`).
+fn screenshot(run: Res<Run>, mut commands: Commands, mut frames: Local<u32>, mut exit: MessageWriter<AppExit>) {
+    use bevy::render::view::screenshot::{Screenshot, save_to_disk};
+    let Some(path) = run.screenshot else { return };
+    *frames += 1;
+    if *frames == 120 {
+        commands.spawn(Screenshot::primary_window()).observe(save_to_disk(path));
+    }
+    if *frames > 125 && std::path::Path::new(path).exists() || *frames > 720 {
+        exit.write(AppExit::Success);
+    }
+}
+
+/// Moves the simulated hand with the keyboard (windowed): arrows in the horizontal plane, PageUp and
+/// PageDown up and down, 5 cm/s.
+pub fn keyboard_hand(keys: Res<ButtonInput<KeyCode>>, hand: Option<ResMut<SimulatedHand>>, time: Res<Time>) {
+    let Some(mut hand) = hand else { return };
+    let pairs = [
+        (KeyCode::ArrowLeft, Vec3::NEG_X),
+        (KeyCode::ArrowRight, Vec3::X),
+        (KeyCode::ArrowUp, Vec3::NEG_Z),
+        (KeyCode::ArrowDown, Vec3::Z),
+        (KeyCode::PageUp, Vec3::Y),
+        (KeyCode::PageDown, Vec3::NEG_Y),
+    ];
+    let direction: Vec3 = pairs.iter().filter(|(k, _)| keys.pressed(*k)).map(|(_, d)| *d).sum();
+    if direction != Vec3::ZERO {
+        let now = hand.now_us();
+        let at = hand.goal().sample(now).translation;
+        hand.set(HandGoal::Hold(bevy_haptics::libs::haptic_common::Pose::from_translation(
+            at + direction * 0.05 * time.delta_secs(),
+        )));
+    }
+}
+
+/// A camera looking at `target` from `eye`, and a light (windowed).
+pub fn camera(commands: &mut Commands, eye: Vec3, target: Vec3) {
+    commands.spawn((Camera3d::default(), Transform::from_translation(eye).looking_at(target, Vec3::Y)));
+    commands.spawn((DirectionalLight::default(), Transform::from_xyz(1.0, 2.0, 1.5).looking_at(Vec3::ZERO, Vec3::Y)));
+}
+
+/// The tool and the force on the device, a red line of 2 cm per newton (windowed).
+pub fn draw_tool(mut gizmos: Gizmos, mut moved: MessageReader<ToolMoved>) {
+    if let Some(m) = moved.read().last() {
+        gizmos.sphere(Isometry3d::from_translation(m.transform.translation), 0.003, Color::WHITE);
+        gizmos.line(m.transform.translation, m.transform.translation + m.force_n * 0.02, Color::srgb(1.0, 0.2, 0.2));
+    }
+}

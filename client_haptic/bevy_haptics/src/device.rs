@@ -1,0 +1,188 @@
+//! Which device the haptic thread drives, where its workspace sits in the world, and the simulated
+//! hand a game (or a test) steers when there is no real device.
+//!
+//! You need this module to choose the device: insert a [`HapticDevice`] before the app starts (default:
+//! a simulated Phantom Desktop). A real device you open yourself with haptico (a Falcon, an Inverse3, a
+//! HID device) goes in as [`DeviceKind::Custom`].
+
+use std::path::PathBuf;
+use std::sync::Mutex;
+
+use bevy::prelude::*;
+use haptic_common::Pose;
+use haptico::steer::{HandControl, HandGoal, SteeredSim};
+use haptico::{Device, DeviceSpecs, HapticClock};
+
+/// The device, chosen before the app starts.
+#[derive(Resource, Debug)]
+pub struct HapticDevice {
+    /// What device.
+    pub kind: DeviceKind,
+    /// Where the device's origin sits in the world (translation and rotation; scale ignored), and how
+    /// many world metres a device metre is (`scale`).
+    pub origin: Transform,
+    /// World metres per device metre (default 1).
+    pub scale: f32,
+    /// Haptic thread rate, Hz (default 1000).
+    pub rate_hz: f32,
+    /// Real-time FIFO priority for the haptic thread (the collision thread gets one less), 1..=99
+    /// (default none: needs the right to use it).
+    pub realtime_priority: Option<i32>,
+}
+
+impl Default for HapticDevice {
+    fn default() -> Self {
+        Self {
+            kind: DeviceKind::default(),
+            origin: Transform::IDENTITY,
+            scale: 1.0,
+            rate_hz: 1000.0,
+            realtime_priority: None,
+        }
+    }
+}
+
+impl HapticDevice {
+    /// A simulated device copying the preset named `preset` (see [`DeviceKind::Simulated`]), its hand
+    /// resting at `start` (device frame, m).
+    pub fn simulated(preset: &str, start: Vec3) -> Self {
+        Self { kind: DeviceKind::Simulated { preset: preset.to_owned(), start }, ..Self::default() }
+    }
+
+    /// Any device opened with haptico (a Falcon, an Inverse3, a HID device, your own [`Device`]).
+    pub fn custom(device: Box<dyn Device>) -> Self {
+        Self { kind: DeviceKind::Custom(Mutex::new(Some(device))), ..Self::default() }
+    }
+
+    /// The device frame to world map the rig uses.
+    pub(crate) fn map(&self) -> haptic_rig::WorkspaceMap {
+        haptic_rig::WorkspaceMap { origin: Pose::new(self.origin.translation, self.origin.rotation), scale: self.scale }
+    }
+}
+
+/// The kinds of device.
+pub enum DeviceKind {
+    /// A simulated device (a hand on a spring, the preset's limits), steered through [`SimulatedHand`].
+    Simulated {
+        /// A haptico preset, by part of its name, any case: `phantom desktop`, `touch`, `falcon`,
+        /// `inverse3`, `premium` (6-DOF force and torque), ... (default the Phantom Desktop: 7.9 N,
+        /// 6-DOF sensing, 3-DOF force).
+        preset: String,
+        /// Where the hand rests at start, device frame, m.
+        start: Vec3,
+    },
+    /// Replays a trace recorded with haptico (CSV), looping.
+    Trace {
+        /// The trace file.
+        path: PathBuf,
+        /// The limits of the device it stands for (a haptico preset's name).
+        preset: String,
+    },
+    /// A device you opened (taken when the app starts).
+    Custom(Mutex<Option<Box<dyn Device>>>),
+}
+
+impl std::fmt::Debug for DeviceKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Simulated { preset, start } => {
+                f.debug_struct("Simulated").field("preset", preset).field("start", start).finish()
+            }
+            Self::Trace { path, preset } => {
+                f.debug_struct("Trace").field("path", path).field("preset", preset).finish()
+            }
+            Self::Custom(_) => f.write_str("Custom"),
+        }
+    }
+}
+
+impl Default for DeviceKind {
+    fn default() -> Self {
+        Self::Simulated { preset: "phantom desktop".into(), start: Vec3::ZERO }
+    }
+}
+
+/// Why the device could not be opened.
+#[derive(Debug, thiserror::Error)]
+pub enum DeviceError {
+    /// No preset by that name.
+    #[error("no device preset named {0:?} (haptico::presets has: {1})")]
+    NoPreset(String, String),
+    /// The trace could not be read.
+    #[error("the trace {0}: {1}")]
+    Trace(PathBuf, String),
+    /// A custom device was already taken by an earlier start.
+    #[error("the custom device was already used")]
+    Taken,
+}
+
+/// The device opened, with the hand that steers it when simulated.
+pub(crate) struct Opened {
+    pub(crate) device: Box<dyn Device>,
+    pub(crate) hand: Option<HandControl>,
+}
+
+fn preset(name: &str) -> Result<DeviceSpecs, DeviceError> {
+    haptico::presets::by_name(name).ok_or_else(|| {
+        let names: Vec<_> = haptico::presets::all().iter().map(|s| s.name).collect();
+        DeviceError::NoPreset(name.to_owned(), names.join(", "))
+    })
+}
+
+impl DeviceKind {
+    pub(crate) fn open(&self) -> Result<Opened, DeviceError> {
+        match self {
+            Self::Simulated { preset: name, start } => {
+                let (device, hand) = SteeredSim::new(preset(name)?, Pose::from_translation(*start));
+                Ok(Opened { device: Box::new(device), hand: Some(hand) })
+            }
+            Self::Trace { path, preset: name } => {
+                let failed = |e: &dyn std::fmt::Display| DeviceError::Trace(path.clone(), e.to_string());
+                let samples = haptico::trace::load(path).map_err(|e| failed(&e))?;
+                let device = haptico::trace::TraceDevice::new(preset(name)?, samples, true).map_err(|e| failed(&e))?;
+                Ok(Opened { device: Box::new(device), hand: None })
+            }
+            Self::Custom(device) => {
+                let device = device.lock().unwrap_or_else(|p| p.into_inner()).take().ok_or(DeviceError::Taken)?;
+                Ok(Opened { device, hand: None })
+            }
+        }
+    }
+}
+
+/// The simulated device's hand (present while a [`DeviceKind::Simulated`] device runs): where it
+/// wants the stylus, sampled by the haptic thread at every tick (device frame). Keys, a mouse, a bot or
+/// a scripted path set it; the forces the device renders push back on it like on a hand.
+#[derive(Resource)]
+pub struct SimulatedHand {
+    control: HandControl,
+    clock: HapticClock,
+}
+
+impl SimulatedHand {
+    pub(crate) fn new(control: HandControl, clock: HapticClock) -> Self {
+        Self { control, clock }
+    }
+
+    /// Sets where the hand goes from now on (times in a goal are on [`SimulatedHand::now_us`]'s clock).
+    pub fn set(&mut self, goal: HandGoal) {
+        self.control.set(goal);
+    }
+
+    /// Moves the hand in a straight line to `to` (device frame, m) in `seconds`, from where it is going now.
+    pub fn move_to(&mut self, to: Vec3, seconds: f32) {
+        let now = self.now_us();
+        let from = self.control.goal().sample(now).translation;
+        self.set(HandGoal::Line { from, to, duration_s: seconds, start_us: now });
+    }
+
+    /// The goal last set.
+    pub fn goal(&self) -> HandGoal {
+        self.control.goal()
+    }
+
+    /// The haptic clock, µs.
+    pub fn now_us(&self) -> u64 {
+        self.clock.now_us()
+    }
+}

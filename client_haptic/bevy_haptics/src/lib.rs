@@ -1,0 +1,41 @@
+#![doc = include_str!("../README.md")]
+#![warn(missing_docs)]
+
+mod components;
+mod device;
+mod effects;
+mod events;
+mod plugins;
+mod runtime;
+mod stats;
+mod tree;
+
+pub use components::{CollisionVolume, ForceComponent, HapticCollider, HapticTool, Ridges};
+pub use device::{DeviceError, DeviceKind, HapticDevice, SimulatedHand};
+pub use effects::{EffectKind, HapticEffect, MAX_EFFECTS};
+pub use events::{ContactData, ContactEnded, ContactOngoing, ContactStarted, ToolMoved};
+pub use plugins::{
+    CollettePlugin, CollisionSettings, ForceCompPlugin, ForceRendering, HapticoPlugin, HapticsPlugins, HapticsSystems,
+    RenderingMode,
+};
+pub use runtime::{HapticDelegates, HapticStatus};
+pub use stats::{HapticStats, WINDOW_US, WindowedRate};
+pub use tree::{SphereTree, SphereTreeError, SphereTreeFromMesh, SphereTreeLoader, SphereTreeSettings, tri_mesh};
+
+/// The libraries underneath, for what the plugins do not wrap (your own device, the force delegates'
+/// payloads, the rig's settings).
+pub mod libs {
+    pub use {collette, forcecomp, haptic_common, haptic_rig, haptico};
+}
+
+/// Everything a game usually needs.
+pub mod prelude {
+    pub use crate::{
+        CollettePlugin, CollisionVolume, ContactEnded, ContactOngoing, ContactStarted, EffectKind, ForceCompPlugin,
+        ForceComponent, HapticCollider, HapticDelegates, HapticDevice, HapticEffect, HapticStats, HapticStatus,
+        HapticTool, HapticoPlugin, HapticsPlugins, HapticsSystems, RenderingMode, SimulatedHand, SphereTree,
+        SphereTreeFromMesh, SphereTreeSettings, ToolMoved,
+    };
+    pub use haptic_common::{ForceOnHapticTick, ForceTorque};
+    pub use haptico::steer::HandGoal;
+}

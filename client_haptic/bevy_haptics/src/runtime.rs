@@ -1,0 +1,488 @@
+//! The running threads and the systems that keep them and the world in step: the tool's `Transform`
+//! from the device, colliders' trees, poses and materials to the collision and haptic threads, contacts
+//! back as messages and observer events, the loop's figures.
+//!
+//! You need this module to see what happens each frame (the plugins add these systems): in `PreUpdate`
+//! the tool moves and contacts are reported, in `PostUpdate` (after transforms propagate) what the game
+//! changed reaches the threads, in `Last` an exiting app stops them.
+
+use std::collections::{HashMap, HashSet};
+use std::sync::{Arc, Mutex};
+
+use bevy::ecs::system::SystemParam;
+use bevy::prelude::*;
+use forcecomp::{SafetyConfig, SafetyLayer};
+use haptic_common::{ForceOnHapticTick, Pose};
+use haptic_rig::{ForceSample, HapticRig, ObjectSpec, Rendering, RigConfig, StepTiming, ToolSpec};
+use haptico::{Device, DeviceSpecs, HapticClock, HapticEvents, HapticHandle, TickTiming};
+
+use crate::components::{CollisionVolume, ForceComponent, HapticCollider, HapticTool};
+use crate::device::{HapticDevice, SimulatedHand};
+use crate::events::{ContactData, ContactEnded, ContactOngoing, ContactStarted, ToolMoved};
+use crate::plugins::{CollisionSettings, ForceRendering};
+use crate::stats::HapticStats;
+use crate::tree::SphereTree;
+
+/// Delegates to bind to the haptic thread's events before it starts (the paper's OnTransform and
+/// ForceOnHapticTick, run at 1 kHz on the haptic thread). Bind them while building the app or in a
+/// `Startup` system; the threads start in `PostStartup` and take them.
+///
+/// A force delegate adds its force and torque (device frame, N and N·m) to the tick; with
+/// `ForceCompPlugin` the contact forces are added after yours, and the safety layer always has the last
+/// word. Delegates run on the haptic thread: they must not allocate, lock, block or log.
+#[derive(Resource, Default)]
+pub struct HapticDelegates {
+    // A mutex only to make the resource `Sync` (delegates are `Send`): it is locked while binding.
+    events: Mutex<Option<HapticEvents>>,
+}
+
+impl HapticDelegates {
+    fn bind(&mut self, f: impl FnOnce(&mut HapticEvents)) {
+        let events = self.events.get_mut().unwrap_or_else(|p| p.into_inner());
+        f(events.get_or_insert_with(HapticEvents::default));
+    }
+
+    fn take(&mut self) -> HapticEvents {
+        self.events.get_mut().unwrap_or_else(|p| p.into_inner()).take().unwrap_or_default()
+    }
+
+    /// Binds `delegate` to ForceOnHapticTick.
+    pub fn force_on_haptic_tick(&mut self, delegate: impl FnMut(&ForceOnHapticTick) + Send + 'static) {
+        self.bind(|e| {
+            e.force_on_haptic_tick.add_delegate(delegate);
+        });
+    }
+
+    /// Binds `delegate` to OnTransform (the device's state, every tick, before the forces).
+    pub fn on_transform(&mut self, delegate: impl FnMut(&haptic_common::DeviceState) + Send + 'static) {
+        self.bind(|e| {
+            e.on_transform.add_delegate(delegate);
+        });
+    }
+}
+
+/// Whether the haptic threads run.
+#[derive(Resource, Clone, Debug, Default, PartialEq)]
+pub enum HapticStatus {
+    /// Not started yet (before `PostStartup`).
+    #[default]
+    Starting,
+    /// Running, with the device's limits and the rendering in use.
+    Running {
+        /// The device's name.
+        device: &'static str,
+        /// The largest force it renders, N.
+        peak_force_n: f32,
+        /// Whether it renders torque.
+        torque: bool,
+        /// How contact forces are rendered (`Off` without `ForceCompPlugin`).
+        rendering: Rendering,
+    },
+    /// It could not start: why.
+    Failed(String),
+    /// Stopped with the app.
+    Stopped,
+}
+
+/// The haptic thread alone (no collision), or the whole rig.
+enum Engine {
+    Device { handle: HapticHandle<Box<dyn Device>>, samples: rtrb::Consumer<ForceSample> },
+    Rig(Box<HapticRig<Box<dyn Device>>>),
+}
+
+/// The running threads (the game thread's end).
+#[derive(Resource)]
+pub(crate) struct HapticRuntime {
+    engine: Mutex<Engine>,
+    map: haptic_rig::WorkspaceMap,
+    ticks: Vec<TickTiming>,
+    steps: Vec<StepTiming>,
+    samples: Vec<ForceSample>,
+}
+
+impl HapticRuntime {
+    fn engine(&self) -> std::sync::MutexGuard<'_, Engine> {
+        self.engine.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    fn rig<T>(&self, f: impl FnOnce(&HapticRig<Box<dyn Device>>) -> T) -> Option<T> {
+        match &*self.engine() {
+            Engine::Rig(rig) => Some(f(rig)),
+            Engine::Device { .. } => None,
+        }
+    }
+}
+
+/// The game thread's record of what the threads watch: collider entities and their ids there.
+#[derive(Resource, Default)]
+pub(crate) struct Watched {
+    ids: HashMap<Entity, u32>,
+    entities: HashMap<u32, Entity>,
+    next_id: u32,
+    touching: HashSet<u32>,
+    tool: Option<ToolKey>,
+    region: Option<(Vec3, Vec3)>,
+}
+
+/// Opens the device and starts the threads (`PostStartup`).
+pub(crate) fn start(world: &mut World) {
+    let status = match try_start(world) {
+        Ok(status) => status,
+        Err(reason) => {
+            error!("haptics did not start: {reason}");
+            HapticStatus::Failed(reason)
+        }
+    };
+    world.insert_resource(status);
+}
+
+fn try_start(world: &mut World) -> Result<HapticStatus, String> {
+    let user = world.get_resource_mut::<HapticDelegates>().map(|mut d| d.take()).unwrap_or_default();
+    let device = world.get_resource::<HapticDevice>().ok_or("no HapticDevice resource")?;
+    let opened = device.kind.open().map_err(|e| e.to_string())?;
+    let specs: DeviceSpecs = opened.device.specs().clone();
+    let map = device.map();
+    // Your delegates, then the effects (the force stage and the safety layer come after both).
+    let (effects, run_effects) = crate::effects::delegate(map);
+    let mut events = user;
+    events.force_on_haptic_tick.add_delegate(run_effects);
+    let rate_hz = device.rate_hz;
+    let mut haptic = haptico::HapticConfig { rate_hz: device.rate_hz, ..Default::default() };
+    haptic.realtime_priority = device.realtime_priority;
+    let collision = world.get_resource::<CollisionSettings>().cloned();
+    let rendering = world.get_resource::<ForceRendering>().map(|r| r.resolve(&specs));
+    let clock = HapticClock::new();
+    let (engine, rendering, clock) = match collision {
+        None => {
+            let (handle, samples) = start_device(opened.device, events, haptic, &specs, clock)?;
+            let clock = handle.clock();
+            (Engine::Device { handle, samples }, Rendering::Off, clock)
+        }
+        Some(CollisionSettings(mut collision)) => {
+            collision.realtime_priority = device.realtime_priority.map(|p| (p - 1).max(1));
+            let (rendering, proxy) = rendering.unwrap_or((Rendering::Off, Default::default()));
+            let config = RigConfig { haptic, collision, map, rendering, proxy, ..RigConfig::default() };
+            let tool = ToolSpec::new(SphereTree::ball(HapticTool::default().tip_radius_m).0, rigid_tool());
+            let rig =
+                HapticRig::start(opened.device, tool, config, events, Default::default()).map_err(|e| e.to_string())?;
+            let clock = rig.clock();
+            (Engine::Rig(Box::new(rig)), rendering, clock)
+        }
+    };
+    if let Some(hand) = opened.hand {
+        world.insert_resource(SimulatedHand::new(hand, clock));
+    }
+    world.insert_resource(HapticRuntime {
+        engine: Mutex::new(engine),
+        map,
+        ticks: Vec::with_capacity(1 << 12),
+        steps: Vec::with_capacity(1 << 12),
+        samples: Vec::with_capacity(1 << 12),
+    });
+    world.init_resource::<Watched>();
+    world.insert_resource(effects);
+    info!("haptics: {} at {rate_hz} Hz, {rendering:?} rendering", specs.name);
+    Ok(HapticStatus::Running {
+        device: specs.name,
+        peak_force_n: specs.peak_force_n,
+        torque: specs.renders_torque(),
+        rendering,
+    })
+}
+
+fn rigid_tool() -> forcecomp::Material {
+    ForceComponent::rigid_tool().material()
+}
+
+/// The haptic thread alone, and the ring of the forces it sent.
+type DeviceOnly = (HapticHandle<Box<dyn Device>>, rtrb::Consumer<ForceSample>);
+
+/// The haptic thread alone: your force delegates, then the safety layer (the device's limits), and a
+/// ring of the forces sent for [`HapticStats`].
+fn start_device(
+    device: Box<dyn Device>,
+    mut events: HapticEvents,
+    config: haptico::HapticConfig,
+    specs: &DeviceSpecs,
+    clock: HapticClock,
+) -> Result<DeviceOnly, String> {
+    let safety = SafetyConfig::for_limits(specs.peak_force_n, specs.max_torque_nm)
+        .with_continuous_force(specs.continuous_force_n);
+    safety.validate().map_err(|e| e.to_string())?;
+    let mut safety = SafetyLayer::new(safety);
+    let (mut samples_in, samples_out) = rtrb::RingBuffer::new(1 << 16);
+    events.force_on_haptic_tick.add_delegate(move |tick: &ForceOnHapticTick| {
+        let out = safety.apply_at(tick.total(), tick.dt_s, 0.0, tick.device.pose.translation);
+        tick.set(out);
+        let sample =
+            ForceSample { t_us: tick.device.timestamp_us, force: out.force, torque: out.torque, ..Default::default() };
+        let _ = samples_in.push(sample);
+    });
+    let handle = HapticHandle::spawn(device, events, config, clock).map_err(|e| e.to_string())?;
+    Ok((handle, samples_out))
+}
+
+/// Stops the threads when the app exits (`Last`).
+pub(crate) fn stop_on_exit(mut commands: Commands, mut exit: MessageReader<AppExit>, mut status: ResMut<HapticStatus>) {
+    if exit.read().next().is_some() {
+        commands.remove_resource::<HapticRuntime>();
+        commands.remove_resource::<SimulatedHand>();
+        commands.remove_resource::<crate::effects::EffectsInput>();
+        if matches!(*status, HapticStatus::Running { .. }) {
+            *status = HapticStatus::Stopped;
+        }
+    }
+}
+
+/// Moves the tool to where the threads have it and tells the game (`PreUpdate`).
+pub(crate) fn follow_device(
+    runtime: Option<Res<HapticRuntime>>,
+    mut tools: Query<(Entity, &mut Transform), With<HapticTool>>,
+    mut moved: MessageWriter<ToolMoved>,
+    mut commands: Commands,
+) {
+    let Some(runtime) = runtime else { return };
+    let (pose, output) = match &*runtime.engine() {
+        Engine::Rig(rig) => {
+            let t = rig.telemetry();
+            (t.tool_pose, t.output)
+        }
+        Engine::Device { handle, .. } => {
+            let t = handle.telemetry();
+            (runtime.map.to_scene(&t.device.pose), t.command)
+        }
+    };
+    for (tool, mut transform) in &mut tools {
+        transform.translation = pose.translation;
+        transform.rotation = pose.rotation;
+        let event = ToolMoved { tool, transform: *transform, force_n: output.force, torque_nm: output.torque };
+        moved.write(event);
+        commands.trigger(event);
+    }
+}
+
+/// Drains the threads' timings and force samples into [`HapticStats`] (`PreUpdate`).
+pub(crate) fn gather_stats(runtime: Option<ResMut<HapticRuntime>>, mut stats: ResMut<HapticStats>) {
+    let Some(mut runtime) = runtime else { return };
+    let runtime = &mut *runtime;
+    runtime.ticks.clear();
+    runtime.steps.clear();
+    runtime.samples.clear();
+    match &mut *runtime.engine.lock().unwrap_or_else(|p| p.into_inner()) {
+        Engine::Rig(rig) => {
+            rig.drain_haptic_timings(&mut runtime.ticks);
+            rig.drain_collision_timings(&mut runtime.steps);
+            rig.drain_force_samples(&mut runtime.samples);
+            rig.collect_garbage();
+        }
+        Engine::Device { handle, samples } => {
+            handle.drain_timings(&mut runtime.ticks);
+            while let Ok(s) = samples.pop() {
+                runtime.samples.push(s);
+            }
+            handle.collect_garbage();
+        }
+    }
+    for t in &runtime.ticks {
+        stats.haptic.record(t.start_us);
+    }
+    for s in &runtime.steps {
+        stats.collision.record(s.start_us);
+    }
+    for s in &runtime.samples {
+        stats.record_force(s.force, s.torque);
+    }
+}
+
+/// What the tool was last sent as: its tree (or its ball's radius) and material.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct ToolKey {
+    tree: Option<AssetId<SphereTree>>,
+    tip_radius_m: f32,
+    material: Option<ForceComponent>,
+}
+
+/// Sends the tool's tree and material when they change (`PostUpdate`).
+pub(crate) fn sync_tool(
+    runtime: Option<Res<HapticRuntime>>,
+    mut watched: Option<ResMut<Watched>>,
+    trees: Res<Assets<SphereTree>>,
+    tools: Query<(&HapticTool, Option<&ForceComponent>)>,
+) {
+    let (Some(runtime), Some(watched)) = (runtime, watched.as_mut()) else { return };
+    let Some((tool, force)) = tools.iter().next() else { return };
+    let tree = tool.tree.as_ref().and_then(|h| trees.get(h).map(|t| (h.id(), t)));
+    let key = ToolKey { tree: tree.map(|(id, _)| id), tip_radius_m: tool.tip_radius_m, material: force.copied() };
+    if watched.tool == Some(key) {
+        return;
+    }
+    let tree = tree.map_or_else(|| SphereTree::ball(tool.tip_radius_m).0, |(_, t)| t.0.clone());
+    let spec = ToolSpec::new(tree, key.material.map_or_else(rigid_tool, |m| m.material()));
+    match runtime.rig(|rig| rig.set_tool(spec)) {
+        Some(Err(e)) => warn!("the tool's tree waits: {e}"),
+        _ => watched.tool = Some(key),
+    }
+}
+
+type ColliderChanged = Or<(Changed<HapticCollider>, Changed<ForceComponent>, Added<HapticCollider>)>;
+type ColliderMoved = (With<HapticCollider>, Changed<GlobalTransform>);
+type Collider<'a> = (Entity, &'a HapticCollider, &'a GlobalTransform, Option<&'a ForceComponent>);
+
+/// The game thread's two ends: the threads (if running) and its record of what they watch.
+#[derive(SystemParam)]
+pub(crate) struct Threads<'w> {
+    runtime: Option<Res<'w, HapticRuntime>>,
+    watched: Option<ResMut<'w, Watched>>,
+}
+
+impl Threads<'_> {
+    fn get(&mut self) -> Option<(&HapticRuntime, &mut Watched)> {
+        Some((self.runtime.as_deref()?, self.watched.as_deref_mut()?))
+    }
+}
+
+/// What tells the game of contacts: the three messages and the observers.
+#[derive(SystemParam)]
+pub(crate) struct ContactWriters<'w, 's> {
+    started: MessageWriter<'w, ContactStarted>,
+    ongoing: MessageWriter<'w, ContactOngoing>,
+    ended: MessageWriter<'w, ContactEnded>,
+    commands: Commands<'w, 's>,
+}
+
+impl ContactWriters<'_, '_> {
+    fn ended(&mut self, object: Entity, tool: Entity) {
+        let event = ContactEnded { object, tool };
+        self.ended.write(event);
+        // A despawned object has no observers of its own left (the global ones heard the message).
+        if self.commands.get_entity(object).is_ok() {
+            self.commands.trigger(event);
+        }
+    }
+}
+
+/// Takes colliders that lost their component (or their entity) off the threads, ending their contacts
+/// (`PostUpdate`).
+pub(crate) fn forget_colliders(
+    mut threads: Threads,
+    mut removed: RemovedComponents<HapticCollider>,
+    tools: Query<Entity, With<HapticTool>>,
+    mut writers: ContactWriters,
+) {
+    let Some((runtime, watched)) = threads.get() else { return };
+    let tool = tools.iter().next().unwrap_or(Entity::PLACEHOLDER);
+    for entity in removed.read() {
+        let Some(id) = watched.ids.remove(&entity) else { continue };
+        watched.entities.remove(&id);
+        if let Some(Err(e)) = runtime.rig(|rig| rig.remove_object(id)) {
+            warn!("removing {entity} from the collision thread: {e}");
+        }
+        if watched.touching.remove(&id) {
+            writers.ended(entity, tool);
+        }
+    }
+}
+
+/// Sends new colliders, and those whose tree or material changed, once their tree is loaded
+/// (`PostUpdate`, after transforms).
+pub(crate) fn send_colliders(
+    mut threads: Threads,
+    trees: Res<Assets<SphereTree>>,
+    changed: Query<Entity, ColliderChanged>,
+    all: Query<Collider>,
+) {
+    let Some((runtime, watched)) = threads.get() else { return };
+    // A collider whose tree is still loading is sent once it is there (checked every frame).
+    let waiting = all.iter().map(|(e, ..)| e).filter(|e| !watched.ids.contains_key(e));
+    let to_send: HashSet<Entity> = changed.iter().chain(waiting).collect();
+    for (entity, collider, transform, force) in to_send.into_iter().filter_map(|e| all.get(e).ok()) {
+        let Some(tree) = trees.get(&collider.tree) else { continue };
+        let id = match watched.ids.get(&entity) {
+            Some(&id) => id,
+            None => {
+                watched.next_id += 1;
+                watched.next_id
+            }
+        };
+        let material = force.copied().unwrap_or_default().material();
+        let spec = ObjectSpec { id, tree: Arc::clone(&tree.0), pose: pose_of(transform), material };
+        match runtime.rig(|rig| rig.add_object(spec)) {
+            Some(Err(e)) => warn!("{entity} waits for the collision thread: {e}"),
+            _ => {
+                watched.ids.insert(entity, id);
+                watched.entities.insert(id, entity);
+            }
+        }
+    }
+}
+
+/// Moves colliders the game moved (`PostUpdate`, after transforms).
+pub(crate) fn move_colliders(mut threads: Threads, moved: Query<(Entity, &GlobalTransform), ColliderMoved>) {
+    let Some((runtime, watched)) = threads.get() else { return };
+    for (entity, transform) in &moved {
+        let Some(&id) = watched.ids.get(&entity) else { continue };
+        if let Some(Err(e)) = runtime.rig(|rig| rig.set_object_pose(id, pose_of(transform))) {
+            warn!("moving {entity} on the collision thread: {e}");
+        }
+    }
+}
+
+fn pose_of(transform: &GlobalTransform) -> Pose {
+    let (_, rotation, translation) = transform.to_scale_rotation_translation();
+    Pose::new(translation, rotation)
+}
+
+/// Sends the collision volume's box when it changes or goes (`PostUpdate`).
+pub(crate) fn sync_volume(
+    runtime: Option<Res<HapticRuntime>>,
+    mut watched: Option<ResMut<Watched>>,
+    volumes: Query<(&CollisionVolume, &GlobalTransform)>,
+) {
+    let (Some(runtime), Some(watched)) = (runtime, watched.as_mut()) else { return };
+    let region = volumes.iter().next().map(|(v, t)| {
+        let c = t.translation();
+        let h = v.half_extents_m.abs();
+        (c - h, c + h)
+    });
+    if region == watched.region {
+        return;
+    }
+    let aabb = region.map(|(min, max)| collette::bounding_volume::Aabb::new(min, max));
+    if let Some(Ok(())) = runtime.rig(|rig| rig.set_region(aabb)) {
+        watched.region = region;
+    }
+}
+
+/// Reports contacts starting, going on and ending (`PreUpdate`).
+pub(crate) fn report_contacts(
+    mut threads: Threads,
+    tools: Query<Entity, With<HapticTool>>,
+    mut writers: ContactWriters,
+    mut stats: ResMut<HapticStats>,
+) {
+    let Some((runtime, watched)) = threads.get() else { return };
+    let Some(telemetry) = runtime.rig(|rig| rig.telemetry()) else { return };
+    let tool = tools.iter().next().unwrap_or(Entity::PLACEHOLDER);
+    let mut now = HashSet::new();
+    for c in telemetry.objects().iter().filter(|c| c.touching) {
+        let Some(&object) = watched.entities.get(&c.id) else { continue };
+        now.insert(c.id);
+        let contact = ContactData { pairs: c.contacts, volume_m3: c.volume, force_n: c.force, torque_nm: c.torque };
+        if watched.touching.contains(&c.id) {
+            let event = ContactOngoing { object, tool, contact };
+            writers.ongoing.write(event);
+            writers.commands.trigger(event);
+        } else {
+            stats.contacts_started += 1;
+            let event = ContactStarted { object, tool, contact };
+            writers.started.write(event);
+            writers.commands.trigger(event);
+        }
+    }
+    for id in watched.touching.difference(&now) {
+        if let Some(&object) = watched.entities.get(id) {
+            writers.ended(object, tool);
+        }
+    }
+    watched.touching = now;
+}

@@ -1,0 +1,236 @@
+//! Sphere trees as Bevy assets: loaded from `.ist` files, built from `.obj` meshes by the asset loader, or
+//! built from a Bevy [`Mesh`] on the async compute pool — never on the game thread.
+//!
+//! You need this module to give a [`HapticTool`](crate::HapticTool) or a
+//! [`HapticCollider`](crate::HapticCollider) its tree: `asset_server.load("meshes/bunny.obj")` (with
+//! [`SphereTreeSettings`] for its sphere count and scale), `asset_server.load("bunny.ist")` (a tree built
+//! beforehand with the `collette` tool), or a [`SphereTreeFromMesh`] beside the entity's `Mesh3d`.
+
+use std::sync::Arc;
+
+use bevy::asset::io::Reader;
+use bevy::asset::{AssetLoader, LoadContext};
+use bevy::mesh::{Indices, Mesh, Mesh3d, VertexAttributeValues};
+use bevy::prelude::*;
+use bevy::tasks::{AsyncComputeTaskPool, Task, block_on, poll_once};
+use collette::{BuildOptions, InnerSphereTree, Sphere, TriMesh};
+use serde::{Deserialize, Serialize};
+
+/// An Inner Sphere Tree: the spheres packed inside a closed mesh, in the mesh's frame (metres), as the
+/// collision thread measures it (the paper's sphere-tree asset).
+#[derive(Asset, TypePath, Clone, Debug)]
+pub struct SphereTree(pub Arc<InnerSphereTree>);
+
+impl SphereTree {
+    /// One sphere of `radius_m` at the origin: a ball tip.
+    pub fn ball(radius_m: f32) -> Self {
+        let r = radius_m.max(1e-6);
+        let volume = 4.0 / 3.0 * std::f32::consts::PI * r * r * r;
+        Self(Arc::new(InnerSphereTree::from_spheres(vec![Sphere { center: Vec3::ZERO, radius: r }], volume)))
+    }
+
+    /// A brilliant-cut gemstone `diameter_m` wide (its table up, +Y), packed with `spheres` spheres: the
+    /// paper's tool. Takes a few milliseconds for a few hundred spheres.
+    pub fn gem(diameter_m: f32, spheres: usize) -> Result<Self, SphereTreeError> {
+        Self::build(&collette::scene::brilliant_cut(diameter_m), spheres)
+    }
+
+    /// Packs `spheres` spheres into `mesh` (takes milliseconds to seconds: call it off the game thread).
+    pub fn build(mesh: &TriMesh, spheres: usize) -> Result<Self, SphereTreeError> {
+        let (tree, _) = collette::build(mesh, &BuildOptions::spheres(spheres.max(1)), &mut |_| {})
+            .map_err(|e| SphereTreeError::Build(e.to_string()))?;
+        Ok(Self(Arc::new(tree)))
+    }
+
+    /// Packs `spheres` spheres into a Bevy mesh (vertices times `scale`, to metres; see [`tri_mesh`]).
+    /// Takes milliseconds to seconds: call it off the game thread, or use [`SphereTreeFromMesh`].
+    pub fn from_mesh(mesh: &Mesh, scale: f32, spheres: usize) -> Result<Self, SphereTreeError> {
+        Self::build(&tri_mesh(mesh, scale)?, spheres)
+    }
+
+    /// Writes the tree as an `.ist` file (what the asset loader and the `collette` tool read).
+    pub fn save(&self, path: impl AsRef<std::path::Path>) -> Result<(), SphereTreeError> {
+        Ok(self.0.save(path)?)
+    }
+
+    /// Number of inner spheres.
+    pub fn len(&self) -> usize {
+        self.0.spheres().len()
+    }
+
+    /// True for a tree without spheres.
+    pub fn is_empty(&self) -> bool {
+        self.0.spheres().is_empty()
+    }
+}
+
+/// Why a sphere tree could not be loaded or built.
+#[derive(Debug, thiserror::Error)]
+pub enum SphereTreeError {
+    /// The file could not be read.
+    #[error("reading it: {0}")]
+    Io(#[from] std::io::Error),
+    /// The `.ist` file is not a sphere tree.
+    #[error("not a sphere tree file: {0}")]
+    Ist(#[from] collette::IstFileError),
+    /// The mesh is not something spheres can be packed into (not closed, no triangles, ...).
+    #[error("its mesh: {0}")]
+    Mesh(String),
+    /// Packing failed.
+    #[error("packing its spheres: {0}")]
+    Build(String),
+}
+
+/// How the loader builds a tree from an `.obj` mesh (ignored for `.ist` files, which hold a built tree).
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
+pub struct SphereTreeSettings {
+    /// Spheres to pack (default 2,000).
+    pub spheres: usize,
+    /// The mesh's vertices are multiplied by this, to metres (default 1).
+    pub scale: f32,
+}
+
+impl Default for SphereTreeSettings {
+    fn default() -> Self {
+        Self { spheres: 2_000, scale: 1.0 }
+    }
+}
+
+/// Loads `.ist` files and builds trees from `.obj` meshes (on Bevy's asset threads).
+#[derive(Default, TypePath)]
+pub struct SphereTreeLoader;
+
+impl AssetLoader for SphereTreeLoader {
+    type Asset = SphereTree;
+    type Settings = SphereTreeSettings;
+    type Error = SphereTreeError;
+
+    async fn load(
+        &self,
+        reader: &mut dyn Reader,
+        settings: &SphereTreeSettings,
+        context: &mut LoadContext<'_>,
+    ) -> Result<SphereTree, SphereTreeError> {
+        let mut bytes = Vec::new();
+        reader.read_to_end(&mut bytes).await?;
+        let is_obj = context.path().path().extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+        if !is_obj {
+            return Ok(SphereTree(Arc::new(InnerSphereTree::from_bytes(&bytes)?)));
+        }
+        let mesh = TriMesh::from_obj_bytes(&bytes, context.path().path())
+            .and_then(|m| m.map_vertices(|v| v * settings.scale))
+            .map_err(|e| SphereTreeError::Mesh(e.to_string()))?;
+        SphereTree::build(&mesh, settings.spheres)
+    }
+
+    fn extensions(&self) -> &[&str] {
+        &["ist", "obj"]
+    }
+}
+
+/// The closed triangle mesh of a Bevy [`Mesh`] (positions as `Float32x3`, any indices), scaled.
+/// Vertices at the same place (within 1 µm) are merged first: Bevy's shapes repeat a corner for each
+/// face it belongs to (for its normals), which would leave every edge open.
+pub fn tri_mesh(mesh: &Mesh, scale: f32) -> Result<TriMesh, SphereTreeError> {
+    let Some(VertexAttributeValues::Float32x3(positions)) = mesh.attribute(Mesh::ATTRIBUTE_POSITION) else {
+        return Err(SphereTreeError::Mesh("it has no Float32x3 positions".into()));
+    };
+    let indices: Vec<u32> = match mesh.indices() {
+        Some(Indices::U16(i)) => i.iter().map(|&i| u32::from(i)).collect(),
+        Some(Indices::U32(i)) => i.clone(),
+        None => (0..positions.len() as u32).collect(),
+    };
+    let mut welded: Vec<Vec3> = Vec::with_capacity(positions.len());
+    let mut slots = std::collections::HashMap::with_capacity(positions.len());
+    let remap: Vec<u32> = positions
+        .iter()
+        .map(|p| {
+            let v = Vec3::from_array(*p) * scale;
+            let key = (v * 1e6).round().as_ivec3().to_array();
+            *slots.entry(key).or_insert_with(|| {
+                welded.push(v);
+                (welded.len() - 1) as u32
+            })
+        })
+        .collect();
+    let mut triangles = Vec::with_capacity(indices.len() / 3);
+    for t in indices.chunks(3) {
+        let corner = |i: u32| {
+            remap.get(i as usize).copied().ok_or_else(|| SphereTreeError::Mesh(format!("index {i} has no vertex")))
+        };
+        let [a, b, c] =
+            [corner(t[0])?, corner(*t.get(1).unwrap_or(&u32::MAX))?, corner(*t.get(2).unwrap_or(&u32::MAX))?];
+        // A triangle whose corners merged into fewer than three has no area.
+        if a != b && b != c && a != c {
+            triangles.push([a, b, c]);
+        }
+    }
+    TriMesh::new(welded, triangles).map_err(|e| SphereTreeError::Mesh(e.to_string()))
+}
+
+/// Builds the entity's tree from its `Mesh3d` on the async compute pool, then sets it on its
+/// [`HapticCollider`](crate::HapticCollider) (inserted with it if missing). The Bevy counterpart of
+/// avian's `ColliderConstructor`: put it beside a mesh, on a glTF node or in a scene file.
+#[derive(Component, Reflect, Clone, Copy, Debug, PartialEq)]
+#[reflect(Component, Default)]
+pub struct SphereTreeFromMesh {
+    /// Spheres to pack (default 2,000).
+    pub spheres: usize,
+}
+
+impl Default for SphereTreeFromMesh {
+    fn default() -> Self {
+        Self { spheres: 2_000 }
+    }
+}
+
+/// A tree being built for an entity.
+#[derive(Component)]
+pub(crate) struct BuildingTree(Task<Result<SphereTree, SphereTreeError>>);
+
+/// Starts a build for each new [`SphereTreeFromMesh`] whose mesh is loaded.
+pub(crate) fn start_mesh_builds(
+    mut commands: Commands,
+    meshes: Option<Res<Assets<Mesh>>>,
+    pending: Query<(Entity, &SphereTreeFromMesh, &Mesh3d, &GlobalTransform), Without<BuildingTree>>,
+    built: Query<(), With<crate::HapticCollider>>,
+) {
+    let Some(meshes) = meshes else { return };
+    for (entity, from, mesh, transform) in &pending {
+        if built.contains(entity) {
+            continue;
+        }
+        let Some(mesh) = meshes.get(&mesh.0) else { continue };
+        // The tree is in the entity's frame; a uniform scale is baked into it (a tree cannot be stretched).
+        let scale = transform.compute_transform().scale.max_element();
+        let (mesh, spheres) = (mesh.clone(), from.spheres);
+        let task = AsyncComputeTaskPool::get()
+            .spawn(async move { tri_mesh(&mesh, scale).and_then(|m| SphereTree::build(&m, spheres)) });
+        commands.entity(entity).insert(BuildingTree(task));
+    }
+}
+
+/// Hands finished builds to their entities' colliders.
+pub(crate) fn finish_mesh_builds(
+    mut commands: Commands,
+    mut trees: ResMut<Assets<SphereTree>>,
+    mut building: Query<(Entity, &mut BuildingTree, Option<&mut crate::HapticCollider>)>,
+) {
+    for (entity, mut task, collider) in &mut building {
+        let Some(result) = block_on(poll_once(&mut task.0)) else { continue };
+        let mut entity_commands = commands.entity(entity);
+        entity_commands.remove::<(BuildingTree, SphereTreeFromMesh)>();
+        match result {
+            Ok(tree) => {
+                let handle = trees.add(tree);
+                match collider {
+                    Some(mut c) => c.tree = handle,
+                    None => {
+                        entity_commands.insert(crate::HapticCollider::new(handle));
+                    }
+                }
+            }
+            Err(e) => error!("no sphere tree for {entity}: {e}"),
+        }
+    }
+}

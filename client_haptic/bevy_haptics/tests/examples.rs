@@ -1,0 +1,95 @@
+//! Every example runs headless (`--headless --seconds N`: the simulated hand follows the example's
+//! script) and ends with one JSON line whose figures are checked: it touched what its path touches,
+//! forces stayed within the device's peak and were numbers, and both threads kept their rate.
+//!
+//! The rate bound here is 500 Hz in every complete 100 ms window, looser than the 950 Hz the issue asks
+//! of a release build: these are debug builds of the examples on a shared two-core machine, beside other
+//! tests. Release rates are measured by `haptic-bench` (docs/haptics.md). One example runs at a time.
+
+use std::path::PathBuf;
+use std::process::Command;
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+
+/// The example's binary, built by `cargo test` beside this test's (target/<profile>/examples/).
+fn example(name: &str) -> PathBuf {
+    let exe = std::env::current_exe().expect("the test's own path");
+    let profile = exe.parent().and_then(|deps| deps.parent()).expect("target/<profile>/deps/<test>");
+    let path = profile.join("examples").join(name);
+    assert!(path.exists(), "{} is not built: `cargo test -p bevy_haptics` builds the examples", path.display());
+    path
+}
+
+/// Runs `name` headless for `seconds` and returns its JSON line.
+fn run(name: &str, seconds: f32) -> serde_json::Value {
+    let _alone = ONE_AT_A_TIME.lock().unwrap_or_else(|p| p.into_inner());
+    let start = Instant::now();
+    let out = Command::new(example(name))
+        .args(["--headless", "--seconds", &seconds.to_string()])
+        .env("RUST_LOG", "warn")
+        .output()
+        .expect("the example starts");
+    assert!(start.elapsed() < Duration::from_secs_f32(seconds + 60.0), "{name} took {:?}", start.elapsed());
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{name} failed: {}\n{stdout}", String::from_utf8_lossy(&out.stderr));
+    let last = stdout.lines().last().unwrap_or_default();
+    serde_json::from_str(last).unwrap_or_else(|e| panic!("{name}'s last line is not JSON ({e}): {last:?}"))
+}
+
+fn number(report: &serde_json::Value, key: &str) -> f64 {
+    report[key].as_f64().unwrap_or_else(|| panic!("{key} is not a number in {report}"))
+}
+
+/// Checks what every example's line must show; `peak_n` is the device's peak force.
+fn check(report: &serde_json::Value, name: &str, seconds: f64, peak_n: f64, collision: bool) {
+    assert_eq!(report["example"], name);
+    assert_eq!(number(report, "seconds"), seconds);
+    assert_eq!(report["non_finite"], false, "{report}");
+    assert!(number(report, "contacts") > 0.0, "the path touches: {report}");
+    let force = number(report, "max_force_n");
+    assert!(force > 0.05 && force <= peak_n + 1e-3, "a force within the device's peak: {report}");
+    // The safety layer moves the force by at most 500 N/s: 0.5 N a tick at 1 kHz (a little more on a
+    // late tick).
+    assert!(number(report, "max_force_step_n") <= 1.0, "{report}");
+    assert!(number(report, "haptic_hz_min") >= 500.0, "{report}");
+    if collision {
+        assert!(number(report, "collision_hz_min") >= 500.0, "{report}");
+    }
+    assert!(number(report, "ticks") >= 0.5 * 1000.0 * seconds, "{report}");
+}
+
+#[test]
+fn touch_bunny_strokes_the_bunny_through_the_3dof_proxy_headless() {
+    let report = run("touch_bunny", 5.0);
+    check(&report, "touch_bunny", 5.0, 7.9, true);
+}
+
+#[test]
+fn custom_force_renders_its_own_floor_and_still_hears_of_contacts_headless() {
+    let report = run("custom_force", 3.0);
+    check(&report, "custom_force", 3.0, 3.3, true);
+}
+
+#[test]
+fn a_bad_argument_is_refused_on_one_line() {
+    let out = Command::new(example("touch_bunny")).arg("--fast").output().expect("starts");
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(stderr.contains("--fast") && stderr.contains("--headless"), "{stderr}");
+}
+
+#[test]
+fn effects_visits_a_spring_a_pool_a_plate_and_lands_on_a_magnetic_bunny_headless() {
+    let report = run("effects", 7.0);
+    check(&report, "effects", 7.0, 3.3, true);
+}
+
+#[test]
+fn six_dof_tool_presses_the_gem_into_the_bunny_and_feels_a_torque_headless() {
+    let report = run("six_dof_tool", 5.0);
+    check(&report, "six_dof_tool", 5.0, 8.5, true);
+    assert!(number(&report, "max_torque_nm") > 0.0, "the gem's off-centre contact twists it: {report}");
+}

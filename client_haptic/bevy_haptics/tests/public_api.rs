@@ -1,0 +1,104 @@
+//! A game written only against bevy_haptics' public API (no haptic_rig or collette import): a tool and
+//! three boxes, their trees from three sources (a Bevy mesh built on the async pool, an `.ist` file
+//! through the asset server, a tree added in code); the simulated hand presses into each box in turn and
+//! the contact observers name the right box, start before end, in that order. Real threads, real time,
+//! bounded.
+
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use bevy::prelude::*;
+use bevy_haptics::prelude::*;
+
+/// Box centres along x, m; each is 2 cm wide with its top at y = 0.01.
+const XS: [f32; 3] = [-0.05, 0.0, 0.05];
+/// The hand travels at this height between boxes, m.
+const ABOVE: f32 = 0.03;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Seen {
+    Started(Entity),
+    Ended(Entity),
+}
+
+#[derive(Resource, Clone, Default)]
+struct Log(Arc<Mutex<Vec<Seen>>>);
+
+/// A 2 cm box's tree.
+fn box_tree() -> SphereTree {
+    SphereTree::from_mesh(&Cuboid::new(0.02, 0.02, 0.02).into(), 1.0, 300).expect("a box packs")
+}
+
+#[test]
+fn contacts_with_three_colliders_start_and_end_in_the_order_the_hand_presses_them() {
+    let dir = std::env::temp_dir().join(format!("bevy-haptics-api-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a temp dir");
+    // A box's tree saved as an `.ist` file, as the `collette` tool writes them.
+    box_tree().save(dir.join("box.ist")).expect("saves");
+
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins,
+        AssetPlugin { file_path: dir.to_string_lossy().into_owned(), ..default() },
+        HapticsPlugins,
+    ))
+    .init_asset::<Mesh>()
+    .insert_resource(HapticDevice::simulated("phantom desktop", Vec3::new(XS[0], ABOVE, 0.0)));
+    let log = Log::default();
+    app.insert_resource(log.clone());
+    app.add_observer(|c: On<ContactStarted>, log: Res<Log>| log.0.lock().unwrap().push(Seen::Started(c.object)));
+    app.add_observer(|c: On<ContactEnded>, log: Res<Log>| log.0.lock().unwrap().push(Seen::Ended(c.object)));
+
+    let world = app.world_mut();
+    world.spawn(HapticTool::ball(0.003));
+    let mesh = world.resource_mut::<Assets<Mesh>>().add(Cuboid::new(0.02, 0.02, 0.02));
+    let from_mesh =
+        world.spawn((Mesh3d(mesh), SphereTreeFromMesh { spheres: 300 }, Transform::from_xyz(XS[0], 0.0, 0.0))).id();
+    let loaded = world.resource::<AssetServer>().load::<SphereTree>("box.ist");
+    let from_file = world.spawn((HapticCollider::new(loaded), Transform::from_xyz(XS[1], 0.0, 0.0))).id();
+    let added = world.resource_mut::<Assets<SphereTree>>().add(box_tree());
+    let from_code =
+        world.spawn((HapticCollider::new(added), ForceComponent::default(), Transform::from_xyz(XS[2], 0.0, 0.0))).id();
+    app.finish();
+    app.cleanup();
+
+    let step = |app: &mut App| {
+        app.update();
+        std::thread::sleep(Duration::from_millis(5));
+    };
+    let deadline = Instant::now() + Duration::from_secs(60);
+    // Every collider reaches the collision thread (trees loaded and built).
+    let ready = |app: &mut App| {
+        let world = app.world_mut();
+        let mut q = world.query::<&HapticCollider>();
+        let trees = world.resource::<Assets<SphereTree>>();
+        q.iter(world).filter(|c| trees.get(&c.tree).is_some()).count() == 3
+    };
+    while !ready(&mut app) {
+        assert!(Instant::now() < deadline, "the three trees were not ready in time");
+        step(&mut app);
+    }
+    assert!(matches!(app.world().resource::<HapticStatus>(), HapticStatus::Running { .. }));
+
+    for (i, x) in XS.into_iter().enumerate() {
+        let press = |to: Vec3, seconds: f32, app: &mut App| {
+            app.world_mut().resource_mut::<SimulatedHand>().move_to(to, seconds);
+            let until = Instant::now() + Duration::from_secs_f32(seconds + 0.4);
+            while Instant::now() < until {
+                step(app);
+            }
+        };
+        press(Vec3::new(x, ABOVE, 0.0), 0.4, &mut app);
+        press(Vec3::new(x, 0.0, 0.0), 0.4, &mut app);
+        press(Vec3::new(x, ABOVE, 0.0), 0.4, &mut app);
+        assert!(Instant::now() < deadline, "box {i} took too long");
+    }
+    let seen = log.0.lock().unwrap().clone();
+    let expected = [from_mesh, from_file, from_code].into_iter().flat_map(|e| [Seen::Started(e), Seen::Ended(e)]);
+    assert_eq!(seen, expected.collect::<Vec<_>>(), "mesh {from_mesh}, file {from_file}, code {from_code}");
+    let stats = *app.world().resource::<HapticStats>();
+    assert_eq!(stats.contacts_started, 3);
+    assert!(stats.max_force_n > 0.1 && stats.max_force_n <= 7.9 + 1e-3, "{stats:?}");
+    assert!(!stats.non_finite);
+    let _ = std::fs::remove_dir_all(dir);
+}
