@@ -11,6 +11,14 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/deps.sh
 cargo fmt --all --check
+# The haptics libraries stay publishable (docs/bevy-haptics.md): packaged without a verify build (the
+# registry cannot resolve our own unpublished crates), and bevy_haptics links none of the tools' crates.
+cargo package --locked --no-verify --quiet \
+    -p haptic_common -p haptico -p collette_ist -p forcecomp -p haptic_rig -p bevy_haptics
+if cargo tree --locked -p bevy_haptics -e normal --prefix none | grep -E '^(clap|indicatif|plotters|png) v'; then
+    echo "bevy_haptics links a command-line tool's crate (above): keep it behind a feature" >&2
+    exit 1
+fi
 RUSTC_WORKSPACE_WRAPPER="$(rustup which clippy-driver 2>/dev/null || command -v clippy-driver)" || {
     echo "clippy-driver not found: install clippy (rustup component add clippy)" >&2
     exit 1

@@ -25,7 +25,8 @@ fn main() {
         app.add_systems(Update, stroke);
     }
     if !run.headless {
-        app.add_systems(Startup, scenery).add_systems(Update, (support::keyboard_hand, support::draw_tool));
+        app.add_systems(Startup, scenery)
+            .add_systems(Update, (support::keyboard_hand, support::show_tool, support::point_force_rod));
     }
     app.run();
 }
@@ -48,8 +49,8 @@ fn setup(mut commands: Commands, assets: Res<AssetServer>) {
     ));
 }
 
-/// Down onto the bunny's back, a circle on it, then up (headless).
-fn stroke(time: Res<Time<Real>>, hand: Option<ResMut<SimulatedHand>>, mut step: Local<u32>) {
+/// Down onto the bunny's back, a circle on it, then up (headless; for a screenshot it stays on the back).
+fn stroke(run: Res<Run>, time: Res<Time<Real>>, hand: Option<ResMut<SimulatedHand>>, mut step: Local<u32>) {
     let Some(mut hand) = hand else { return };
     let t = support::elapsed(&time);
     let start_us = hand.now_us();
@@ -63,7 +64,7 @@ fn stroke(time: Res<Time<Real>>, hand: Option<ResMut<SimulatedHand>>, mut step: 
             turns: 1.0,
             start_us,
         }),
-        2 if t > 4.0 => hand.move_to(START, 0.5),
+        2 if t > 4.0 && run.headless => hand.move_to(START, 0.5),
         _ => return,
     }
     *step += 1;
@@ -75,15 +76,17 @@ fn scenery(mut commands: Commands, mut meshes: ResMut<Assets<Mesh>>, mut materia
     match bevy_haptics::libs::collette::TriMesh::from_obj(path) {
         Ok(bunny) => {
             let positions: Vec<[f32; 3]> = bunny.vertices().iter().map(|v| (*v * 0.01).to_array()).collect();
-            let indices = bunny.triangles().iter().flatten().copied().collect();
-            let mesh = Mesh::new(bevy::mesh::PrimitiveTopology::TriangleList, default())
+            // The file winds its triangles clockwise seen from outside: reversed, the normals point out.
+            let indices = bunny.triangles().iter().flat_map(|t| [t[0], t[2], t[1]]).collect();
+            let mut mesh = Mesh::new(bevy::mesh::PrimitiveTopology::TriangleList, default())
                 .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, positions)
-                .with_inserted_indices(bevy::mesh::Indices::U32(indices))
-                .with_computed_smooth_normals();
+                .with_inserted_indices(bevy::mesh::Indices::U32(indices));
+            mesh.duplicate_vertices();
+            mesh.compute_flat_normals();
             let look = materials.add(StandardMaterial { base_color: Color::srgb(0.8, 0.7, 0.6), ..default() });
             commands.spawn((Mesh3d(meshes.add(mesh)), MeshMaterial3d(look)));
         }
         Err(e) => error!("no bunny to show: {e}"),
     }
-    support::camera(&mut commands, Vec3::new(0.15, 0.15, 0.25), Vec3::new(0.0, 0.05, 0.0));
+    support::camera(&mut commands, Vec3::new(0.08, 0.12, 0.15), Vec3::new(0.0, 0.05, 0.0));
 }

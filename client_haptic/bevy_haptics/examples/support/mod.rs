@@ -114,6 +114,8 @@ fn screenshot(run: Res<Run>, mut commands: Commands, mut frames: Local<u32>, mut
     let Some(path) = run.screenshot else { return };
     *frames += 1;
     if *frames == 120 {
+        // An older picture at the path would end the wait before this one is written.
+        let _ = std::fs::remove_file(path);
         commands.spawn(Screenshot::primary_window()).observe(save_to_disk(path));
     }
     if *frames > 125 && std::path::Path::new(path).exists() || *frames > 720 {
@@ -146,13 +148,47 @@ pub fn keyboard_hand(keys: Res<ButtonInput<KeyCode>>, hand: Option<ResMut<Simula
 /// A camera looking at `target` from `eye`, and a light (windowed).
 pub fn camera(commands: &mut Commands, eye: Vec3, target: Vec3) {
     commands.spawn((Camera3d::default(), Transform::from_translation(eye).looking_at(target, Vec3::Y)));
-    commands.spawn((DirectionalLight::default(), Transform::from_xyz(1.0, 2.0, 1.5).looking_at(Vec3::ZERO, Vec3::Y)));
+    // No shadows: their default bias is for scenes in metres, not a 10 cm bunny.
+    let sun = DirectionalLight { illuminance: 12_000.0, shadow_maps_enabled: false, ..default() };
+    commands.spawn((sun, Transform::from_xyz(1.0, 2.0, 1.5).looking_at(Vec3::ZERO, Vec3::Y)));
+    let lamp = PointLight { intensity: 20_000.0, range: 3.0, shadow_maps_enabled: false, ..default() };
+    commands.spawn((lamp, Transform::from_translation(eye + Vec3::Y * 0.2)));
+    commands.insert_resource(GlobalAmbientLight { brightness: 80.0, ..default() });
+    commands.insert_resource(ClearColor(Color::srgb(0.05, 0.06, 0.09)));
 }
 
-/// The tool and the force on the device, a red line of 2 cm per newton (windowed).
-pub fn draw_tool(mut gizmos: Gizmos, mut moved: MessageReader<ToolMoved>) {
-    if let Some(m) = moved.read().last() {
-        gizmos.sphere(Isometry3d::from_translation(m.transform.translation), 0.003, Color::WHITE);
-        gizmos.line(m.transform.translation, m.transform.translation + m.force_n * 0.02, Color::srgb(1.0, 0.2, 0.2));
+/// Shows the tool (a white ball on the tool entity, which follows the device) and the force on the
+/// device (a red rod of 2 cm per newton) in the window.
+pub fn show_tool(
+    mut commands: Commands,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+    tools: Query<(Entity, &HapticTool), Added<HapticTool>>,
+) {
+    for (tool, spec) in &tools {
+        let white = materials.add(StandardMaterial { base_color: Color::WHITE, unlit: true, ..default() });
+        commands.entity(tool).insert((Mesh3d(meshes.add(Sphere::new(spec.tip_radius_m))), MeshMaterial3d(white)));
+        let red = materials.add(StandardMaterial { base_color: Color::srgb(1.0, 0.2, 0.2), unlit: true, ..default() });
+        commands.spawn((ForceRod, Mesh3d(meshes.add(Cylinder::new(0.0008, 1.0))), MeshMaterial3d(red)));
+    }
+}
+
+/// The rod showing the force on the device.
+#[derive(Component)]
+pub struct ForceRod;
+
+/// Points the force rod along the last frame's force (windowed).
+pub fn point_force_rod(
+    mut moved: MessageReader<ToolMoved>,
+    mut rods: Query<(&mut Transform, &mut Visibility), With<ForceRod>>,
+) {
+    let Some(m) = moved.read().last() else { return };
+    let length = m.force_n.length() * 0.02;
+    for (mut transform, mut visibility) in &mut rods {
+        *visibility = if length > 1e-4 { Visibility::Visible } else { Visibility::Hidden };
+        let direction = m.force_n.normalize_or(Vec3::Y);
+        *transform = Transform::from_translation(m.transform.translation + direction * length * 0.5)
+            .with_rotation(Quat::from_rotation_arc(Vec3::Y, direction))
+            .with_scale(Vec3::new(1.0, length.max(1e-4), 1.0));
     }
 }
