@@ -25,8 +25,7 @@ fn main() {
         app.add_systems(Update, stroke);
     }
     if !run.headless {
-        app.add_systems(Startup, scenery)
-            .add_systems(Update, (support::keyboard_hand, support::show_tool, support::point_force_rod));
+        app.add_systems(Startup, scenery).add_systems(Update, (support::keyboard_hand, support::show_tool));
     }
     app.run();
 }

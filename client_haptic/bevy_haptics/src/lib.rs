@@ -2,6 +2,8 @@
 #![warn(missing_docs)]
 
 mod components;
+#[cfg(feature = "debug")]
+pub mod debug;
 mod device;
 mod effects;
 mod events;
@@ -11,6 +13,8 @@ mod stats;
 mod tree;
 
 pub use components::{CollisionVolume, ForceComponent, HapticCollider, HapticTool, Ridges};
+#[cfg(feature = "debug")]
+pub use debug::{HapticsDebugConfig, HapticsDebugPlugin};
 pub use device::{DeviceError, DeviceKind, HapticDevice, SimulatedHand};
 pub use effects::{EffectKind, HapticEffect, MAX_EFFECTS};
 pub use events::{ContactData, ContactEnded, ContactOngoing, ContactStarted, ToolMoved};

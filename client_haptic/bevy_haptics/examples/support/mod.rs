@@ -60,7 +60,9 @@ impl Run {
             // Pipelines compiled before the first frame: on a software renderer (lavapipe) the first
             // frames are black otherwise.
             let render = bevy::render::RenderPlugin { synchronous_pipeline_compilation: true, ..default() };
-            app.add_plugins(DefaultPlugins.set(assets).set(render)).add_systems(Update, screenshot);
+            app.add_plugins((DefaultPlugins.set(assets).set(render), bevy_haptics::HapticsDebugPlugin))
+                .insert_resource(bevy_haptics::HapticsDebugConfig { tree_depth: None, ..default() })
+                .add_systems(Update, (screenshot, toggle_trees));
         }
         app.insert_resource(self).add_systems(Update, end);
         app
@@ -157,8 +159,8 @@ pub fn camera(commands: &mut Commands, eye: Vec3, target: Vec3) {
     commands.insert_resource(ClearColor(Color::srgb(0.05, 0.06, 0.09)));
 }
 
-/// Shows the tool (a white ball on the tool entity, which follows the device) and the force on the
-/// device (a red rod of 2 cm per newton) in the window.
+/// Shows the tool as a white ball on the tool entity (which follows the device); the debug plugin draws
+/// the force (red) and torque (blue) arrows.
 pub fn show_tool(
     mut commands: Commands,
     mut meshes: ResMut<Assets<Mesh>>,
@@ -168,27 +170,16 @@ pub fn show_tool(
     for (tool, spec) in &tools {
         let white = materials.add(StandardMaterial { base_color: Color::WHITE, unlit: true, ..default() });
         commands.entity(tool).insert((Mesh3d(meshes.add(Sphere::new(spec.tip_radius_m))), MeshMaterial3d(white)));
-        let red = materials.add(StandardMaterial { base_color: Color::srgb(1.0, 0.2, 0.2), unlit: true, ..default() });
-        commands.spawn((ForceRod, Mesh3d(meshes.add(Cylinder::new(0.0008, 1.0))), MeshMaterial3d(red)));
     }
 }
 
-/// The rod showing the force on the device.
-#[derive(Component)]
-pub struct ForceRod;
-
-/// Points the force rod along the last frame's force (windowed).
-pub fn point_force_rod(
-    mut moved: MessageReader<ToolMoved>,
-    mut rods: Query<(&mut Transform, &mut Visibility), With<ForceRod>>,
-) {
-    let Some(m) = moved.read().last() else { return };
-    let length = m.force_n.length() * 0.02;
-    for (mut transform, mut visibility) in &mut rods {
-        *visibility = if length > 1e-4 { Visibility::Visible } else { Visibility::Hidden };
-        let direction = m.force_n.normalize_or(Vec3::Y);
-        *transform = Transform::from_translation(m.transform.translation + direction * length * 0.5)
-            .with_rotation(Quat::from_rotation_arc(Vec3::Y, direction))
-            .with_scale(Vec3::new(1.0, length.max(1e-4), 1.0));
+/// T shows the sphere trees one level deeper each time, then hides them (windowed).
+fn toggle_trees(keys: Res<ButtonInput<KeyCode>>, mut config: ResMut<bevy_haptics::HapticsDebugConfig>) {
+    if keys.just_pressed(KeyCode::KeyT) {
+        config.tree_depth = match config.tree_depth {
+            None => Some(0),
+            Some(d) if d >= 6 => None,
+            Some(d) => Some(d + 1),
+        };
     }
 }
