@@ -48,13 +48,7 @@ fn setup(mut commands: Commands, assets: Res<AssetServer>) {
         at(PLATE_X),
     ));
     // A 5 cm bunny that pulls the tip onto its surface from 1.5 cm away, and pushes back when touched.
-    let tree = assets
-        .load_builder()
-        .with_settings(|s: &mut SphereTreeSettings| {
-            s.scale = 0.005;
-            s.spheres = 2000;
-        })
-        .load("meshes/bunny.obj");
+    let tree = support::bunny(&assets, 0.005, 2000);
     commands.spawn((
         HapticCollider::new(tree),
         ForceComponent { stiffness_n_per_m3: 3e7, ..default() },

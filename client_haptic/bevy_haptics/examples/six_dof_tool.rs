@@ -37,13 +37,7 @@ fn setup(mut commands: Commands, mut trees: ResMut<Assets<SphereTree>>, assets: 
         }
         Err(e) => error!("no gem: {e}"),
     }
-    let tree = assets
-        .load_builder()
-        .with_settings(|s: &mut SphereTreeSettings| {
-            s.scale = 0.01;
-            s.spheres = 3000;
-        })
-        .load("meshes/bunny.obj");
+    let tree = support::bunny(&assets, 0.01, 3000);
     commands.spawn((
         HapticCollider::new(tree),
         ForceComponent { stiffness_n_per_m3: 2e8, damping_ns_per_m: 5.0, ..default() },

@@ -33,13 +33,7 @@ fn main() {
 fn setup(mut commands: Commands, assets: Res<AssetServer>) {
     commands.spawn((HapticTool::ball(0.003), Name::new("tool")));
     // The bunny, 10 cm tall, its sphere tree built from the mesh on Bevy's asset threads.
-    let tree = assets
-        .load_builder()
-        .with_settings(|s: &mut SphereTreeSettings| {
-            s.scale = 0.01;
-            s.spheres = 3000;
-        })
-        .load("meshes/bunny.obj");
+    let tree = support::bunny(&assets, 0.01, 3000);
     commands.spawn((
         HapticCollider::new(tree),
         ForceComponent { stiffness_n_per_m3: 3e7, ..default() },

@@ -7,8 +7,10 @@ pub mod debug;
 mod device;
 mod effects;
 mod events;
+mod mesh_build;
 mod plugins;
 mod runtime;
+mod settings;
 mod stats;
 mod tree;
 
@@ -18,13 +20,12 @@ pub use debug::{HapticsDebugConfig, HapticsDebugPlugin};
 pub use device::{DeviceError, DeviceKind, HapticDevice, SimulatedHand};
 pub use effects::{EffectKind, HapticEffect, MAX_EFFECTS};
 pub use events::{ContactData, ContactEnded, ContactOngoing, ContactStarted, ToolMoved};
-pub use plugins::{
-    CollettePlugin, CollisionSettings, ForceCompPlugin, ForceRendering, HapticoPlugin, HapticsPlugins, HapticsSystems,
-    RenderingMode,
-};
+pub use mesh_build::SphereTreeFromMesh;
+pub use plugins::{CollettePlugin, ForceCompPlugin, HapticoPlugin, HapticsPlugins, HapticsSystems};
 pub use runtime::{HapticDelegates, HapticStatus};
+pub use settings::{CollisionSettings, ForceRendering, RenderingMode};
 pub use stats::{HapticStats, WINDOW_US, WindowedRate};
-pub use tree::{SphereTree, SphereTreeError, SphereTreeFromMesh, SphereTreeLoader, SphereTreeSettings, tri_mesh};
+pub use tree::{SphereTree, SphereTreeError, SphereTreeLoader, SphereTreeSettings, tri_mesh};
 
 /// The libraries underneath, for what the plugins do not wrap (your own device, the force delegates'
 /// payloads, the rig's settings).

@@ -11,16 +11,17 @@
 
 use bevy::app::PluginGroupBuilder;
 use bevy::prelude::*;
-use haptic_rig::{ProxyRendering, Rendering};
-use haptico::DeviceSpecs;
+use haptic_rig::ProxyRendering;
 
 use crate::components::{CollisionVolume, ForceComponent, HapticCollider, HapticTool, Ridges};
 use crate::device::HapticDevice;
 use crate::effects::{self, EffectKind, HapticEffect};
 use crate::events::{ContactData, ContactEnded, ContactOngoing, ContactStarted, ToolMoved};
+use crate::mesh_build::{self, SphereTreeFromMesh};
 use crate::runtime::{self, HapticDelegates, HapticStatus};
+use crate::settings::{CollisionSettings, ForceRendering, RenderingMode};
 use crate::stats::HapticStats;
-use crate::tree::{self, SphereTree, SphereTreeFromMesh, SphereTreeLoader};
+use crate::tree::{SphereTree, SphereTreeLoader};
 
 /// System sets of the haptics plugins, to order your systems against them.
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -77,10 +78,6 @@ impl Plugin for HapticoPlugin {
     }
 }
 
-/// The collision thread's settings (present when [`CollettePlugin`] is added).
-#[derive(Resource, Clone, Debug, Default, PartialEq)]
-pub struct CollisionSettings(pub haptic_rig::CollisionConfig);
-
 /// The collision thread (collette's pipeline at 1 kHz): sphere trees as assets (`.ist` files, `.obj`
 /// meshes, a [`SphereTreeFromMesh`] beside a `Mesh3d`), [`HapticCollider`]s against the tool,
 /// a [`CollisionVolume`], and contact messages and observer events.
@@ -103,7 +100,7 @@ impl Plugin for CollettePlugin {
             .add_message::<ContactOngoing>()
             .add_message::<ContactEnded>()
             .add_systems(PreUpdate, runtime::report_contacts.in_set(HapticsSystems::Read))
-            .add_systems(Update, (tree::start_mesh_builds, tree::finish_mesh_builds))
+            .add_systems(Update, (mesh_build::start_mesh_builds, mesh_build::finish_mesh_builds))
             .add_systems(
                 PostUpdate,
                 (
@@ -113,40 +110,6 @@ impl Plugin for CollettePlugin {
                 )
                     .in_set(HapticsSystems::Write),
             );
-    }
-}
-
-/// How contact forces are rendered.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Reflect)]
-pub enum RenderingMode {
-    /// By the device: volumetric when it renders torque, else the 3-DOF proxy.
-    #[default]
-    Auto,
-    /// The tool's inner spheres against the object's (force and torque, through a virtual coupling).
-    Volumetric,
-    /// The 3-DOF god-object: the tool's tip held on the surface (force only).
-    Proxy,
-}
-
-/// The force stage's settings (present when [`ForceCompPlugin`] is added).
-#[derive(Resource, Clone, Copy, Debug, PartialEq)]
-pub struct ForceRendering {
-    /// How contact forces are rendered.
-    pub mode: RenderingMode,
-    /// How the 3-DOF proxy feels materials.
-    pub proxy: ProxyRendering,
-}
-
-impl ForceRendering {
-    /// The rendering for `specs`.
-    pub(crate) fn resolve(&self, specs: &DeviceSpecs) -> (Rendering, ProxyRendering) {
-        let rendering = match self.mode {
-            RenderingMode::Volumetric => Rendering::Coupled,
-            RenderingMode::Proxy => Rendering::Proxy,
-            RenderingMode::Auto if specs.renders_torque() => Rendering::Coupled,
-            RenderingMode::Auto => Rendering::Proxy,
-        };
-        (rendering, self.proxy)
     }
 }
 

@@ -19,7 +19,7 @@ use haptico::{Device, DeviceSpecs, HapticClock, HapticEvents, HapticHandle, Tick
 use crate::components::{CollisionVolume, ForceComponent, HapticCollider, HapticTool};
 use crate::device::{HapticDevice, SimulatedHand};
 use crate::events::{ContactData, ContactEnded, ContactOngoing, ContactStarted, ToolMoved};
-use crate::plugins::{CollisionSettings, ForceRendering};
+use crate::settings::{CollisionSettings, ForceRendering};
 use crate::stats::HapticStats;
 use crate::tree::SphereTree;
 

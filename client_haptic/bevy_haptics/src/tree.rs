@@ -1,18 +1,17 @@
 //! Sphere trees as Bevy assets: loaded from `.ist` files, built from `.obj` meshes by the asset loader, or
-//! built from a Bevy [`Mesh`] on the async compute pool — never on the game thread.
+//! built from a Bevy [`Mesh`] on the async compute pool (`mesh_build`) — never on the game thread.
 //!
 //! You need this module to give a [`HapticTool`](crate::HapticTool) or a
 //! [`HapticCollider`](crate::HapticCollider) its tree: `asset_server.load("meshes/bunny.obj")` (with
 //! [`SphereTreeSettings`] for its sphere count and scale), `asset_server.load("bunny.ist")` (a tree built
-//! beforehand with the `collette` tool), or a [`SphereTreeFromMesh`] beside the entity's `Mesh3d`.
+//! beforehand with the `collette` tool), or a [`SphereTreeFromMesh`](crate::SphereTreeFromMesh) beside the entity's `Mesh3d`.
 
 use std::sync::Arc;
 
 use bevy::asset::io::Reader;
 use bevy::asset::{AssetLoader, LoadContext};
-use bevy::mesh::{Indices, Mesh, Mesh3d, VertexAttributeValues};
+use bevy::mesh::{Indices, Mesh, VertexAttributeValues};
 use bevy::prelude::*;
-use bevy::tasks::{AsyncComputeTaskPool, Task, block_on, poll_once};
 use collette::{BuildOptions, InnerSphereTree, Sphere, TriMesh};
 use serde::{Deserialize, Serialize};
 
@@ -43,7 +42,8 @@ impl SphereTree {
     }
 
     /// Packs `spheres` spheres into a Bevy mesh (vertices times `scale`, to metres; see [`tri_mesh`]).
-    /// Takes milliseconds to seconds: call it off the game thread, or use [`SphereTreeFromMesh`].
+    /// Takes milliseconds to seconds: call it off the game thread, or use
+    /// [`SphereTreeFromMesh`](crate::SphereTreeFromMesh).
     pub fn from_mesh(mesh: &Mesh, scale: f32, spheres: usize) -> Result<Self, SphereTreeError> {
         Self::build(&tri_mesh(mesh, scale)?, spheres)
     }
@@ -166,71 +166,4 @@ pub fn tri_mesh(mesh: &Mesh, scale: f32) -> Result<TriMesh, SphereTreeError> {
         }
     }
     TriMesh::new(welded, triangles).map_err(|e| SphereTreeError::Mesh(e.to_string()))
-}
-
-/// Builds the entity's tree from its `Mesh3d` on the async compute pool, then sets it on its
-/// [`HapticCollider`](crate::HapticCollider) (inserted with it if missing). The Bevy counterpart of
-/// avian's `ColliderConstructor`: put it beside a mesh, on a glTF node or in a scene file.
-#[derive(Component, Reflect, Clone, Copy, Debug, PartialEq)]
-#[reflect(Component, Default)]
-pub struct SphereTreeFromMesh {
-    /// Spheres to pack (default 2,000).
-    pub spheres: usize,
-}
-
-impl Default for SphereTreeFromMesh {
-    fn default() -> Self {
-        Self { spheres: 2_000 }
-    }
-}
-
-/// A tree being built for an entity.
-#[derive(Component)]
-pub(crate) struct BuildingTree(Task<Result<SphereTree, SphereTreeError>>);
-
-/// Starts a build for each new [`SphereTreeFromMesh`] whose mesh is loaded.
-pub(crate) fn start_mesh_builds(
-    mut commands: Commands,
-    meshes: Option<Res<Assets<Mesh>>>,
-    pending: Query<(Entity, &SphereTreeFromMesh, &Mesh3d, &GlobalTransform), Without<BuildingTree>>,
-    built: Query<(), With<crate::HapticCollider>>,
-) {
-    let Some(meshes) = meshes else { return };
-    for (entity, from, mesh, transform) in &pending {
-        if built.contains(entity) {
-            continue;
-        }
-        let Some(mesh) = meshes.get(&mesh.0) else { continue };
-        // The tree is in the entity's frame; a uniform scale is baked into it (a tree cannot be stretched).
-        let scale = transform.compute_transform().scale.max_element();
-        let (mesh, spheres) = (mesh.clone(), from.spheres);
-        let task = AsyncComputeTaskPool::get()
-            .spawn(async move { tri_mesh(&mesh, scale).and_then(|m| SphereTree::build(&m, spheres)) });
-        commands.entity(entity).insert(BuildingTree(task));
-    }
-}
-
-/// Hands finished builds to their entities' colliders.
-pub(crate) fn finish_mesh_builds(
-    mut commands: Commands,
-    mut trees: ResMut<Assets<SphereTree>>,
-    mut building: Query<(Entity, &mut BuildingTree, Option<&mut crate::HapticCollider>)>,
-) {
-    for (entity, mut task, collider) in &mut building {
-        let Some(result) = block_on(poll_once(&mut task.0)) else { continue };
-        let mut entity_commands = commands.entity(entity);
-        entity_commands.remove::<(BuildingTree, SphereTreeFromMesh)>();
-        match result {
-            Ok(tree) => {
-                let handle = trees.add(tree);
-                match collider {
-                    Some(mut c) => c.tree = handle,
-                    None => {
-                        entity_commands.insert(crate::HapticCollider::new(handle));
-                    }
-                }
-            }
-            Err(e) => error!("no sphere tree for {entity}: {e}"),
-        }
-    }
 }

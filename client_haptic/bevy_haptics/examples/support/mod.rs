@@ -1,6 +1,8 @@
 //! What every example shares: `--headless --seconds N` (no window; the simulated device follows the
 //! example's scripted path; one JSON line of the loop's figures at the end), or a window
-//! (`--screenshot PNG`: save the window after 120 frames and quit).
+//! (`--screenshot PNG`: save the window after 120 frames and quit; T cycles the trees' depth).
+// Each example uses part of this module.
+#![allow(dead_code)]
 
 use std::time::Duration;
 
@@ -182,4 +184,16 @@ fn toggle_trees(keys: Res<ButtonInput<KeyCode>>, mut config: ResMut<bevy_haptics
             Some(d) => Some(d + 1),
         };
     }
+}
+
+/// The Stanford bunny's sphere tree, loaded from the repository's `assets/meshes/bunny.obj` (about 10
+/// units tall) times `scale` (to metres), packed with `spheres` spheres on Bevy's asset threads.
+pub fn bunny(assets: &AssetServer, scale: f32, spheres: usize) -> Handle<SphereTree> {
+    assets
+        .load_builder()
+        .with_settings(move |s: &mut SphereTreeSettings| {
+            s.scale = scale;
+            s.spheres = spheres;
+        })
+        .load("meshes/bunny.obj")
 }
