@@ -1,58 +1,22 @@
 //! Which haptic device the client drives, and how the game thread steers a simulated hand.
 //!
 //! You need this module to open the device named on the command line (`sim`, `trace:FILE`,
-//! `hid[:PATH]`, `falcon[:FIRMWARE]`, `haply[:URL]`), to check a real one before a session and watch it
+//! `hid[:PATH]`, `falcon[:FIRMWARE]`, `haply[:URL]`: haptico's [`DeviceChoice`], opened by haptico), to check a real one before a session and watch it
 //! during one ([`check`], [`DeviceHealth`]), and, with the sim device, to move its hand from the keyboard or from the bot through
 //! a [`HandControl`] (latest [`HandGoal`] through a triple buffer: the haptic thread never waits).
 
-use std::path::PathBuf;
-use std::str::FromStr;
 use std::sync::Arc;
 
-use glam::{Quat, Vec3};
-use haptic_common::Pose;
+use glam::Vec3;
 use haptico::{Device, DeviceSpecs};
 
 use crate::error::ClientError;
 
-/// The device named by `--device`.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum DeviceChoice {
-    /// A simulated device moved by the keyboard or the bot (the default).
-    Sim,
-    /// Replays a recorded trace (haptico's CSV format), looping.
-    Trace(PathBuf),
-    /// A HID device: the first HID PID force-feedback device or SpaceMouse, or the one at hidraw `PATH`.
-    Hid(Option<String>),
-    /// The first Novint Falcon on USB, loading Novint's firmware from `FIRMWARE` when it is not running.
-    Falcon(Option<PathBuf>),
-    /// The first Haply Inverse3 of the Haply Inverse Service at `URL` (a WebSocket address).
-    Haply(String),
-}
+pub use haptico::DeviceChoice;
 
 /// Where a real device's grip is put in the device frame when the game starts: where the simulated hand
 /// starts, in front of the workbench.
 pub const START: Vec3 = Vec3::new(0.0, 0.06, 0.07);
-
-impl FromStr for DeviceChoice {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s.split_once(':') {
-            None if s == "sim" => Ok(Self::Sim),
-            None if s == "hid" => Ok(Self::Hid(None)),
-            None if s == "falcon" => Ok(Self::Falcon(None)),
-            None if s == "haply" => Ok(Self::Haply(haptico::haply::DEFAULT_URL.to_owned())),
-            Some(("haply", url)) if !url.is_empty() => Ok(Self::Haply(url.to_owned())),
-            Some(("falcon", file)) if !file.is_empty() => Ok(Self::Falcon(Some(PathBuf::from(file)))),
-            Some(("trace", file)) if !file.is_empty() => Ok(Self::Trace(PathBuf::from(file))),
-            Some(("hid", path)) if !path.is_empty() => Ok(Self::Hid(Some(path.to_owned()))),
-            _ => {
-                Err(format!("{s:?} is not a device: use sim, trace:FILE, hid[:PATH], falcon[:FIRMWARE] or haply[:URL]"))
-            }
-        }
-    }
-}
 
 pub use haptico::steer::{HandControl, HandGoal, SteeredSim};
 
@@ -233,67 +197,26 @@ pub fn check(choice: &DeviceChoice) -> Result<Option<String>, ClientError> {
     }
 }
 
-/// Opens the chosen device. With `sim`, also returns the control that moves its hand.
+/// Opens the chosen device (haptico's [`haptico::choice::open`]). With `sim`, also returns the control
+/// that moves its hand.
 pub fn open(choice: &DeviceChoice, specs: DeviceSpecs) -> Result<Opened, ClientError> {
-    let local = |device: Box<dyn Device>, hand| Opened { device, hand, health: DeviceHealth::Local };
-    match choice {
-        DeviceChoice::Sim => {
-            let (device, control) = SteeredSim::new(specs, Pose::new(START, Quat::IDENTITY));
-            Ok(local(Box::new(device), Some(control)))
-        }
-        DeviceChoice::Trace(path) => {
-            let samples = haptico::trace::load(path)
-                .map_err(|e| ClientError::Device(format!("reading the trace {}: {e}", path.display())))?;
-            let device = haptico::trace::TraceDevice::new(specs, samples, true)
-                .map_err(|e| ClientError::Device(format!("the trace {}: {e}", path.display())))?;
-            Ok(local(Box::new(device), None))
-        }
-        DeviceChoice::Hid(path) => open_hid(path.as_deref(), &specs).map(|d| local(d, None)),
-        DeviceChoice::Falcon(firmware) => {
-            let (device, status) = haptico::falcon::open(firmware.as_deref())
-                .map_err(|e| ClientError::Device(format!("the Falcon: {e}")))?;
-            Ok(Opened { device: Box::new(device), hand: None, health: DeviceHealth::Falcon(status) })
-        }
-        DeviceChoice::Haply(url) => {
-            let (device, status) = haptico::haply::open(url, haptico::presets::inverse3(), START)
-                .map_err(|e| ClientError::Device(format!("the Haply Inverse3: {e}")))?;
-            Ok(Opened { device: Box::new(device), hand: None, health: DeviceHealth::Haply(status) })
-        }
-    }
+    let opened = haptico::choice::open(choice, specs, START).map_err(|e| ClientError::Device(e.to_string()))?;
+    Ok(Opened { device: opened.device, hand: opened.hand, health: opened.link.into() })
 }
 
-fn open_hid(path: Option<&str>, specs: &DeviceSpecs) -> Result<Box<dyn Device>, ClientError> {
-    use haptico::hid::{PidForceDevice, PidReportIds, SpaceMouse, SpaceMouseMode};
-    match PidForceDevice::open(PidReportIds::default(), specs.peak_force_n, path) {
-        Ok(d) => return Ok(Box::new(d)),
-        Err(e) => log::info!("no HID force-feedback device: {e}"),
+impl From<haptico::DeviceLink> for DeviceHealth {
+    fn from(link: haptico::DeviceLink) -> Self {
+        match link {
+            haptico::DeviceLink::Local => Self::Local,
+            haptico::DeviceLink::Falcon(status) => Self::Falcon(status),
+            haptico::DeviceLink::Haply(status) => Self::Haply(status),
+        }
     }
-    let mode = SpaceMouseMode::Rate { metres_per_s_per_count: 2e-4, radians_per_s_per_count: 2e-3 };
-    let device = SpaceMouse::open(mode, path).map_err(|e| ClientError::Device(format!("no HID device: {e}")))?;
-    Ok(Box::new(device))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn device_names_parse_and_bad_ones_say_what_is_accepted() {
-        assert_eq!("sim".parse(), Ok(DeviceChoice::Sim));
-        assert_eq!("trace:/tmp/a.csv".parse(), Ok(DeviceChoice::Trace("/tmp/a.csv".into())));
-        assert_eq!("hid".parse(), Ok(DeviceChoice::Hid(None)));
-        assert_eq!("hid:/dev/hidraw2".parse(), Ok(DeviceChoice::Hid(Some("/dev/hidraw2".into()))));
-        assert_eq!("falcon".parse(), Ok(DeviceChoice::Falcon(None)));
-        assert_eq!(
-            "falcon:/opt/novint/nvent_firmware.bin".parse(),
-            Ok(DeviceChoice::Falcon(Some("/opt/novint/nvent_firmware.bin".into())))
-        );
-        assert_eq!("haply".parse(), Ok(DeviceChoice::Haply("ws://localhost:10001/".into())));
-        assert_eq!("haply:ws://10.0.0.2:10001/".parse(), Ok(DeviceChoice::Haply("ws://10.0.0.2:10001/".into())));
-        let err = "trace:".parse::<DeviceChoice>().unwrap_err();
-        assert!(err.contains("sim, trace:FILE, hid[:PATH], falcon[:FIRMWARE] or haply[:URL]"), "{err}");
-        assert!("inverse3".parse::<DeviceChoice>().is_err());
-    }
 
     #[test]
     fn a_falcon_that_is_not_plugged_in_is_refused_at_once_with_what_to_check() {

@@ -2,16 +2,15 @@
 //! hand a game (or a test) steers when there is no real device.
 //!
 //! You need this module to choose the device: insert a [`HapticDevice`] before the app starts (default:
-//! a simulated Phantom Desktop). A real device you open yourself with haptico (a Falcon, an Inverse3, a
-//! HID device) goes in as [`DeviceKind::Custom`].
+//! a simulated Phantom Desktop), by name (`sim`, `trace:FILE`, `hid[:PATH]`, `falcon[:FIRMWARE]`,
+//! `haply[:URL]`: haptico's [`DeviceChoice`]) or as any [`Device`] you opened yourself.
 
-use std::path::PathBuf;
 use std::sync::Mutex;
 
 use bevy::prelude::*;
 use haptic_common::Pose;
-use haptico::steer::{HandControl, HandGoal, SteeredSim};
-use haptico::{Device, DeviceSpecs, HapticClock};
+use haptico::steer::{HandControl, HandGoal};
+use haptico::{Device, DeviceChoice, DeviceLink, DeviceSpecs, HapticClock};
 
 /// The device, chosen before the app starts.
 #[derive(Resource, Debug)]
@@ -43,10 +42,20 @@ impl Default for HapticDevice {
 }
 
 impl HapticDevice {
-    /// A simulated device copying the preset named `preset` (see [`DeviceKind::Simulated`]), its hand
+    /// A simulated device copying the preset named `preset` (see [`DeviceKind::Named`]), its hand
     /// resting at `start` (device frame, m).
     pub fn simulated(preset: &str, start: Vec3) -> Self {
-        Self { kind: DeviceKind::Simulated { preset: preset.to_owned(), start }, ..Self::default() }
+        let kind = DeviceKind::Named { choice: DeviceChoice::Sim, preset: preset.to_owned(), start };
+        Self { kind, ..Self::default() }
+    }
+
+    /// The device named `name` (`sim`, `trace:FILE`, `hid[:PATH]`, `falcon[:FIRMWARE]`, `haply[:URL]`),
+    /// with the Phantom Desktop's limits where the device brings none (sim, trace, HID). A name that is
+    /// not a device is refused with the names that are.
+    pub fn named(name: &str) -> Result<Self, String> {
+        let choice = name.parse()?;
+        let (_, preset, start) = DeviceKind::default_named();
+        Ok(Self { kind: DeviceKind::Named { choice, preset, start }, ..Self::default() })
     }
 
     /// Any device opened with haptico (a Falcon, an Inverse3, a HID device, your own [`Device`]).
@@ -62,34 +71,33 @@ impl HapticDevice {
 
 /// The kinds of device.
 pub enum DeviceKind {
-    /// A simulated device (a hand on a spring, the preset's limits), steered through [`SimulatedHand`].
-    Simulated {
-        /// A haptico preset, by part of its name, any case: `phantom desktop`, `touch`, `falcon`,
-        /// `inverse3`, `premium` (6-DOF force and torque), ... (default the Phantom Desktop: 7.9 N,
-        /// 6-DOF sensing, 3-DOF force).
+    /// A device by name, opened by haptico.
+    Named {
+        /// Which device: a simulated one (steered through [`SimulatedHand`]), a trace, a HID device, a
+        /// Falcon, an Inverse3.
+        choice: DeviceChoice,
+        /// The limits of a simulated, replayed or HID device: a haptico preset, by part of its name, any
+        /// case: `phantom desktop`, `touch`, `falcon`, `inverse3`, `premium` (6-DOF force and torque), ...
+        /// (default the Phantom Desktop: 7.9 N, 6-DOF sensing, 3-DOF force).
         preset: String,
-        /// Where the hand rests at start, device frame, m.
+        /// Where a simulated hand rests, and where an Inverse3 is centred, device frame, m.
         start: Vec3,
-    },
-    /// Replays a trace recorded with haptico (CSV), looping.
-    Trace {
-        /// The trace file.
-        path: PathBuf,
-        /// The limits of the device it stands for (a haptico preset's name).
-        preset: String,
     },
     /// A device you opened (taken when the app starts).
     Custom(Mutex<Option<Box<dyn Device>>>),
 }
 
+impl DeviceKind {
+    fn default_named() -> (DeviceChoice, String, Vec3) {
+        (DeviceChoice::Sim, "phantom desktop".into(), Vec3::ZERO)
+    }
+}
+
 impl std::fmt::Debug for DeviceKind {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            Self::Simulated { preset, start } => {
-                f.debug_struct("Simulated").field("preset", preset).field("start", start).finish()
-            }
-            Self::Trace { path, preset } => {
-                f.debug_struct("Trace").field("path", path).field("preset", preset).finish()
+            Self::Named { choice, preset, start } => {
+                f.debug_struct("Named").field("choice", choice).field("preset", preset).field("start", start).finish()
             }
             Self::Custom(_) => f.write_str("Custom"),
         }
@@ -98,7 +106,8 @@ impl std::fmt::Debug for DeviceKind {
 
 impl Default for DeviceKind {
     fn default() -> Self {
-        Self::Simulated { preset: "phantom desktop".into(), start: Vec3::ZERO }
+        let (choice, preset, start) = Self::default_named();
+        Self::Named { choice, preset, start }
     }
 }
 
@@ -108,18 +117,12 @@ pub enum DeviceError {
     /// No preset by that name.
     #[error("no device preset named {0:?} (haptico::presets has: {1})")]
     NoPreset(String, String),
-    /// The trace could not be read.
-    #[error("the trace {0}: {1}")]
-    Trace(PathBuf, String),
+    /// haptico could not open it.
+    #[error(transparent)]
+    Open(#[from] haptico::OpenError),
     /// A custom device was already taken by an earlier start.
     #[error("the custom device was already used")]
     Taken,
-}
-
-/// The device opened, with the hand that steers it when simulated.
-pub(crate) struct Opened {
-    pub(crate) device: Box<dyn Device>,
-    pub(crate) hand: Option<HandControl>,
 }
 
 fn preset(name: &str) -> Result<DeviceSpecs, DeviceError> {
@@ -130,25 +133,21 @@ fn preset(name: &str) -> Result<DeviceSpecs, DeviceError> {
 }
 
 impl DeviceKind {
-    pub(crate) fn open(&self) -> Result<Opened, DeviceError> {
+    pub(crate) fn open(&self) -> Result<haptico::choice::Opened, DeviceError> {
         match self {
-            Self::Simulated { preset: name, start } => {
-                let (device, hand) = SteeredSim::new(preset(name)?, Pose::from_translation(*start));
-                Ok(Opened { device: Box::new(device), hand: Some(hand) })
-            }
-            Self::Trace { path, preset: name } => {
-                let failed = |e: &dyn std::fmt::Display| DeviceError::Trace(path.clone(), e.to_string());
-                let samples = haptico::trace::load(path).map_err(|e| failed(&e))?;
-                let device = haptico::trace::TraceDevice::new(preset(name)?, samples, true).map_err(|e| failed(&e))?;
-                Ok(Opened { device: Box::new(device), hand: None })
-            }
+            Self::Named { choice, preset: name, start } => Ok(haptico::choice::open(choice, preset(name)?, *start)?),
             Self::Custom(device) => {
                 let device = device.lock().unwrap_or_else(|p| p.into_inner()).take().ok_or(DeviceError::Taken)?;
-                Ok(Opened { device, hand: None })
+                Ok(haptico::choice::Opened { device, hand: None, link: DeviceLink::Local })
             }
         }
     }
 }
+
+/// A real device's link (USB, a service) and its state, to watch while it runs (present once the
+/// device is open): e.g. a Falcon's homing, a service that went away.
+#[derive(Resource, Clone, Debug)]
+pub struct HapticDeviceLink(pub DeviceLink);
 
 /// The simulated device's hand (present while a [`DeviceKind::Simulated`] device runs): where it
 /// wants the stylus, sampled by the haptic thread at every tick (device frame). Keys, a mouse, a bot or

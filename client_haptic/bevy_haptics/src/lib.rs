@@ -17,7 +17,7 @@ mod tree;
 pub use components::{CollisionVolume, ForceComponent, HapticCollider, HapticTool, Ridges};
 #[cfg(feature = "debug")]
 pub use debug::{HapticsDebugConfig, HapticsDebugPlugin};
-pub use device::{DeviceError, DeviceKind, HapticDevice, SimulatedHand};
+pub use device::{DeviceError, DeviceKind, HapticDevice, HapticDeviceLink, SimulatedHand};
 pub use effects::{EffectKind, HapticEffect, MAX_EFFECTS};
 pub use events::{ContactData, ContactEnded, ContactOngoing, ContactStarted, ToolMoved};
 pub use mesh_build::SphereTreeFromMesh;

@@ -17,7 +17,7 @@ use haptic_rig::{ForceSample, HapticRig, ObjectSpec, Rendering, RigConfig, StepT
 use haptico::{Device, DeviceSpecs, HapticClock, HapticEvents, HapticHandle, TickTiming};
 
 use crate::components::{CollisionVolume, ForceComponent, HapticCollider, HapticTool};
-use crate::device::{HapticDevice, SimulatedHand};
+use crate::device::{HapticDevice, HapticDeviceLink, SimulatedHand};
 use crate::events::{ContactData, ContactEnded, ContactOngoing, ContactStarted, ToolMoved};
 use crate::settings::{CollisionSettings, ForceRendering};
 use crate::stats::HapticStats;
@@ -139,8 +139,8 @@ pub(crate) fn start(world: &mut World) {
 fn try_start(world: &mut World) -> Result<HapticStatus, String> {
     let user = world.get_resource_mut::<HapticDelegates>().map(|mut d| d.take()).unwrap_or_default();
     let device = world.get_resource::<HapticDevice>().ok_or("no HapticDevice resource")?;
-    let opened = device.kind.open().map_err(|e| e.to_string())?;
-    let specs: DeviceSpecs = opened.device.specs().clone();
+    let haptico::choice::Opened { device: opened, hand, link } = device.kind.open().map_err(|e| e.to_string())?;
+    let specs: DeviceSpecs = opened.specs().clone();
     let map = device.map();
     // Your delegates, then the effects (the force stage and the safety layer come after both).
     let (effects, run_effects) = crate::effects::delegate(map);
@@ -154,7 +154,7 @@ fn try_start(world: &mut World) -> Result<HapticStatus, String> {
     let clock = HapticClock::new();
     let (engine, rendering, clock) = match collision {
         None => {
-            let (handle, samples) = start_device(opened.device, events, haptic, &specs, clock)?;
+            let (handle, samples) = start_device(opened, events, haptic, &specs, clock)?;
             let clock = handle.clock();
             (Engine::Device { handle, samples }, Rendering::Off, clock)
         }
@@ -163,15 +163,15 @@ fn try_start(world: &mut World) -> Result<HapticStatus, String> {
             let (rendering, proxy) = rendering.unwrap_or((Rendering::Off, Default::default()));
             let config = RigConfig { haptic, collision, map, rendering, proxy, ..RigConfig::default() };
             let tool = ToolSpec::new(SphereTree::ball(HapticTool::default().tip_radius_m).0, rigid_tool());
-            let rig =
-                HapticRig::start(opened.device, tool, config, events, Default::default()).map_err(|e| e.to_string())?;
+            let rig = HapticRig::start(opened, tool, config, events, Default::default()).map_err(|e| e.to_string())?;
             let clock = rig.clock();
             (Engine::Rig(Box::new(rig)), rendering, clock)
         }
     };
-    if let Some(hand) = opened.hand {
+    if let Some(hand) = hand {
         world.insert_resource(SimulatedHand::new(hand, clock));
     }
+    world.insert_resource(HapticDeviceLink(link));
     world.insert_resource(HapticRuntime {
         engine: Mutex::new(engine),
         map,

@@ -102,3 +102,25 @@ fn contacts_with_three_colliders_start_and_end_in_the_order_the_hand_presses_the
     assert!(!stats.non_finite);
     let _ = std::fs::remove_dir_all(dir);
 }
+
+#[test]
+fn a_device_that_cannot_be_opened_is_reported_and_the_app_runs_on_without_haptics() {
+    let device = HapticDevice::named("trace:/nonexistent/hand.csv").expect("a device name");
+    let mut app = App::new();
+    app.add_plugins((MinimalPlugins, AssetPlugin::default(), HapticsPlugins)).insert_resource(device);
+    app.world_mut().spawn(HapticTool::ball(0.003));
+    app.finish();
+    app.cleanup();
+    for _ in 0..3 {
+        app.update();
+    }
+    match app.world().resource::<HapticStatus>() {
+        HapticStatus::Failed(why) => {
+            assert!(why.contains("/nonexistent/hand.csv") && !why.contains('\n'), "{why}");
+        }
+        other => panic!("expected a failure, got {other:?}"),
+    }
+    assert!(app.world().get_resource::<SimulatedHand>().is_none());
+    let err = HapticDevice::named("inverse3").expect_err("not a device name");
+    assert!(err.contains("sim, trace:FILE, hid[:PATH], falcon[:FIRMWARE] or haply[:URL]"), "{err}");
+}

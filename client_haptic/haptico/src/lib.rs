@@ -5,6 +5,7 @@
 #[global_allocator]
 static ALLOCATOR: assert_no_alloc::AllocDisabler = assert_no_alloc::AllocDisabler;
 
+pub mod choice;
 pub mod core;
 pub mod device;
 pub mod error;
@@ -23,6 +24,7 @@ pub mod timing;
 pub mod trace;
 
 pub use crate::core::{HapticCore, HapticEvents};
+pub use choice::{DeviceChoice, DeviceLink, OpenError};
 pub use device::{Device, DeviceSpecs};
 pub use error::{HapticoError, Result};
 pub use mock::{MockDevice, MockLog};
