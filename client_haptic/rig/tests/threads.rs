@@ -67,17 +67,23 @@ fn the_pipeline_under_the_rig_adds_replaces_removes_and_keeps_to_its_region_with
     objects_come_and_go_in_the_one_pipeline(Rendering::Proxy);
 }
 
-/// With the tool resting 2 mm deep in a slab: the slab's contacts come and go as it is added, replaced
-/// far away, added again under another id, left outside the region, removed; what is replaced or removed
-/// comes back to be freed; a fifth object is refused.
-fn objects_come_and_go_in_the_one_pipeline(rendering: Rendering) {
+/// A rig whose 5 mm ball tool rests 2 mm below y = 0 at x = 0 (a simulated Touch held still), rendering
+/// with `rendering`, `events` bound before its force stage.
+fn resting_rig(rendering: Rendering, events: HapticEvents) -> HapticRig<SimDevice> {
     let device = SimDevice::new(
         SimConfig::new(presets::touch()),
         TargetPath::line(Vec3::new(0.0, -0.002, 0.0), Vec3::new(0.0, -0.002, 0.0), 0.1),
     );
     let tool = ToolSpec::new(utils::ball_tool(), Material::default());
     let config = RigConfig { rendering, ..RigConfig::default() };
-    let rig = HapticRig::start(device, tool, config, HapticEvents::default(), Delegator::new()).expect("rig");
+    HapticRig::start(device, tool, config, events, Delegator::new()).expect("rig")
+}
+
+/// With the tool resting 2 mm deep in a slab: the slab's contacts come and go as it is added, replaced
+/// far away, added again under another id, left outside the region, removed; what is replaced or removed
+/// comes back to be freed; one object past `MAX_OBJECTS` is refused.
+fn objects_come_and_go_in_the_one_pipeline(rendering: Rendering) {
+    let rig = resting_rig(rendering, HapticEvents::default());
     // Contacts seen on a tick whose data came from a step after `after`.
     let touching = |after: u64| {
         let t = rig.telemetry();
@@ -142,18 +148,12 @@ fn a_moved_object_is_felt_where_it_went_with_proxy_rendering() {
 
 #[test]
 fn without_a_force_stage_contacts_are_reported_and_only_the_delegates_push() {
-    let device = SimDevice::new(
-        SimConfig::new(presets::touch()),
-        TargetPath::line(Vec3::new(0.0, -0.002, 0.0), Vec3::new(0.0, -0.002, 0.0), 0.1),
-    );
-    let tool = ToolSpec::new(utils::ball_tool(), Material::default());
-    let config = RigConfig { rendering: Rendering::Off, ..RigConfig::default() };
     // A delegate's constant 0.1 N upwards (below the safety layer's engagement threshold): the only force.
     let mut events = HapticEvents::default();
     events.force_on_haptic_tick.add_delegate(|t: &haptic_common::ForceOnHapticTick| {
         t.add(haptic_common::ForceTorque { force: Vec3::Y * 0.1, torque: Vec3::ZERO })
     });
-    let rig = HapticRig::start(device, tool, config, events, Delegator::new()).expect("rig");
+    let rig = resting_rig(Rendering::Off, events);
     rig.add_object(utils::slab_object(3)).expect("add");
     let touched = |t: &haptic_rig::RigTelemetry| t.objects().iter().any(|c| c.id == 3 && c.touching && c.volume > 0.0);
     assert!(eventually(|| touched(&rig.telemetry())), "the slab's contact is reported: {:?}", rig.telemetry());
@@ -168,13 +168,7 @@ fn without_a_force_stage_contacts_are_reported_and_only_the_delegates_push() {
 /// The tool rests 2 mm below y = 0 at x = 0; two slabs start far apart from it; moving the second one
 /// under the tool makes it (and only it) touched, moving it away again ends the contact.
 fn objects_move_and_are_named(rendering: Rendering) {
-    let device = SimDevice::new(
-        SimConfig::new(presets::touch()),
-        TargetPath::line(Vec3::new(0.0, -0.002, 0.0), Vec3::new(0.0, -0.002, 0.0), 0.1),
-    );
-    let tool = ToolSpec::new(utils::ball_tool(), Material::default());
-    let config = RigConfig { rendering, ..RigConfig::default() };
-    let rig = HapticRig::start(device, tool, config, HapticEvents::default(), Delegator::new()).expect("rig");
+    let rig = resting_rig(rendering, HapticEvents::default());
     let away = |x: f32| Pose::from_translation(Vec3::new(x, -0.01, 0.0));
     rig.add_object(ObjectSpec { pose: away(0.5), ..utils::slab_object(1) }).expect("add");
     rig.add_object(ObjectSpec { pose: away(-0.5), ..utils::slab_object(2) }).expect("add");
