@@ -24,6 +24,10 @@ enum Seen {
 #[derive(Resource, Clone, Default)]
 struct Log(Arc<Mutex<Vec<Seen>>>);
 
+/// The tools the contact events named.
+#[derive(Resource, Clone, Default)]
+struct Tools(Arc<Mutex<Vec<Entity>>>);
+
 /// A 2 cm box's tree.
 fn box_tree() -> SphereTree {
     SphereTree::from_mesh(&Cuboid::new(0.02, 0.02, 0.02).into(), 1.0, 300).expect("a box packs")
@@ -46,11 +50,19 @@ fn contacts_with_three_colliders_start_and_end_in_the_order_the_hand_presses_the
     .insert_resource(HapticDevice::simulated("phantom desktop", Vec3::new(XS[0], ABOVE, 0.0)));
     let log = Log::default();
     app.insert_resource(log.clone());
-    app.add_observer(|c: On<ContactStarted>, log: Res<Log>| log.0.lock().unwrap().push(Seen::Started(c.object)));
-    app.add_observer(|c: On<ContactEnded>, log: Res<Log>| log.0.lock().unwrap().push(Seen::Ended(c.object)));
+    let tools = Tools::default();
+    app.insert_resource(tools.clone());
+    app.add_observer(|c: On<ContactStarted>, log: Res<Log>, tools: Res<Tools>| {
+        log.0.lock().unwrap().push(Seen::Started(c.object));
+        tools.0.lock().unwrap().push(c.tool);
+    });
+    app.add_observer(|c: On<ContactEnded>, log: Res<Log>, tools: Res<Tools>| {
+        log.0.lock().unwrap().push(Seen::Ended(c.object));
+        tools.0.lock().unwrap().push(c.tool);
+    });
 
     let world = app.world_mut();
-    world.spawn(HapticTool::ball(0.003));
+    let tool = world.spawn(HapticTool::ball(0.003)).id();
     let mesh = world.resource_mut::<Assets<Mesh>>().add(Cuboid::new(0.02, 0.02, 0.02));
     let from_mesh =
         world.spawn((Mesh3d(mesh), SphereTreeFromMesh { spheres: 300 }, Transform::from_xyz(XS[0], 0.0, 0.0))).id();
@@ -96,6 +108,12 @@ fn contacts_with_three_colliders_start_and_end_in_the_order_the_hand_presses_the
     let seen = log.0.lock().unwrap().clone();
     let expected = [from_mesh, from_file, from_code].into_iter().flat_map(|e| [Seen::Started(e), Seen::Ended(e)]);
     assert_eq!(seen, expected.collect::<Vec<_>>(), "mesh {from_mesh}, file {from_file}, code {from_code}");
+    let named = tools.0.lock().unwrap().clone();
+    assert!(named.len() == 6 && named.iter().all(|&t| t == tool), "every event names the tool {tool}: {named:?}");
+    // The tool's Transform follows the device: after the last press it hovers above the third box.
+    let mut q = app.world_mut().query_filtered::<&Transform, With<HapticTool>>();
+    let at = q.iter(app.world()).next().expect("the tool").translation;
+    assert!((at - Vec3::new(XS[2], ABOVE, 0.0)).length() < 0.01, "the tool is at {at}");
     let stats = *app.world().resource::<HapticStats>();
     assert_eq!(stats.contacts_started, 3);
     assert!(stats.max_force_n > 0.1 && stats.max_force_n <= 7.9 + 1e-3, "{stats:?}");
