@@ -5,10 +5,8 @@
 //! during one ([`check`], [`DeviceHealth`]), and, with the sim device, to move its hand from the keyboard or from the bot through
 //! a [`HandControl`] (latest [`HandGoal`] through a triple buffer: the haptic thread never waits).
 
-use std::sync::Arc;
-
 use glam::Vec3;
-use haptico::{Device, DeviceSpecs};
+use haptico::{Device, DeviceLink, DeviceSpecs};
 
 use crate::error::ClientError;
 
@@ -30,17 +28,9 @@ pub fn preset(name: Option<&str>) -> Result<DeviceSpecs, ClientError> {
     }
 }
 
-/// What a real device's I/O thread tells of its link, watched during a session.
+/// What a real device's I/O thread tells of its link (haptico's [`DeviceLink`]), watched during a session.
 #[derive(Clone, Debug, Default)]
-pub enum DeviceHealth {
-    /// A device with no link to lose (simulated, a trace, HID).
-    #[default]
-    Local,
-    /// A Novint Falcon on USB.
-    Falcon(Arc<haptico::falcon::device::FalconStatus>),
-    /// A Haply Inverse3 through its service.
-    Haply(Arc<haptico::haply::HaplyStatus>),
-}
+pub struct DeviceHealth(pub DeviceLink);
 
 /// What the link says now, for a [`Guide`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -67,16 +57,16 @@ impl DeviceHealth {
     /// copy is felt at, [`START`]'s 9 cm from where the grip was held still to centre it). `None` for
     /// simulated, recorded and HID devices, whose grip goes where the program puts it.
     pub fn workspace(&self, specs: &DeviceSpecs) -> Option<forcecomp::Workspace> {
-        let real = matches!(self, Self::Falcon(_) | Self::Haply(_));
+        let real = matches!(self.0, DeviceLink::Falcon(_) | DeviceLink::Haply(_));
         (real && specs.workspace_radius_m > 0.0)
             .then_some(forcecomp::Workspace { centre: Vec3::ZERO, radius_m: specs.workspace_radius_m })
     }
 
     /// The link's state now.
     pub fn reading(&self) -> Reading {
-        match self {
-            Self::Local => Reading::default(),
-            Self::Falcon(s) => Reading {
+        match &self.0 {
+            DeviceLink::Local => Reading::default(),
+            DeviceLink::Falcon(s) => Reading {
                 lost: s.disconnected().then_some(
                     "The Falcon stopped answering: no force reaches it. Check its cable and power, then start again.",
                 ),
@@ -84,7 +74,7 @@ impl DeviceHealth {
                 homed: (s.replies() > 0).then(|| s.homed().iter().all(|&h| h)),
                 outside_workspace: false,
             },
-            Self::Haply(s) => Reading {
+            DeviceLink::Haply(s) => Reading {
                 lost: s.disconnected().then_some(
                     "The Haply service went away: no force reaches the Inverse3. Check that the Haply Inverse \
                      Service runs and the Inverse3 is on, then start again.",
@@ -201,21 +191,13 @@ pub fn check(choice: &DeviceChoice) -> Result<Option<String>, ClientError> {
 /// that moves its hand.
 pub fn open(choice: &DeviceChoice, specs: DeviceSpecs) -> Result<Opened, ClientError> {
     let opened = haptico::choice::open(choice, specs, START).map_err(|e| ClientError::Device(e.to_string()))?;
-    Ok(Opened { device: opened.device, hand: opened.hand, health: opened.link.into() })
-}
-
-impl From<haptico::DeviceLink> for DeviceHealth {
-    fn from(link: haptico::DeviceLink) -> Self {
-        match link {
-            haptico::DeviceLink::Local => Self::Local,
-            haptico::DeviceLink::Falcon(status) => Self::Falcon(status),
-            haptico::DeviceLink::Haply(status) => Self::Haply(status),
-        }
-    }
+    Ok(Opened { device: opened.device, hand: opened.hand, health: DeviceHealth(opened.link) })
 }
 
 #[cfg(test)]
 mod tests {
+    use std::sync::Arc;
+
     use super::*;
 
     #[test]
@@ -239,7 +221,7 @@ mod tests {
         let Err(opened) = open(&choice, haptico::presets::inverse3()) else { panic!("opened a closed port") };
         assert_eq!(opened.to_string(), e, "the check and the open say the same");
         assert!(!e.contains('\n') && start.elapsed() < std::time::Duration::from_secs(5), "{:?}", start.elapsed());
-        assert!(DeviceHealth::Local.reading().lost.is_none());
+        assert!(DeviceHealth::default().reading().lost.is_none());
     }
 
     #[test]
@@ -264,7 +246,7 @@ mod tests {
         // A device without homing only ever hears of a loss.
         let mut g = Guide::default();
         assert_eq!(g.next(Reading::default(), 0.0), None);
-        assert_eq!(DeviceHealth::Local.reading(), Reading::default());
+        assert_eq!(DeviceHealth::default().reading(), Reading::default());
     }
 
     #[test]
@@ -288,12 +270,12 @@ mod tests {
 
     #[test]
     fn real_devices_keep_forces_to_their_published_workspace_and_programs_steer_anywhere() {
-        let falcon = DeviceHealth::Falcon(Arc::default());
+        let falcon = DeviceHealth(DeviceLink::Falcon(Arc::default()));
         let w = falcon.workspace(&haptico::presets::falcon()).expect("a Falcon has a workspace");
         assert_eq!((w.centre, w.radius_m), (Vec3::ZERO, 0.04));
         let inverse3 = haptico::presets::inverse3();
-        let haply = DeviceHealth::Haply(Arc::default()).workspace(&inverse3).expect("an Inverse3 has one");
+        let haply = DeviceHealth(DeviceLink::Haply(Arc::default())).workspace(&inverse3).expect("an Inverse3 has one");
         assert!(haply.holds(START), "the grip is centred inside the Inverse3's reach: {START} in {haply:?}");
-        assert_eq!(DeviceHealth::Local.workspace(&haptico::presets::phantom_desktop()), None);
+        assert_eq!(DeviceHealth::default().workspace(&haptico::presets::phantom_desktop()), None);
     }
 }

@@ -124,6 +124,9 @@ pub(crate) struct EffectsInput(pub(crate) triple_buffer::Input<EffectSet>);
 /// A force delegate for the haptic thread reading the latest set (bind it before the rig's force stage).
 pub(crate) fn delegate(map: WorkspaceMap) -> (EffectsInput, impl FnMut(&ForceOnHapticTick) + Send + 'static) {
     let (input, mut output) = triple_buffer::triple_buffer(&EffectSet::default());
+    // The magnet's tree walk: a few nodes a level (at most 4 children), far below this capacity, so it
+    // never grows on the haptic thread.
+    let mut stack = Vec::with_capacity(TREE_WALK_CAPACITY);
     let run = move |tick: &ForceOnHapticTick| {
         let set = output.read();
         if set.len == 0 {
@@ -134,15 +137,19 @@ pub(crate) fn delegate(map: WorkspaceMap) -> (EffectsInput, impl FnMut(&ForceOnH
         let t_s = tick.device.timestamp_us as f32 * 1e-6;
         let mut force = Vec3::ZERO;
         for placed in &set.effects[..set.len] {
-            force += effect_force(placed, tool, velocity, t_s);
+            force += effect_force(placed, tool, velocity, t_s, &mut stack);
         }
         tick.add(map.wrench_to_device(ForceTorque { force, torque: Vec3::ZERO }));
     };
     (EffectsInput(input), run)
 }
 
-/// The force of one effect on a tool at `tool` moving at `velocity` (world frame), time `t_s`.
-fn effect_force(placed: &Placed, tool: Vec3, velocity: Vec3, t_s: f32) -> Vec3 {
+/// Scratch capacity of the magnet's tree walk (see [`collette::partitioning::for_each_leaf_in_sphere`]).
+const TREE_WALK_CAPACITY: usize = 1024;
+
+/// The force of one effect on a tool at `tool` moving at `velocity` (world frame), time `t_s`; `stack`
+/// is the scratch of a magnet's tree walk.
+fn effect_force(placed: &Placed, tool: Vec3, velocity: Vec3, t_s: f32, stack: &mut Vec<u32>) -> Vec3 {
     let Some(effect) = placed.effect else { return Vec3::ZERO };
     let offset = tool - placed.position;
     let fade = if effect.radius_m > 0.0 {
@@ -171,15 +178,18 @@ fn effect_force(placed: &Placed, tool: Vec3, velocity: Vec3, t_s: f32) -> Vec3 {
         EffectKind::Magnetic { strength_n, reach_m } => {
             let Some(tree) = &placed.tree else { return Vec3::ZERO };
             let local = placed.rotation.inverse() * offset;
-            // The nearest inner sphere's surface: where the pull points, and how far.
-            let nearest = tree
-                .spheres()
-                .iter()
-                .map(|s| (s, s.center.distance(local) - s.radius))
-                .min_by(|a, b| a.1.total_cmp(&b.1));
+            // The nearest inner sphere's surface: where the pull points, and how far. Only spheres within
+            // reach can be nearer than `reach_m`: the tree's hierarchy finds them.
+            let mut nearest: Option<(Vec3, f32)> = None;
+            collette::partitioning::for_each_leaf_in_sphere(tree, local, reach_m, stack, |_, s| {
+                let d = s.center.distance(local) - s.radius;
+                if nearest.is_none_or(|(_, best)| d < best) {
+                    nearest = Some((s.center, d));
+                }
+            });
             match nearest {
-                Some((s, d)) if d > 0.0 && d < reach_m => {
-                    let towards = (s.center - local).normalize_or_zero();
+                Some((center, d)) if d > 0.0 && d < reach_m => {
+                    let towards = (center - local).normalize_or_zero();
                     placed.rotation * towards * strength_n * (1.0 - d / reach_m)
                 }
                 _ => Vec3::ZERO,
@@ -241,31 +251,35 @@ mod tests {
     #[test]
     fn a_spring_pulls_back_to_its_point_and_only_within_its_radius() {
         let spring = placed(EffectKind::Spring { stiffness_n_per_m: 100.0, damping_ns_per_m: 0.0 }, 0.05);
-        let f = effect_force(&spring, Vec3::new(0.01, 1.0, 0.0), Vec3::ZERO, 0.0);
+        let f = effect_force(&spring, Vec3::new(0.01, 1.0, 0.0), Vec3::ZERO, 0.0, &mut Vec::new());
         assert!((f - Vec3::new(-1.0, 0.0, 0.0)).length() < 1e-5, "{f}");
-        assert_eq!(effect_force(&spring, Vec3::new(0.1, 1.0, 0.0), Vec3::ZERO, 0.0), Vec3::ZERO, "outside");
+        assert_eq!(
+            effect_force(&spring, Vec3::new(0.1, 1.0, 0.0), Vec3::ZERO, 0.0, &mut Vec::new()),
+            Vec3::ZERO,
+            "outside"
+        );
         // Fading over the outer fifth: half way through it, half the force; nothing at the edge.
-        let f = effect_force(&spring, Vec3::new(0.045, 1.0, 0.0), Vec3::ZERO, 0.0);
+        let f = effect_force(&spring, Vec3::new(0.045, 1.0, 0.0), Vec3::ZERO, 0.0, &mut Vec::new());
         assert!((f - Vec3::new(-4.5 * 0.5, 0.0, 0.0)).length() < 1e-4, "{f}");
-        assert!(effect_force(&spring, Vec3::new(0.05, 1.0, 0.0), Vec3::ZERO, 0.0).length() < 1e-4);
+        assert!(effect_force(&spring, Vec3::new(0.05, 1.0, 0.0), Vec3::ZERO, 0.0, &mut Vec::new()).length() < 1e-4);
     }
 
     #[test]
     fn a_line_spring_pulls_across_its_axis_not_along_it() {
         let rail = placed(EffectKind::SpringToLine { stiffness_n_per_m: 100.0, damping_ns_per_m: 0.0 }, 0.0);
-        let f = effect_force(&rail, Vec3::new(0.02, 1.5, 0.0), Vec3::ZERO, 0.0);
+        let f = effect_force(&rail, Vec3::new(0.02, 1.5, 0.0), Vec3::ZERO, 0.0, &mut Vec::new());
         assert!((f - Vec3::new(-2.0, 0.0, 0.0)).length() < 1e-5, "{f}");
     }
 
     #[test]
     fn a_viscous_region_resists_motion_and_a_vibration_oscillates_along_its_axis() {
         let honey = placed(EffectKind::Viscous { damping_ns_per_m: 5.0 }, 0.0);
-        assert_eq!(effect_force(&honey, Vec3::Y, Vec3::X * 0.1, 0.0), Vec3::X * -0.5);
+        assert_eq!(effect_force(&honey, Vec3::Y, Vec3::X * 0.1, 0.0, &mut Vec::new()), Vec3::X * -0.5);
         let plate = placed(EffectKind::Vibration { amplitude_n: 1.0, frequency_hz: 100.0 }, 0.0);
-        let peak = effect_force(&plate, Vec3::Y, Vec3::ZERO, 0.0025);
+        let peak = effect_force(&plate, Vec3::Y, Vec3::ZERO, 0.0025, &mut Vec::new());
         assert!((peak - Vec3::Y).length() < 1e-4, "a quarter period: {peak}");
         let constant = placed(EffectKind::Constant { force_n: Vec3::Z }, 0.0);
-        assert_eq!(effect_force(&constant, Vec3::ZERO, Vec3::X, 3.0), Vec3::Z);
+        assert_eq!(effect_force(&constant, Vec3::ZERO, Vec3::X, 3.0, &mut Vec::new()), Vec3::Z);
     }
 
     #[test]
@@ -274,9 +288,17 @@ mod tests {
         let magnet =
             Placed { tree: Some(tree), ..placed(EffectKind::Magnetic { strength_n: 2.0, reach_m: 0.02 }, 0.0) };
         // 5 mm from the ball's surface, on its +X side: pulled towards −X with 3/4 of the strength.
-        let f = effect_force(&magnet, Vec3::new(0.015, 1.0, 0.0), Vec3::ZERO, 0.0);
+        let f = effect_force(&magnet, Vec3::new(0.015, 1.0, 0.0), Vec3::ZERO, 0.0, &mut Vec::new());
         assert!((f - Vec3::new(-1.5, 0.0, 0.0)).length() < 1e-4, "{f}");
-        assert_eq!(effect_force(&magnet, Vec3::new(0.05, 1.0, 0.0), Vec3::ZERO, 0.0), Vec3::ZERO, "beyond reach");
-        assert_eq!(effect_force(&magnet, Vec3::new(0.005, 1.0, 0.0), Vec3::ZERO, 0.0), Vec3::ZERO, "inside");
+        assert_eq!(
+            effect_force(&magnet, Vec3::new(0.05, 1.0, 0.0), Vec3::ZERO, 0.0, &mut Vec::new()),
+            Vec3::ZERO,
+            "beyond reach"
+        );
+        assert_eq!(
+            effect_force(&magnet, Vec3::new(0.005, 1.0, 0.0), Vec3::ZERO, 0.0, &mut Vec::new()),
+            Vec3::ZERO,
+            "inside"
+        );
     }
 }

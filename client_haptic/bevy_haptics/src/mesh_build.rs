@@ -36,13 +36,9 @@ pub(crate) fn start_mesh_builds(
     mut commands: Commands,
     meshes: Option<Res<Assets<Mesh>>>,
     pending: Query<(Entity, &SphereTreeFromMesh, &Mesh3d, &GlobalTransform), Without<BuildingTree>>,
-    built: Query<(), With<HapticCollider>>,
 ) {
     let Some(meshes) = meshes else { return };
     for (entity, from, mesh, transform) in &pending {
-        if built.contains(entity) {
-            continue;
-        }
         let Some(mesh) = meshes.get(&mesh.0) else { continue };
         // The tree is in the entity's frame; a uniform scale is baked into it (a tree cannot be stretched).
         let scale = transform.compute_transform().scale.max_element();

@@ -11,7 +11,7 @@ use std::sync::{Arc, Mutex};
 
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
-use forcecomp::{SafetyConfig, SafetyLayer};
+use forcecomp::SafetyLayer;
 use haptic_common::{ForceOnHapticTick, Pose};
 use haptic_rig::{ForceSample, HapticRig, ObjectSpec, Rendering, RigConfig, StepTiming, ToolSpec};
 use haptico::{Device, DeviceSpecs, HapticClock, HapticEvents, HapticHandle, TickTiming};
@@ -146,9 +146,12 @@ fn try_start(world: &mut World) -> Result<HapticStatus, String> {
     let (effects, run_effects) = crate::effects::delegate(map);
     let mut events = user;
     events.force_on_haptic_tick.add_delegate(run_effects);
-    let rate_hz = device.rate_hz;
-    let mut haptic = haptico::HapticConfig { rate_hz: device.rate_hz, ..Default::default() };
-    haptic.realtime_priority = device.realtime_priority;
+    let haptic = haptico::HapticConfig {
+        rate_hz: device.rate_hz,
+        realtime_priority: device.realtime_priority,
+        ..Default::default()
+    };
+    let rate_hz = haptic.rate_hz;
     let collision = world.get_resource::<CollisionSettings>().cloned();
     let rendering = world.get_resource::<ForceRendering>().map(|r| r.resolve(&specs));
     let clock = HapticClock::new();
@@ -206,8 +209,7 @@ fn start_device(
     specs: &DeviceSpecs,
     clock: HapticClock,
 ) -> Result<DeviceOnly, String> {
-    let safety = SafetyConfig::for_limits(specs.peak_force_n, specs.max_torque_nm)
-        .with_continuous_force(specs.continuous_force_n);
+    let safety = haptic_rig::safety_for(specs);
     safety.validate().map_err(|e| e.to_string())?;
     let mut safety = SafetyLayer::new(safety);
     let (mut samples_in, samples_out) = rtrb::RingBuffer::new(1 << 16);
@@ -304,12 +306,11 @@ pub(crate) struct ToolKey {
 
 /// Sends the tool's tree and material when they change (`PostUpdate`).
 pub(crate) fn sync_tool(
-    runtime: Option<Res<HapticRuntime>>,
-    mut watched: Option<ResMut<Watched>>,
+    mut threads: Threads,
     trees: Res<Assets<SphereTree>>,
     tools: Query<(&HapticTool, Option<&ForceComponent>)>,
 ) {
-    let (Some(runtime), Some(watched)) = (runtime, watched.as_mut()) else { return };
+    let Some((runtime, watched)) = threads.get() else { return };
     let Some((tool, force)) = tools.iter().next() else { return };
     let tree = tool.tree.as_ref().and_then(|h| trees.get(h).map(|t| (h.id(), t)));
     let key = ToolKey { tree: tree.map(|(id, _)| id), tip_radius_m: tool.tip_radius_m, material: force.copied() };
@@ -433,12 +434,8 @@ fn pose_of(transform: &GlobalTransform) -> Pose {
 }
 
 /// Sends the collision volume's box when it changes or goes (`PostUpdate`).
-pub(crate) fn sync_volume(
-    runtime: Option<Res<HapticRuntime>>,
-    mut watched: Option<ResMut<Watched>>,
-    volumes: Query<(&CollisionVolume, &GlobalTransform)>,
-) {
-    let (Some(runtime), Some(watched)) = (runtime, watched.as_mut()) else { return };
+pub(crate) fn sync_volume(mut threads: Threads, volumes: Query<(&CollisionVolume, &GlobalTransform)>) {
+    let Some((runtime, watched)) = threads.get() else { return };
     let region = volumes.iter().next().map(|(v, t)| {
         let c = t.translation();
         let h = v.half_extents_m.abs();

@@ -6,21 +6,15 @@
 //! of a release build: these are debug builds of the examples on a shared two-core machine, beside other
 //! tests. Release rates are measured by `haptic-bench` (docs/haptics.md). One example runs at a time.
 
-use std::path::PathBuf;
 use std::process::Command;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+mod support;
 
-/// The example's binary, built by `cargo test` beside this test's (target/<profile>/examples/).
-fn example(name: &str) -> PathBuf {
-    let exe = std::env::current_exe().expect("the test's own path");
-    let profile = exe.parent().and_then(|deps| deps.parent()).expect("target/<profile>/deps/<test>");
-    let path = profile.join("examples").join(name);
-    assert!(path.exists(), "{} is not built: `cargo test -p bevy_haptics` builds the examples", path.display());
-    path
-}
+use support::example;
+
+static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
 
 /// Runs `name` headless for `seconds` and returns its JSON line.
 fn run(name: &str, seconds: f32) -> serde_json::Value {

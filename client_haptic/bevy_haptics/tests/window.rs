@@ -6,6 +6,8 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+mod support;
+
 /// Decodes an 8-bit RGB(A) PNG into (width, height, RGB pixels).
 fn decode(path: &Path) -> (u32, u32, Vec<[u8; 3]>) {
     let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).expect("the screenshot exists")));
@@ -19,11 +21,7 @@ fn decode(path: &Path) -> (u32, u32, Vec<[u8; 3]>) {
 
 #[test]
 fn touch_bunny_shows_the_lit_bunny_and_the_force_under_xvfb_on_lavapipe() {
-    let example = std::env::current_exe()
-        .ok()
-        .and_then(|exe| Some(exe.parent()?.parent()?.join("examples").join("touch_bunny")))
-        .filter(|p| p.exists())
-        .expect("touch_bunny is built beside this test (`cargo test -p bevy_haptics` builds the examples)");
+    let example = support::example("touch_bunny");
     let shot = std::env::temp_dir().join(format!("bevy-haptics-touch-bunny-{}.png", std::process::id()));
     let _ = std::fs::remove_file(&shot);
     let mut child = Command::new("xvfb-run")

@@ -352,15 +352,14 @@ impl ForceStage {
         let balls = self.balls.as_slice();
         // The spring of the material the proxy rests on: the object of the sphere nearest to it.
         let near = if self.god.in_contact() { self.god.proxy() } else { tip.translation };
-        let nearest = balls
+        let nearest_slot = balls
             .iter()
             .enumerate()
             .min_by(|a, b| {
                 (a.1.center.distance(near) - a.1.radius).total_cmp(&(b.1.center.distance(near) - b.1.radius))
             })
             .map(|(i, _)| usize::from(self.ball_objects[i]));
-        let nearest_slot = nearest;
-        let nearest = nearest.map(|slot| &self.objects[slot]);
+        let nearest = nearest_slot.map(|slot| &self.objects[slot]);
         let material = nearest.map(|o| self.tool_material.combine(&o.material));
         let config = ProxyConfig {
             stiffness_n_per_m: material

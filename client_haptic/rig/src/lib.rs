@@ -14,6 +14,6 @@ pub mod workspace;
 pub use collision::{CollisionConfig, StepTiming};
 pub use error::{Result, RigError};
 pub use force::{ForceSample, ObjectContact, ProxyRendering, Rendering, RigTelemetry};
-pub use rig::{HapticRig, RigConfig};
+pub use rig::{HapticRig, RigConfig, safety_for};
 pub use spec::{MAX_OBJECTS, ObjectSpec, ToolSpec};
 pub use workspace::WorkspaceMap;

@@ -57,6 +57,12 @@ impl Default for RigConfig {
     }
 }
 
+/// The safety layer's settings for a device: its peak force and torque, heating down to its continuous
+/// force, with the default habits (what a [`RigConfig`] without `safety` uses).
+pub fn safety_for(specs: &haptico::DeviceSpecs) -> SafetyConfig {
+    SafetyConfig::for_limits(specs.peak_force_n, specs.max_torque_nm).with_continuous_force(specs.continuous_force_n)
+}
+
 /// What the game thread reads back from the force stage.
 pub(crate) struct Outputs {
     pub(crate) samples: rtrb::Consumer<ForceSample>,
@@ -84,10 +90,7 @@ impl Parts {
             CouplingConfig::for_device(specs.max_stiffness_n_per_m, specs.max_damping_ns_per_m, 4.0, period_s)
         });
         coupling.validate()?;
-        let mut safety = config.safety.unwrap_or_else(|| {
-            SafetyConfig::for_limits(specs.peak_force_n, specs.max_torque_nm)
-                .with_continuous_force(specs.continuous_force_n)
-        });
+        let mut safety = config.safety.unwrap_or_else(|| safety_for(specs));
         safety.workspace = config.workspace.or(safety.workspace);
         safety.validate()?;
         let tool_pose = collision.add_object(tool.tree, Pose::IDENTITY).ok_or(RigError::QueueFull("collision"))?;
