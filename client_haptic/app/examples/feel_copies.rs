@@ -12,8 +12,8 @@
 use clap::Parser;
 use client_haptic::cli::KindArg;
 use client_haptic::explore::feel;
-use client_haptic::haptics::{Haptics, HapticsSettings, RenderingChoice};
-use client_haptic::touch_bench::{LockstepHaptics, TouchBench};
+use client_haptic::haptics::{HapticsSettings, RenderingChoice};
+use client_haptic::touch_bench::{LockstepHaptics, RealTimeHaptics, TouchBench};
 use heist_shared::artifact::{ArtifactKind, build_mesh, copy_mesh_seed, generate_copies, target_seed};
 use heist_shared::level::Level;
 use heist_shared::protocol::{ItemId, WorkbenchCopy};
@@ -54,8 +54,7 @@ fn main() -> anyhow::Result<()> {
     if args.lockstep {
         return feel_all(&mut LockstepHaptics::start(settings)?, &args);
     }
-    let mut h = Haptics::start(settings)?;
-    std::thread::sleep(std::time::Duration::from_millis(2500)); // the safety layer ramps forces in
+    let mut h = RealTimeHaptics::start(settings)?;
     let felt = feel_all(&mut h, &args);
     h.stop();
     felt

@@ -21,10 +21,11 @@ use heist_shared::protocol::{
 
 use crate::audio::synth::{ContactParams, Earcon};
 use crate::audio::{AudioEngine, AudioSettings, listener_offset};
+use crate::bench::{CopyLanded, Haptics};
 use crate::device::HandGoal;
 use crate::error::ClientError;
-use crate::explore::{Exploration, Findings, to_device};
-use crate::haptics::{Haptics, HapticsSettings};
+use crate::explore::{Exploration, Findings};
+use crate::haptics::HapticsSettings;
 use crate::speech::Speaker;
 use crate::status::{self, MenuItem};
 
@@ -146,9 +147,9 @@ pub fn start_with(
     mut audio: AudioEngine,
     mut speaker: Speaker,
 ) -> Result<(), ClientError> {
-    let haptics = Haptics::start(settings.haptics.clone())?;
+    crate::bench::add_haptics(app, &settings.haptics)?;
     crate::settings::plugin::apply(&settings.prefs.run, &mut speaker, &mut audio);
-    app.insert_non_send(haptics).insert_non_send(audio).insert_non_send(speaker);
+    app.insert_non_send(audio).insert_non_send(speaker);
     app.insert_resource(settings.prefs.clone());
     app.add_plugins((PhantomClientPlugin { settings }, crate::settings::plugin::SettingsPlugin));
     Ok(())
@@ -194,7 +195,7 @@ fn receive(
     mut inbox: ResMut<Inbox>,
     mut events: MessageWriter<HeistEvent>,
     mut state: ResMut<PhantomState>,
-    mut haptics: NonSendMut<Haptics>,
+    mut haptics: Haptics,
     mut bench: ResMut<BenchView>,
     items: Query<&ItemView>,
 ) {
@@ -203,7 +204,7 @@ fn receive(
     }
     if let Some(copy) = inbox.workbench.take() {
         let kind = kind_of(&items, copy.item);
-        haptics.place(&copy);
+        haptics.bench.place(&copy);
         let colour = kind.map_or([200, 200, 200], |k| heist_shared::artifact::look(k).colour_srgb);
         bench.copy = Some((copy.item, copy.mesh.clone(), colour));
         state.copy = Some((copy.item, kind));
@@ -225,7 +226,7 @@ fn receive(
 /// Guides the player through the real device's set-up as the session goes (the Falcon's homing, a grip
 /// read out of reach) and tells them, once, when it stopped answering (its link went: no force reaches it).
 fn watch_device(
-    haptics: NonSend<Haptics>,
+    haptics: Haptics,
     mut speaker: NonSendMut<Speaker>,
     mut guide: Local<crate::device::Guide>,
     mut started: Local<Option<std::time::Instant>>,
@@ -237,32 +238,33 @@ fn watch_device(
     }
 }
 
-/// Polls the tree build and the rig's rings; announces when the copy can be felt.
+/// Announces when the copy can be felt (or cannot).
 fn poll_haptics(
-    mut haptics: NonSendMut<Haptics>,
+    mut landed: MessageReader<CopyLanded>,
     mut speaker: NonSendMut<Speaker>,
     mut audio: NonSendMut<AudioEngine>,
     settings: Res<PhantomSettings>,
 ) {
-    match haptics.poll() {
-        Some(Ok(on)) => {
-            log::info!(
-                "copy {} on the bench: {} spheres{}{}",
-                on.item.0,
-                on.spheres,
-                if on.cached { " (cached)" } else { "" },
-                on.surface_bytes.map_or(String::new(), |b| format!(", its surface grid {:.1} MB", b as f64 / 1e6))
-            );
-            audio.earcon(Earcon::ReadyToFeel);
-            if !settings.bot {
-                speaker.say("You can feel it now. Y if it is real, N if it is fake.");
+    for CopyLanded { item, result } in landed.read() {
+        match result {
+            Ok(on) => {
+                log::info!(
+                    "copy {} on the bench: {} spheres{}{}",
+                    on.item.0,
+                    on.spheres,
+                    if on.cached { " (cached)" } else { "" },
+                    on.surface_bytes.map_or(String::new(), |b| format!(", its surface grid {:.1} MB", b as f64 / 1e6))
+                );
+                audio.earcon(Earcon::ReadyToFeel);
+                if !settings.bot {
+                    speaker.say("You can feel it now. Y if it is real, N if it is fake.");
+                }
+            }
+            Err(reason) => {
+                log::error!("{}", ClientError::Copy { item: item.0 as u32, reason: reason.clone() });
+                speaker.say("This copy cannot be felt: its shape is broken.");
             }
         }
-        Some(Err(e)) => {
-            log::error!("{e}");
-            speaker.say("This copy cannot be felt: its shape is broken.");
-        }
-        None => {}
     }
 }
 
@@ -340,7 +342,7 @@ fn keys(
     guards: Query<&GuardView>,
     vive: Query<&ViveAvatar>,
     mut speaker: NonSendMut<Speaker>,
-    mut haptics: NonSendMut<Haptics>,
+    mut haptics: Haptics,
     mut out: MessageWriter<ClientMsg>,
     mut leaving: Option<ResMut<heist_client::Leaving>>,
     mut exit: MessageWriter<AppExit>,
@@ -421,7 +423,7 @@ fn keys(
             }
         }
         if let Some((item, _)) = state.copy
-            && haptics.on_bench.as_ref().is_some_and(|o| o.item == item)
+            && haptics.bench.holds(item)
         {
             for (key, real) in [(KeyCode::KeyY, true), (KeyCode::KeyN, false)] {
                 if keys.just_pressed(key) {
@@ -445,32 +447,29 @@ fn keys(
         }
     }
     if d != Vec3::ZERO && state.exploration.is_none() {
-        let map = haptics.map;
         let at = *state.hand_target.get_or_insert(Vec3::new(0.0, 0.06, 0.07));
         let next = (at + d * 0.1 * time.delta_secs()).clamp(Vec3::splat(-0.12), Vec3::splat(0.12));
         state.hand_target = Some(next);
-        if let Some(hand) = haptics.hand.as_mut() {
-            hand.set(to_device(&map, HandGoal::Hold(haptic_common::Pose::from_translation(next))));
-        }
+        haptics.steer(HandGoal::Hold(haptic_common::Pose::from_translation(next)));
     }
 }
 
 /// Device buttons: the first says real, the second fake (on press).
 fn device_buttons(
     mut state: ResMut<PhantomState>,
-    haptics: NonSend<Haptics>,
+    haptics: Haptics,
     settings: Res<PhantomSettings>,
     mut speaker: NonSendMut<Speaker>,
     mut out: MessageWriter<ClientMsg>,
 ) {
-    let buttons = haptics.telemetry().device.buttons.0;
+    let buttons = haptics.frame.device.buttons.0;
     let pressed = buttons & !state.buttons;
     state.buttons = buttons;
     if settings.bot || pressed == 0 {
         return;
     }
     if let Some((item, _)) = state.copy
-        && haptics.on_bench.as_ref().is_some_and(|o| o.item == item)
+        && haptics.bench.holds(item)
     {
         if pressed & 1 != 0 {
             send_verdict(&mut state, &mut out, &mut speaker, item, true, None);
@@ -486,7 +485,7 @@ fn after_verdict(
     mut events: MessageReader<HeistEvent>,
     mut state: ResMut<PhantomState>,
     settings: Res<PhantomSettings>,
-    mut haptics: NonSendMut<Haptics>,
+    mut haptics: Haptics,
     mut bench: ResMut<BenchView>,
     mut speaker: NonSendMut<Speaker>,
     mut out: MessageWriter<ClientMsg>,
@@ -495,7 +494,7 @@ fn after_verdict(
         if let GameEvent::RoundStarted(_) = e {
             // A new round: the last round's copy, briefing and verdicts mean nothing now.
             state.new_round();
-            haptics.clear();
+            haptics.bench.clear();
             bench.copy = None;
             continue;
         }
@@ -504,7 +503,7 @@ fn after_verdict(
                 if state.copy.is_some_and(|c| c.0 == *item) {
                     state.copy = None;
                     state.exploration = None;
-                    haptics.clear();
+                    haptics.bench.clear();
                     bench.copy = None;
                 }
                 continue;
@@ -519,7 +518,7 @@ fn after_verdict(
 /// The touch bot: explores the copy with the simulated hand and gives its verdict from what it felt.
 fn touch_bot(
     mut state: ResMut<PhantomState>,
-    mut haptics: NonSendMut<Haptics>,
+    mut haptics: Haptics,
     inbox: Res<Inbox>,
     settings: Res<PhantomSettings>,
     mut speaker: NonSendMut<Speaker>,
@@ -529,23 +528,20 @@ fn touch_bot(
         return;
     }
     let now = haptics.now_us();
-    let map = haptics.map;
     // Start on a copy that can be felt, whose kind is known, and that was not judged yet.
     if state.exploration.is_none()
         && let Some((item, Some(kind))) = state.copy
-        && haptics.on_bench.as_ref().is_some_and(|o| o.item == item)
+        && haptics.bench.holds(item)
         && state.judged != Some(item)
     {
-        let ex = Exploration::new(kind, now, haptics.stylus()).judging_springs(haptics.hard_above_n_per_m());
-        if let Some(hand) = haptics.hand.as_mut() {
-            hand.set(to_device(&map, ex.goal()));
-        }
+        let ex = Exploration::new(kind, now, haptics.stylus()).judging_springs(haptics.bench.hard_above_n_per_m());
+        haptics.steer(ex.goal());
         state.exploration = Some(ex);
     }
     let Some(ex) = state.exploration.as_mut() else { return };
-    let changed = ex.step(now, &haptics.samples);
-    if changed && let Some(hand) = haptics.hand.as_mut() {
-        hand.set(to_device(&map, ex.goal()));
+    let changed = ex.step(now, haptics.samples());
+    if changed {
+        haptics.steer(ex.goal());
     }
     if !ex.done() {
         return;
@@ -690,9 +686,9 @@ fn museum_sounds(
 }
 
 /// Drives the contact sound from this frame's haptic samples: force and sliding speed, taps on impact.
-fn contact_sound(mut state: ResMut<PhantomState>, haptics: NonSend<Haptics>, mut audio: NonSendMut<AudioEngine>) {
+fn contact_sound(mut state: ResMut<PhantomState>, haptics: Haptics, mut audio: NonSendMut<AudioEngine>) {
     let feel = state.copy_feel;
-    let params = contact_params(&haptics.samples, &mut state.last_tool, feel);
+    let params = contact_params(haptics.samples(), &mut state.last_tool, feel);
     let touching = params.force_n > 0.05;
     if touching && !state.touching {
         audio.tap((params.force_n / 2.0).min(1.0));
@@ -751,7 +747,7 @@ fn speak(mut speaker: NonSendMut<Speaker>, mut audio: NonSendMut<AudioEngine>) {
 /// Tells the server where the stylus is (20 times a second, during the heist) so Vive sees it move.
 fn send_tool_pose(
     mut state: ResMut<PhantomState>,
-    haptics: NonSend<Haptics>,
+    frame: Res<bevy_haptics::HapticFrame>,
     q: Query<&SessionView>,
     mut out: MessageWriter<ClientMsg>,
 ) {
@@ -759,7 +755,7 @@ fn send_tool_pose(
     if session(&q).is_none_or(|s| s.phase != Phase::Heist) || !state.frame.is_multiple_of(3) {
         return;
     }
-    let pose = haptics.telemetry().tool_pose;
+    let pose = frame.tool;
     out.write(ClientMsg::Phantom(PhantomMsg::ToolPose { position: pose.translation, rotation: pose.rotation }));
 }
 

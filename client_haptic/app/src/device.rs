@@ -52,16 +52,6 @@ pub const BACK_TO_THE_MIDDLE: &str =
 pub const BACK_IN_REACH: &str = "The grip is back in reach: you will feel the copies now.";
 
 impl DeviceHealth {
-    /// Where a real device's grip must be read for forces to engage: the ball of its published workspace
-    /// around the device frame's origin (the Falcon's centre of travel; with the Inverse3, the point the
-    /// copy is felt at, [`START`]'s 9 cm from where the grip was held still to centre it). `None` for
-    /// simulated, recorded and HID devices, whose grip goes where the program puts it.
-    pub fn workspace(&self, specs: &DeviceSpecs) -> Option<forcecomp::Workspace> {
-        let real = matches!(self.0, DeviceLink::Falcon(_) | DeviceLink::Haply(_));
-        (real && specs.workspace_radius_m > 0.0)
-            .then_some(forcecomp::Workspace { centre: Vec3::ZERO, radius_m: specs.workspace_radius_m })
-    }
-
     /// The link's state now.
     pub fn reading(&self) -> Reading {
         match &self.0 {
@@ -196,8 +186,6 @@ pub fn open(choice: &DeviceChoice, specs: DeviceSpecs) -> Result<Opened, ClientE
 
 #[cfg(test)]
 mod tests {
-    use std::sync::Arc;
-
     use super::*;
 
     #[test]
@@ -266,16 +254,5 @@ mod tests {
         let homed_out = Reading { homed: Some(true), outside_workspace: true, ..Reading::default() };
         assert_eq!(g.next(homed_out, 2.0), Some("The Falcon is homed: you will feel the copies now."));
         assert_eq!(g.next(homed_out, 2.1), Some(BACK_TO_THE_MIDDLE));
-    }
-
-    #[test]
-    fn real_devices_keep_forces_to_their_published_workspace_and_programs_steer_anywhere() {
-        let falcon = DeviceHealth(DeviceLink::Falcon(Arc::default()));
-        let w = falcon.workspace(&haptico::presets::falcon()).expect("a Falcon has a workspace");
-        assert_eq!((w.centre, w.radius_m), (Vec3::ZERO, 0.04));
-        let inverse3 = haptico::presets::inverse3();
-        let haply = DeviceHealth(DeviceLink::Haply(Arc::default())).workspace(&inverse3).expect("an Inverse3 has one");
-        assert!(haply.holds(START), "the grip is centred inside the Inverse3's reach: {START} in {haply:?}");
-        assert_eq!(DeviceHealth::default().workspace(&haptico::presets::phantom_desktop()), None);
     }
 }

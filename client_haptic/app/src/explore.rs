@@ -295,7 +295,7 @@ pub struct Exploration {
 
 impl Exploration {
     /// Starts exploring a copy of `kind` at haptic-clock time `now_us`, with the stylus at `hand`
-    /// (workbench frame: [`crate::haptics::Haptics::stylus`]). The hand first goes out from the
+    /// (workbench frame: [`crate::bench::Haptics::stylus`]). The hand first goes out from the
     /// copy's axis and round it to where the pokes start, never across the copy: a hand that jumped
     /// straight there from the far side (where the last exploration ended) pulled the stylus through
     /// the copy, and the 3-DOF proxy, which lets go only once the way back is free, held it inside,
@@ -341,7 +341,7 @@ impl Exploration {
 
     /// Judges hardness by the resting force over the depth against `threshold` (N/m) instead of the
     /// volumetric rendering's force over depth²: with 3-DOF proxy rendering the force is a spring,
-    /// k × depth (see [`crate::haptics::Haptics::hard_above_n_per_m`]).
+    /// k × depth (see [`crate::bench::Bench::hard_above_n_per_m`]).
     pub fn judging_springs(mut self, threshold: Option<f32>) -> Self {
         self.hard_above_n_per_m = threshold;
         self

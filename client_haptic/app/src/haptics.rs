@@ -1,33 +1,28 @@
-//! The haptic side of the Phantom client: the 1 kHz rig, the copy on the workbench as a sphere tree,
-//! and the loop's window rates.
+//! What a copy is to the hand: its Inner Sphere Tree (built, or loaded from the cache keyed by the
+//! mesh's content hash), its surface grid, its briefed material as a force component, and the stylus's
+//! gemstone and rendering for a device.
 //!
-//! You need this module to feel a copy. When a copy lands on the workbench its Inner Sphere Tree is
-//! built (or loaded from the cache, keyed by the mesh's content hash) on a worker thread, then handed
-//! to the collision thread with the copy's material; the haptic thread renders the paper's volumetric
-//! force (and torque on 6-DOF devices) against the stylus's gemstone. With volumetric rendering the copy
-//! also gets a signed distance grid of its surface, built on the same worker, so the gem's spheres are
-//! measured against the copy's real surface rather than its packing (collette's `overlap_field`: the
-//! overlap within about 1 % of the true one, no packing bumps under a smooth copy). Nothing here waits
-//! for the network or blocks the game thread: a build in progress is polled each frame.
+//! You need this module to change how a copy feels. The running client hands what it builds here to
+//! `bevy_haptics` ([`crate::bench`]); the lockstep rig the tests explore copies with takes the same
+//! ([`crate::touch_bench`]). With volumetric rendering a copy also gets a signed distance grid of its
+//! surface, so the gem's spheres are measured against the copy's real surface rather than its packing
+//! (collette's `overlap_field`: the overlap within about 1 % of the true one, no packing bumps under a
+//! smooth copy).
 
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::sync::mpsc::{Receiver, TryRecvError};
 
-use bevy::prelude::*;
+use bevy::prelude::Resource;
+use bevy_haptics::{ForceComponent, Ridges};
 use collette::{BuildOptions, InnerSphereTree, SignedDistanceGrid, TriMesh};
-use forcecomp::Material;
 use glam::Vec3;
 use haptic_common::Pose;
-use haptic_rig::{
-    ForceSample, HapticRig, ObjectSpec, ProxyRendering, Rendering, RigConfig, StepTiming, ToolSpec, WorkspaceMap,
-};
-use haptico::trace::TraceWriter;
-use haptico::{Device, DeviceSpecs, HapticEvents, TickTiming};
+use haptic_rig::{ProxyRendering, Rendering, RigConfig, ToolSpec, WorkspaceMap};
+use haptico::DeviceSpecs;
 use heist_shared::artifact::{self, HapticMesh};
-use heist_shared::protocol::{ItemId, WorkbenchCopy};
+use heist_shared::protocol::ItemId;
 
-use crate::device::{self, DeviceChoice, HandControl};
+use crate::device::DeviceChoice;
 use crate::error::ClientError;
 
 /// Diameter of the stylus's gemstone, m (a fine tip: the idol's notches are 16 mm wide).
@@ -36,10 +31,8 @@ pub const TOOL_DIAMETER_M: f32 = 0.006;
 pub const REFERENCE_DEPTH_M: f32 = 0.002;
 /// The gem's sphere count.
 const TOOL_SPHERES: usize = 200;
-/// Id of the copy on the collision thread.
+/// Id of the copy on the lockstep rig's collision thread.
 pub(crate) const COPY_OBJECT: u32 = 1;
-/// Length of a rate window, µs.
-const WINDOW_US: u64 = 1_000_000;
 
 /// The stiffest material a copy can have, N/m (`artifact::MaterialClass`: hard 800, soft 300, within
 /// 200–1000): a 3-DOF device that cannot render it gets every copy's stiffness scaled down by the same
@@ -131,7 +124,8 @@ pub struct RateWindow {
 }
 
 /// What the worker sends back for a copy, or why it could not.
-pub(crate) struct BuiltCopy {
+pub struct BuiltCopy {
+    /// The copy's tree.
     pub tree: InnerSphereTree,
     /// Whether the tree came from the cache.
     pub cached: bool,
@@ -140,237 +134,18 @@ pub(crate) struct BuiltCopy {
 }
 
 /// What the worker sends back: the copy built, or why not.
-pub(crate) type Built = Result<BuiltCopy, String>;
+pub type Built = Result<BuiltCopy, String>;
 
 /// Builds (or loads) the tree of `mesh`, and its surface grid when `with_surface`.
-pub(crate) fn build_copy(
-    mesh: &HapticMesh,
-    spheres: usize,
-    cache: Option<&std::path::Path>,
-    with_surface: bool,
-) -> Built {
+pub fn build_copy(mesh: &HapticMesh, spheres: usize, cache: Option<&std::path::Path>, with_surface: bool) -> Built {
     let (tree, cached) = build_tree(mesh, spheres, cache)?;
     let surface = with_surface.then(|| surface_grid(mesh, spheres)).transpose()?;
     Ok(BuiltCopy { tree, cached, surface })
 }
 
-/// The running rig and what it renders (a non-send resource: the device lives on the haptic thread, this
-/// is the game thread's handle).
-pub struct Haptics {
-    rig: HapticRig<Box<dyn Device>>,
-    /// Writes the recorded ticks (`--record`); declared after the rig, so that it is dropped after the
-    /// haptic thread stopped and writes every tick.
-    recording: Option<TraceWriter>,
-    /// Ticks the recording had lost when last told.
-    recording_lost: u64,
-    /// Moves the simulated hand (sim device only).
-    pub hand: Option<HandControl>,
-    /// The real device's link (watched by the client: [`device::Guide`]).
-    pub health: device::DeviceHealth,
-    /// The device's limits.
-    pub specs: DeviceSpecs,
-    /// How forces are rendered (the choice resolved for the device).
-    pub rendering: Rendering,
-    /// With proxy rendering: every copy's stiffness is scaled by this to fit the device (1 when the
-    /// device renders [`STIFFEST_COPY_N_PER_M`]).
-    pub stiffness_scale: f32,
-    /// Device frame to scene (the workbench frame).
-    pub map: WorkspaceMap,
-    /// The gem's packed volume [`REFERENCE_DEPTH_M`] deep in a flat face, m³ (see [`haptic_material`]).
-    pub tool_reference_volume_m3: f32,
-    building: Option<(ItemId, Receiver<Built>, Material)>,
-    /// The copy being felt.
-    pub on_bench: Option<OnBench>,
-    /// Force samples drained this frame (1 kHz; preallocated).
-    pub samples: Vec<ForceSample>,
-    ticks: Vec<TickTiming>,
-    steps: Vec<StepTiming>,
-    window: Option<(u64, u32, u32, bool)>,
-    /// Every complete rate window so far.
-    pub rates: Vec<RateWindow>,
-    settings: HapticsSettings,
-}
-
-impl Haptics {
-    /// Opens the device and starts the haptic and collision threads with the gemstone tool.
-    pub fn start(settings: HapticsSettings) -> Result<Self, ClientError> {
-        let specs = device::preset(settings.preset.as_deref())?;
-        let device::Opened { device, hand, health } = device::open(&settings.device, specs.clone())?;
-        let (device, recording): (Box<dyn Device>, _) = match &settings.record {
-            Some(path) => {
-                let (device, writer) = haptico::trace::record(device, path)
-                    .map_err(|e| ClientError::Device(format!("recording the device: {e}")))?;
-                (Box::new(device), Some(writer))
-            }
-            None => (device, None),
-        };
-        let specs = device.specs().clone();
-        let RigSetup { tool, config, rendering, stiffness_scale, map, tool_reference_volume_m3 } =
-            RigSetup::new(&specs, &settings, health.workspace(&specs))?;
-        let rig = HapticRig::start(device, tool, config, HapticEvents::default(), haptic_common::Delegator::new())?;
-        Ok(Self {
-            rig,
-            recording,
-            recording_lost: 0,
-            hand,
-            health,
-            specs,
-            rendering,
-            stiffness_scale,
-            map,
-            tool_reference_volume_m3,
-            building: None,
-            on_bench: None,
-            samples: Vec::with_capacity(1 << 14),
-            ticks: Vec::with_capacity(1 << 14),
-            steps: Vec::with_capacity(1 << 14),
-            window: None,
-            rates: Vec::new(),
-            settings,
-        })
-    }
-
-    /// What the device's link and the safety layer say now, for the [`device::Guide`].
-    pub fn device_reading(&self) -> device::Reading {
-        device::Reading { outside_workspace: self.telemetry().outside_workspace, ..self.health.reading() }
-    }
-
-    /// Microseconds on the haptic clock.
-    pub fn now_us(&self) -> u64 {
-        self.rig.clock().now_us()
-    }
-
-    /// The rig's latest state (device sample, output force, contacts).
-    pub fn telemetry(&self) -> haptic_rig::RigTelemetry {
-        self.rig.telemetry()
-    }
-
-    /// Where the stylus's tip is now, in the scene (the workbench's) frame.
-    pub fn stylus(&self) -> Vec3 {
-        self.map.to_scene(&self.telemetry().device.pose).translation
-    }
-
-    /// Whether 6-DOF torques reach the device.
-    pub fn renders_torque(&self) -> bool {
-        self.specs.renders_torque() && self.rendering != Rendering::Proxy
-    }
-
-    /// With proxy rendering, the resting force over depth (N/m) above which a copy feels hard; `None`
-    /// with volumetric rendering (the touch bot then judges by force over depth²).
-    pub fn hard_above_n_per_m(&self) -> Option<f32> {
-        proxy_hard_above(self.rendering, self.stiffness_scale)
-    }
-
-    /// Starts building the tree of `copy` (replacing whatever was on the bench), and its surface grid
-    /// unless the proxy renders it (the proxy reads the tree's spheres alone).
-    pub fn place(&mut self, copy: &WorkbenchCopy) {
-        self.clear();
-        let (tx, rx) = std::sync::mpsc::channel();
-        let mesh = copy.mesh.clone();
-        let (spheres, cache) = (self.settings.spheres, self.settings.cache_dir.clone());
-        let with_surface = self.rendering != Rendering::Proxy;
-        let item = copy.item;
-        std::thread::Builder::new()
-            .name("ist-build".into())
-            .spawn(move || {
-                let _ = tx.send(build_copy(&mesh, spheres, cache.as_deref(), with_surface));
-            })
-            .map_or_else(|e| log::error!("could not start building copy {}: {e}", item.0), drop);
-        self.building = Some((copy.item, rx, haptic_material(&copy.material, self.tool_reference_volume_m3)));
-    }
-
-    /// Takes the copy off the bench.
-    pub fn clear(&mut self) {
-        self.building = None;
-        if self.on_bench.take().is_some() {
-            let _ = self.rig.remove_object(COPY_OBJECT);
-            self.rig.collect_garbage();
-        }
-    }
-
-    /// True while a copy's tree is being built.
-    pub fn building(&self) -> Option<ItemId> {
-        self.building.as_ref().map(|b| b.0)
-    }
-
-    /// Polls the build, drains the rig's rings and closes rate windows. Call once per frame.
-    pub fn poll(&mut self) -> Option<Result<OnBench, ClientError>> {
-        self.samples.clear();
-        self.rig.drain_force_samples(&mut self.samples);
-        self.drain_rates();
-        if let Some(writer) = &self.recording
-            && writer.dropped() > self.recording_lost
-        {
-            self.recording_lost = writer.dropped();
-            log::warn!(
-                "the trace {} has lost {} ticks: the disk is too slow",
-                writer.path().display(),
-                self.recording_lost
-            );
-        }
-        let (item, rx, material) = self.building.as_ref()?;
-        let (item, material) = (*item, *material);
-        let built = match rx.try_recv() {
-            Err(TryRecvError::Empty) => return None,
-            Err(TryRecvError::Disconnected) => Err("the build thread stopped".to_owned()),
-            Ok(r) => r,
-        };
-        self.building = None;
-        let result = built.and_then(|BuiltCopy { tree, cached, surface }| {
-            let spheres = tree.spheres().len();
-            let surface_bytes = surface.as_ref().map(SignedDistanceGrid::memory_bytes);
-            let object = ObjectSpec { id: COPY_OBJECT, tree: Arc::new(tree), pose: Pose::IDENTITY, material };
-            self.rig.add_object(object).map_err(|e| e.to_string())?;
-            if let Some(grid) = surface {
-                self.rig.set_surface(COPY_OBJECT, Some(Arc::new(grid))).map_err(|e| e.to_string())?;
-            }
-            Ok(OnBench { item, since_us: self.now_us(), spheres, cached, surface_bytes })
-        });
-        Some(match result {
-            Ok(on) => {
-                self.on_bench = Some(on.clone());
-                Ok(on)
-            }
-            Err(reason) => Err(ClientError::Copy { item: item.0 as u32, reason }),
-        })
-    }
-
-    fn drain_rates(&mut self) {
-        self.ticks.clear();
-        self.steps.clear();
-        self.rig.drain_haptic_timings(&mut self.ticks);
-        self.rig.drain_collision_timings(&mut self.steps);
-        let with_copy = self.on_bench.is_some();
-        for t in self.ticks.iter().map(|t| (t.start_us, true)).chain(self.steps.iter().map(|s| (s.start_us, false))) {
-            let w = self.window.get_or_insert((t.0 - t.0 % WINDOW_US, 0, 0, with_copy));
-            if t.0 >= w.0 + WINDOW_US {
-                let done = RateWindow { start_us: w.0, haptic_hz: w.1, collision_hz: w.2, with_copy: w.3 };
-                self.rates.push(done);
-                log::debug!(
-                    "haptic loop: {} Hz, collision {} Hz{}",
-                    done.haptic_hz,
-                    done.collision_hz,
-                    if done.with_copy { " (copy on the bench)" } else { "" }
-                );
-                *w = (t.0 - t.0 % WINDOW_US, 0, 0, with_copy);
-            }
-            if t.1 {
-                w.1 += 1
-            } else {
-                w.2 += 1
-            }
-            w.3 &= with_copy;
-        }
-    }
-
-    /// Stops both threads.
-    pub fn stop(self) {
-        self.rig.stop();
-    }
-}
-
-/// The gemstone tool and the rig's configuration for a device: what the threaded rig ([`Haptics`]) and
-/// the lockstep one ([`crate::touch_bench::LockstepHaptics`]) both start from.
+/// The gemstone tool and the rig's configuration for a device: what the running client's haptics
+/// ([`crate::bench::add_haptics`], through `bevy_haptics`) and the lockstep rig
+/// ([`crate::touch_bench::LockstepHaptics`]) both start from.
 pub(crate) struct RigSetup {
     /// The gemstone.
     pub tool: ToolSpec,
@@ -384,16 +159,14 @@ pub(crate) struct RigSetup {
     pub map: WorkspaceMap,
     /// The gem's packed volume [`REFERENCE_DEPTH_M`] deep in a flat face, m³.
     pub tool_reference_volume_m3: f32,
+    /// Whether the device renders torque.
+    pub device_torque: bool,
 }
 
 impl RigSetup {
-    /// The gemstone's tree, the rendering the settings choose for `specs`, the proxy's spring scaled to
-    /// the device, and `workspace` (where the grip must be read for forces to engage).
-    pub fn new(
-        specs: &DeviceSpecs,
-        settings: &HapticsSettings,
-        workspace: Option<forcecomp::Workspace>,
-    ) -> Result<Self, ClientError> {
+    /// The gemstone's tree, the rendering the settings choose for `specs` and the proxy's spring scaled
+    /// to the device.
+    pub fn new(specs: &DeviceSpecs, settings: &HapticsSettings) -> Result<Self, ClientError> {
         let gem = collette::scene::brilliant_cut(TOOL_DIAMETER_M);
         let (tree, _) = collette::build(&gem, &BuildOptions::spheres(TOOL_SPHERES), &mut |_| {})
             .map_err(|e| ClientError::Device(format!("building the gemstone's tree: {e}")))?;
@@ -401,10 +174,7 @@ impl RigSetup {
             immersed_volume(tree.spheres(), tree.weights(), glam::Vec3::X, REFERENCE_DEPTH_M);
         // The gem is far stiffer than any copy, and its friction is 1 so the copy's own coefficient decides
         // (see `haptic_material`).
-        let tool = ToolSpec::new(
-            Arc::new(tree),
-            Material { stiffness_n_per_m3: 1e12, damping_ns_per_m: 1e6, friction: 1.0, texture: None },
-        );
+        let tool = ToolSpec::new(Arc::new(tree), ForceComponent::rigid_tool().material());
         let scale = if specs.workspace_radius_m > 0.0 { (0.08 / specs.workspace_radius_m).max(1.0) } else { 1.0 };
         let map = WorkspaceMap { origin: Pose::IDENTITY, scale };
         let rendering = match settings.rendering {
@@ -419,10 +189,11 @@ impl RigSetup {
             volume_per_depth_m2: tool_reference_volume_m3 / REFERENCE_DEPTH_M * stiffness_scale,
             ..ProxyRendering::default()
         };
-        let mut config = RigConfig { map, rendering, proxy, workspace, ..RigConfig::default() };
+        let mut config = RigConfig { map, rendering, proxy, ..RigConfig::default() };
         config.haptic.realtime_priority = settings.realtime_priority;
         config.collision.realtime_priority = settings.realtime_priority.map(|p| (p - 1).max(1));
-        Ok(Self { tool, config, rendering, stiffness_scale, map, tool_reference_volume_m3 })
+        let device_torque = specs.renders_torque();
+        Ok(Self { tool, config, rendering, stiffness_scale, map, tool_reference_volume_m3, device_torque })
     }
 }
 
@@ -431,12 +202,17 @@ impl RigSetup {
 /// packed face, where its weighted volume is `tool_volume_m3` (see [`immersed_volume`]). Friction is
 /// squared because contact friction is the geometric mean with the gem's (1). Ridges become a texture
 /// repeating up the copy (+Y), their depth read with the briefed stiffness.
-pub fn haptic_material(m: &artifact::Material, tool_volume_m3: f32) -> Material {
-    Material {
+pub fn haptic_material(m: &artifact::Material, tool_volume_m3: f32) -> ForceComponent {
+    ForceComponent {
         stiffness_n_per_m3: m.stiffness_n_per_m * REFERENCE_DEPTH_M / tool_volume_m3.max(1e-12),
         damping_ns_per_m: m.damping,
         friction: m.friction * m.friction,
-        texture: m.ridges.map(|r| forcecomp::Texture::ribs(r.spacing_m, r.depth_m, m.stiffness_n_per_m)),
+        ridges: m.ridges.map(|r| Ridges {
+            spacing_m: r.spacing_m,
+            depth_m: r.depth_m,
+            stiffness_n_per_m: m.stiffness_n_per_m,
+        }),
+        force_scale: 1.0,
     }
 }
 
@@ -541,18 +317,17 @@ mod tests {
                 .abs()
                 < 1e-4
         );
-        let m = haptic_material(&MaterialClass::HardRough.material(), cap);
+        let m = haptic_material(&MaterialClass::HardRough.material(), cap).material();
         let force = m.stiffness_n_per_m3 * cap;
         assert!((force / (800.0 * d) - 1.0).abs() < 1e-4, "{force} N at {d} m");
-        let soft = haptic_material(&MaterialClass::SoftRough.material(), cap);
+        let soft = haptic_material(&MaterialClass::SoftRough.material(), cap).material();
         assert!((m.stiffness_n_per_m3 / soft.stiffness_n_per_m3 - 800.0 / 300.0).abs() < 1e-3);
-        let contact =
-            m.combine(&Material { stiffness_n_per_m3: 1e12, damping_ns_per_m: 1e6, friction: 1.0, texture: None });
+        let contact = m.combine(&ForceComponent::rigid_tool().material());
         assert!((contact.friction - 0.6).abs() < 1e-4);
         // The rough copy's ridges reach the contact, read with its briefed stiffness; a smooth copy has none.
         let ridges = contact.texture.expect("a rough copy is ribbed");
         assert_eq!((ridges.spacing, ridges.amplitude, ridges.stiffness, ridges.axis), (0.003, 0.0003, 800.0, Vec3::Y));
-        assert!(haptic_material(&MaterialClass::HardSmooth.material(), cap).texture.is_none());
+        assert!(haptic_material(&MaterialClass::HardSmooth.material(), cap).ridges.is_none());
     }
 
     #[test]

@@ -1,13 +1,14 @@
 //! The Phantom client: join a heist as the blind player and play by touch and sound alone.
 //!
-//! The tree: [`device`] (which device, the steerable simulated hand), [`haptics`] (the 1 kHz rig and the
-//! copy on the workbench as a sphere tree), [`explore`] (the touch bot), [`touch_bench`] (where it feels a copy: the running loop or the same loop in
+//! The tree: [`device`] (which device, the steerable simulated hand), [`haptics`] (what a copy is to
+//! the hand: its sphere tree and material), [`bench`] (the copy on the workbench, on `bevy_haptics`), [`explore`] (the touch bot), [`touch_bench`] (where it feels a copy: the running loop or the same loop in
 //! lockstep), [`audio`] (kira, binaural voices,
 //! synthesized sounds), [`speech`] (espeak-ng), [`status`] (the sentences), [`client`] (the Bevy app that
 //! ties them to the session), [`cli`] (the command line) and, with the `spectator` feature, [`spectator`]
 //! (a window for sighted onlookers).
 #![warn(missing_docs)]
 
+pub mod bench;
 pub mod cli;
 pub mod client;
 pub mod device;

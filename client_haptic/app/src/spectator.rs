@@ -1,8 +1,10 @@
 //! The optional spectator window for sighted onlookers: the copy on the workbench, the stylus's
-//! gemstone where the haptic loop has it, and the contact force as an arrow.
+//! gemstone where the haptic loop has it, and the force on the device as an arrow.
 //!
 //! You need this module only with a window (feature `spectator`, no `--headless`). It reads what the
-//! rest of the client already has ([`BenchView`], the rig's telemetry) and never feeds back into play.
+//! rest of the client already has ([`BenchView`]; the gemstone is `bevy_haptics`' tool entity, which
+//! follows the device by itself) and draws the force with `bevy_haptics`' debug plugin; it never feeds
+//! back into play.
 //! [`ShotRequest`] saves one screenshot and quits (used for the README's picture and its test).
 
 use std::path::PathBuf;
@@ -14,11 +16,10 @@ use bevy::render::RenderPlugin;
 use bevy::render::view::screenshot::{Screenshot, save_to_disk};
 use bevy::window::{PresentMode, WindowResolution};
 
-use crate::client::BenchView;
-use crate::haptics::{Haptics, TOOL_DIAMETER_M};
+use bevy_haptics::{HapticTool, HapticsDebugConfig, HapticsDebugPlugin};
 
-/// Centimetres of arrow per newton of contact force, in metres.
-const ARROW_M_PER_N: f32 = 0.02;
+use crate::client::BenchView;
+use crate::haptics::TOOL_DIAMETER_M;
 
 /// Adds Bevy's default plugins with a small window and synchronous pipeline compilation (so the first
 /// frames are not black on software renderers such as lavapipe).
@@ -53,18 +54,24 @@ pub struct SpectatorPlugin;
 #[derive(Component)]
 struct CopyMesh(u16);
 
-#[derive(Component)]
-struct Gem;
-
 impl Plugin for SpectatorPlugin {
     fn build(&self, app: &mut App) {
+        // The force on the device as an arrow from the gem, 2 cm a newton; no sphere trees.
+        let debug = HapticsDebugConfig { tree_depth: None, metres_per_newton: 0.02, ..default() };
         app.insert_resource(ClearColor(Color::srgb(0.05, 0.06, 0.09)))
+            .add_plugins(HapticsDebugPlugin)
+            .insert_resource(debug)
             .add_systems(Startup, setup)
-            .add_systems(Update, (show_copy, move_gem, draw_force, take_shot));
+            .add_systems(Update, (show_copy, take_shot));
     }
 }
 
-fn setup(mut commands: Commands, mut meshes: ResMut<Assets<Mesh>>, mut materials: ResMut<Assets<StandardMaterial>>) {
+fn setup(
+    mut commands: Commands,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+    tools: Query<Entity, With<HapticTool>>,
+) {
     commands.spawn((
         Camera3d::default(),
         Transform::from_xyz(0.16, 0.14, 0.26).looking_at(Vec3::new(0.0, -0.01, 0.0), Vec3::Y),
@@ -89,8 +96,8 @@ fn setup(mut commands: Commands, mut meshes: ResMut<Assets<Mesh>>, mut materials
         })),
         Transform::from_xyz(0.0, -0.071, 0.0),
     ));
-    commands.spawn((
-        Gem,
+    // The gemstone: the haptic tool's entity, which follows the device.
+    let gem = (
         Mesh3d(meshes.add(
             Sphere::new(TOOL_DIAMETER_M / 2.0).mesh().ico(3).unwrap_or_else(|_| Sphere::new(0.003).mesh().uv(16, 8)),
         )),
@@ -99,8 +106,10 @@ fn setup(mut commands: Commands, mut meshes: ResMut<Assets<Mesh>>, mut materials
             emissive: LinearRgba::rgb(0.3, 0.6, 0.9),
             ..default()
         })),
-        Transform::from_xyz(0.0, 0.06, 0.07),
-    ));
+    );
+    for tool in &tools {
+        commands.entity(tool).insert(gem.clone());
+    }
 }
 
 /// Shows the copy on the bench (replacing the previous one).
@@ -140,24 +149,6 @@ fn show_copy(
         })),
         Transform::IDENTITY,
     ));
-}
-
-/// Puts the gemstone where the haptic loop has the simulated tool.
-fn move_gem(haptics: NonSend<Haptics>, mut gem: Query<&mut Transform, With<Gem>>) {
-    let pose = haptics.telemetry().tool_pose;
-    for mut t in &mut gem {
-        t.translation = pose.translation;
-        t.rotation = pose.rotation;
-    }
-}
-
-/// Draws the contact force on the tool as an arrow from the gem.
-fn draw_force(haptics: NonSend<Haptics>, mut gizmos: Gizmos) {
-    let Some(s) = haptics.samples.last() else { return };
-    let f = s.contact_force;
-    if f.length() > 0.02 {
-        gizmos.arrow(s.tool_position, s.tool_position + f * ARROW_M_PER_N, Color::srgb(1.0, 0.3, 0.2));
-    }
 }
 
 /// Counts frames once a copy is on the bench, then saves the screenshot and quits.

@@ -15,7 +15,6 @@ use heist_voice::{HeardVoice, Talk};
 
 use crate::audio::synth::{self, Earcon};
 use crate::audio::{AudioEngine, listener_offset};
-use crate::haptics::Haptics;
 use crate::settings::plugin::Settings;
 use crate::speech::Speaker;
 
@@ -42,12 +41,12 @@ fn push_to_talk(
     keys: Option<Res<ButtonInput<KeyCode>>>,
     terminal: Option<Res<crate::terminal::TerminalInput>>,
     settings: Res<Settings>,
-    haptics: NonSend<Haptics>,
+    frame: Res<bevy_haptics::HapticFrame>,
     mut talk: ResMut<Talk>,
 ) {
     let key = keys.is_some_and(|k| k.pressed(settings.run.talk_key.key_code())) && !settings.is_open();
     let typed = terminal.is_some_and(|t| t.talking);
-    let button = haptics.telemetry().device.buttons.0 & TALK_BUTTON != 0;
+    let button = frame.pressed(TALK_BUTTON);
     let down = key || typed || button;
     if talk.down != down {
         talk.down = down;

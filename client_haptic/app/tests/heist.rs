@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use bevy::prelude::*;
 use client_haptic::audio::{AudioOutput, AudioSettings};
-use client_haptic::haptics::Haptics;
+use client_haptic::bench::LoopRates;
 use client_haptic::{PhantomSettings, PhantomState};
 use heist_bots::{ViveBotPlugin, ViveStyle};
 use heist_server::demo::join;
@@ -86,8 +86,7 @@ fn the_server_a_vive_bot_and_the_touch_bot_win_a_heist_over_loopback_udp() {
             v.findings.as_ref().map(|f| f.describe())
         );
     }
-    let haptics = phantom.world().non_send::<Haptics>();
-    let felt: Vec<_> = haptics.rates.iter().filter(|w| w.with_copy).collect();
+    let felt: Vec<_> = phantom.world().resource::<LoopRates>().rates.iter().filter(|w| w.with_copy).collect();
     let min = |f: fn(&&client_haptic::haptics::RateWindow) -> u32| felt.iter().map(f).min().unwrap_or(0);
     println!(
         "haptic loop while a copy was on the bench: {} one-second windows, haptic min {} Hz, collision min {} Hz",

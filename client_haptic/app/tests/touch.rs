@@ -7,17 +7,16 @@
 //!   renderings. What these check is the judging — the rig's forces and the bot's thresholds — not the
 //!   haptic clock, so the rig is stepped tick by tick on the test's thread, as fast as the machine computes
 //!   it, and every run feels the same.
-//! - **Real time** ([`Haptics`]: the haptic and collision threads at 1 kHz, the collision step budgeted,
+//! - **Real time** ([`RealTimeHaptics`]: the client's `bevy_haptics` set-up, the haptic and collision threads at 1 kHz, the collision step budgeted,
 //!   the hand steered across threads): one copy through each rendering, so the loop the player feels is
 //!   still explored for real, with its latencies between the threads. These need the machine to
 //!   themselves; the lockstep tests beside them would only slow them.
 
 use std::sync::RwLock;
-use std::time::Duration;
 
 use client_haptic::explore::feel;
-use client_haptic::haptics::{Haptics, HapticsSettings, RenderingChoice};
-use client_haptic::touch_bench::{LockstepHaptics, TouchBench};
+use client_haptic::haptics::{HapticsSettings, RenderingChoice};
+use client_haptic::touch_bench::{LockstepHaptics, RealTimeHaptics, TouchBench};
 use haptic_rig::Rendering;
 use heist_shared::artifact::{ArtifactKind, CopyTraits, build_mesh, generate_copies};
 use heist_shared::protocol::{ItemId, WorkbenchCopy};
@@ -72,14 +71,13 @@ fn every_copy_is_told_right_in_lockstep(rendering: RenderingChoice, expect: Rend
 
 fn a_copy_is_told_right_in_real_time(rendering: RenderingChoice, expect: Rendering, kind: ArtifactKind) {
     let _alone = MACHINE.write().unwrap_or_else(|p| p.into_inner());
-    let mut h =
-        Haptics::start(HapticsSettings { rendering, ..HapticsSettings::default() }).expect("the haptic loop starts");
-    assert_eq!(h.rendering, expect);
-    std::thread::sleep(Duration::from_millis(2500)); // the safety layer ramps forces in
+    let mut h = RealTimeHaptics::start(HapticsSettings { rendering, ..HapticsSettings::default() })
+        .expect("the haptic loop starts");
+    assert_eq!(h.bench().rendering, expect);
     let copy = every_copy().into_iter().find(|c| c.0 == kind).expect("a copy of the kind");
     let wrong = misjudged(&mut h, &[copy]);
     // The real loop ran: the copy was felt on the haptic thread's clock, with the collision thread's steps.
-    let with_copy = h.rates.iter().filter(|w| w.with_copy).count();
+    let with_copy = h.rates().iter().filter(|w| w.with_copy).count();
     h.stop();
     assert!(with_copy > 0, "no whole second of the loop with the copy on the bench");
     assert!(wrong.is_empty(), "misjudged: {wrong:?}");
@@ -111,15 +109,10 @@ fn a_copy_gets_its_surface_grid_with_volumetric_rendering_and_none_through_the_p
     let (copies, _) = generate_copies(ArtifactKind::Idol, 3, 3);
     let copy = copy_of(&copies[0], 3, 1);
     for (rendering, with_surface) in [(RenderingChoice::Volumetric, true), (RenderingChoice::Proxy, false)] {
-        let mut h = Haptics::start(HapticsSettings { rendering, ..HapticsSettings::default() }).expect("starts");
-        h.place(&copy);
-        let on = (0..600)
-            .find_map(|_| {
-                std::thread::sleep(Duration::from_millis(50));
-                h.poll()
-            })
-            .expect("the copy reaches the bench within 30 s")
-            .expect("the copy is built");
+        let mut h =
+            RealTimeHaptics::start(HapticsSettings { rendering, ..HapticsSettings::default() }).expect("starts");
+        h.place_and_wait(&copy).expect("the copy is built");
+        let on = h.bench().on_bench.clone().expect("the copy is on the bench");
         h.stop();
         assert_eq!(on.surface_bytes.is_some(), with_surface, "{rendering:?}: {on:?}");
         // An idol of about 9 cm at 100 voxels along its longest side: a few megabytes.

@@ -18,6 +18,7 @@ use crate::tree::SphereTree;
 /// loaded) the tool is a ball of `tip_radius_m`.
 #[derive(Component, Reflect, Clone, Debug, PartialEq)]
 #[reflect(Component, Default)]
+#[type_path = "bevy_haptics"]
 #[require(Transform)]
 pub struct HapticTool {
     /// The tool's sphere tree (`None`: a ball).
@@ -51,6 +52,7 @@ impl HapticTool {
 /// [`ForceComponent::default`]).
 #[derive(Component, Reflect, Clone, Debug, Default, PartialEq)]
 #[reflect(Component, Default)]
+#[type_path = "bevy_haptics"]
 #[require(Transform)]
 pub struct HapticCollider {
     /// The object's sphere tree.
@@ -67,6 +69,7 @@ impl HapticCollider {
 /// Ridges across a surface, felt as the tool slides over them.
 #[derive(Reflect, Clone, Copy, Debug, PartialEq)]
 #[reflect(Default)]
+#[type_path = "bevy_haptics"]
 pub struct Ridges {
     /// Distance between ridges, m.
     pub spacing_m: f32,
@@ -87,6 +90,7 @@ impl Default for Ridges {
 /// damping in series, friction as the geometric mean).
 #[derive(Component, Reflect, Clone, Copy, Debug, PartialEq)]
 #[reflect(Component, Default)]
+#[type_path = "bevy_haptics"]
 pub struct ForceComponent {
     /// Force per overlap volume, N/m³ (default 3e6: 1 N at 0.33 cm³).
     pub stiffness_n_per_m3: f32,
@@ -137,6 +141,7 @@ impl ForceComponent {
 /// (axis-aligned in the world). Without one, collisions are checked everywhere. One per app.
 #[derive(Component, Reflect, Clone, Copy, Debug, PartialEq)]
 #[reflect(Component, Default)]
+#[type_path = "bevy_haptics"]
 #[require(Transform)]
 pub struct CollisionVolume {
     /// Half the box's size along each world axis, m.

@@ -18,6 +18,7 @@ use crate::tree::SphereTree;
 /// What the debug gizmos draw.
 #[derive(Resource, Reflect, Clone, Copy, Debug, PartialEq)]
 #[reflect(Resource, Default)]
+#[type_path = "bevy_haptics"]
 pub struct HapticsDebugConfig {
     /// Depth at which trees are drawn: 0 is each tree's root sphere, deeper levels their children, the
     /// leaves' inner spheres below the last level (default 2; `None`: no trees).
@@ -119,7 +120,7 @@ fn draw_trees(
             continue;
         };
         let Some(tree) = trees.get(handle) else { continue };
-        let spheres = levels.0.entry((handle.id(), depth)).or_insert_with(|| spheres_at_depth(&tree.0, depth));
+        let spheres = levels.0.entry((handle.id(), depth)).or_insert_with(|| spheres_at_depth(&tree.tree, depth));
         let (_, rotation, translation) = transform.to_scale_rotation_translation();
         for s in spheres.iter() {
             let at = Isometry3d::new(translation + rotation * s.center, rotation);
@@ -150,7 +151,7 @@ mod tests {
 
     #[test]
     fn a_trees_levels_cover_it_from_the_root_down_to_its_inner_spheres() {
-        let tree = SphereTree::gem(0.02, 300).expect("a gem packs").0;
+        let tree = SphereTree::gem(0.02, 300).expect("a gem packs").tree;
         let root = spheres_at_depth(&tree, 0);
         assert_eq!(root.len(), 1);
         let deep = spheres_at_depth(&tree, 64);

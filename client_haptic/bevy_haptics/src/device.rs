@@ -5,6 +5,7 @@
 //! a simulated Phantom Desktop), by name (`sim`, `trace:FILE`, `hid[:PATH]`, `falcon[:FIRMWARE]`,
 //! `haply[:URL]`: haptico's [`DeviceChoice`]) or as any [`Device`] you opened yourself.
 
+use std::path::PathBuf;
 use std::sync::Mutex;
 
 use bevy::prelude::*;
@@ -27,6 +28,10 @@ pub struct HapticDevice {
     /// Real-time FIFO priority for the haptic thread (the collision thread gets one less), 1..=99
     /// (default none: needs the right to use it).
     pub realtime_priority: Option<i32>,
+    /// Record every tick (the device's state and the force sent) to this trace file, to replay later
+    /// with `HapticDevice::named("trace:FILE")` (default none). A file that cannot be written leaves
+    /// [`HapticStatus::Failed`](crate::HapticStatus::Failed) saying why.
+    pub record: Option<PathBuf>,
 }
 
 impl Default for HapticDevice {
@@ -37,6 +42,7 @@ impl Default for HapticDevice {
             scale: 1.0,
             rate_hz: 1000.0,
             realtime_priority: None,
+            record: None,
         }
     }
 }
@@ -60,7 +66,14 @@ impl HapticDevice {
 
     /// Any device opened with haptico (a Falcon, an Inverse3, a HID device, your own [`Device`]).
     pub fn custom(device: Box<dyn Device>) -> Self {
-        Self { kind: DeviceKind::Custom(Mutex::new(Some(device))), ..Self::default() }
+        Self::opened(haptico::choice::Opened { device, hand: None, link: DeviceLink::Local })
+    }
+
+    /// A device you opened with [`haptico::choice::open`] (to know its limits before the app starts, or
+    /// to report a device that cannot be opened your own way), with its simulated hand (which becomes
+    /// the [`SimulatedHand`]) and its link (which becomes the [`HapticDeviceLink`]).
+    pub fn opened(opened: haptico::choice::Opened) -> Self {
+        Self { kind: DeviceKind::Opened(Mutex::new(Some(opened))), ..Self::default() }
     }
 
     /// The device frame to world map the rig uses.
@@ -84,7 +97,7 @@ pub enum DeviceKind {
         start: Vec3,
     },
     /// A device you opened (taken when the app starts).
-    Custom(Mutex<Option<Box<dyn Device>>>),
+    Opened(Mutex<Option<haptico::choice::Opened>>),
 }
 
 impl DeviceKind {
@@ -99,7 +112,7 @@ impl std::fmt::Debug for DeviceKind {
             Self::Named { choice, preset, start } => {
                 f.debug_struct("Named").field("choice", choice).field("preset", preset).field("start", start).finish()
             }
-            Self::Custom(_) => f.write_str("Custom"),
+            Self::Opened(_) => f.write_str("Opened"),
         }
     }
 }
@@ -120,8 +133,8 @@ pub enum DeviceError {
     /// haptico could not open it.
     #[error(transparent)]
     Open(#[from] haptico::OpenError),
-    /// A custom device was already taken by an earlier start.
-    #[error("the custom device was already used")]
+    /// A device opened beforehand was already taken by an earlier start.
+    #[error("the device opened beforehand was already used")]
     Taken,
 }
 
@@ -136,10 +149,7 @@ impl DeviceKind {
     pub(crate) fn open(&self) -> Result<haptico::choice::Opened, DeviceError> {
         match self {
             Self::Named { choice, preset: name, start } => Ok(haptico::choice::open(choice, preset(name)?, *start)?),
-            Self::Custom(device) => {
-                let device = device.lock().unwrap_or_else(|p| p.into_inner()).take().ok_or(DeviceError::Taken)?;
-                Ok(haptico::choice::Opened { device, hand: None, link: DeviceLink::Local })
-            }
+            Self::Opened(opened) => opened.lock().unwrap_or_else(|p| p.into_inner()).take().ok_or(DeviceError::Taken),
         }
     }
 }
@@ -149,7 +159,7 @@ impl DeviceKind {
 #[derive(Resource, Clone, Debug)]
 pub struct HapticDeviceLink(pub DeviceLink);
 
-/// The simulated device's hand (present while a [`DeviceKind::Simulated`] device runs): where it
+/// The simulated device's hand (present while a simulated device, `sim`, runs): where it
 /// wants the stylus, sampled by the haptic thread at every tick (device frame). Keys, a mouse, a bot or
 /// a scripted path set it; the forces the device renders push back on it like on a hand.
 #[derive(Resource)]

@@ -28,6 +28,7 @@ pub const MAX_EFFECTS: usize = 32;
 /// out linearly over the outer fifth of the radius, so crossing the edge never kicks the hand.
 #[derive(Component, Reflect, Clone, Copy, Debug, PartialEq)]
 #[reflect(Component, Default)]
+#[type_path = "bevy_haptics"]
 #[require(Transform)]
 pub struct HapticEffect {
     /// What force.
@@ -45,6 +46,7 @@ impl Default for HapticEffect {
 /// The kinds of effect (world frame; the entity's `GlobalTransform` places them).
 #[derive(Reflect, Clone, Copy, Debug, PartialEq)]
 #[reflect(Default)]
+#[type_path = "bevy_haptics"]
 pub enum EffectKind {
     /// Pulls the tool to the entity's position: `stiffness` × distance, minus `damping` × velocity.
     Spring {
@@ -227,7 +229,7 @@ pub(crate) fn sync_effects(
             break;
         }
         let (_, rotation, position) = transform.to_scale_rotation_translation();
-        let tree = collider.zip(trees.as_ref()).and_then(|(c, trees)| trees.get(&c.tree)).map(|t| Arc::clone(&t.0));
+        let tree = collider.zip(trees.as_ref()).and_then(|(c, trees)| trees.get(&c.tree)).map(|t| Arc::clone(&t.tree));
         *incomplete |= matches!(effect.kind, EffectKind::Magnetic { .. }) && tree.is_none();
         set.effects[set.len] = Placed { effect: Some(*effect), position, rotation, tree };
         set.len += 1;
@@ -284,7 +286,7 @@ mod tests {
 
     #[test]
     fn a_magnet_pulls_towards_the_surface_within_its_reach() {
-        let tree = SphereTree::ball(0.01).0;
+        let tree = SphereTree::ball(0.01).tree;
         let magnet =
             Placed { tree: Some(tree), ..placed(EffectKind::Magnetic { strength_n: 2.0, reach_m: 0.02 }, 0.0) };
         // 5 mm from the ball's surface, on its +X side: pulled towards −X with 3/4 of the strength.

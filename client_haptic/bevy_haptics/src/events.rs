@@ -62,6 +62,7 @@ pub struct ContactEnded {
 
 /// A contact as the latest haptic tick saw it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Reflect)]
+#[type_path = "bevy_haptics"]
 pub struct ContactData {
     /// Overlapping sphere pairs (volumetric rendering) or the object's spheres near the tip (3-DOF proxy).
     pub pairs: u32,

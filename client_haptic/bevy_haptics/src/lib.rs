@@ -7,10 +7,12 @@ pub mod debug;
 mod device;
 mod effects;
 mod events;
+mod frame;
 mod mesh_build;
 mod plugins;
 mod runtime;
 mod settings;
+mod source;
 mod stats;
 mod tree;
 
@@ -20,10 +22,12 @@ pub use debug::{HapticsDebugConfig, HapticsDebugPlugin};
 pub use device::{DeviceError, DeviceKind, HapticDevice, HapticDeviceLink, SimulatedHand};
 pub use effects::{EffectKind, HapticEffect, MAX_EFFECTS};
 pub use events::{ContactData, ContactEnded, ContactOngoing, ContactStarted, ToolMoved};
+pub use frame::HapticFrame;
 pub use mesh_build::SphereTreeFromMesh;
 pub use plugins::{CollettePlugin, ForceCompPlugin, HapticoPlugin, HapticsPlugins, HapticsSystems};
 pub use runtime::{HapticDelegates, HapticStatus};
 pub use settings::{CollisionSettings, ForceRendering, RenderingMode};
+pub use source::SphereTreeSource;
 pub use stats::{HapticStats, WINDOW_US, WindowedRate};
 pub use tree::{SphereTree, SphereTreeError, SphereTreeLoader, SphereTreeSettings, tri_mesh};
 
@@ -37,9 +41,9 @@ pub mod libs {
 pub mod prelude {
     pub use crate::{
         CollettePlugin, CollisionVolume, ContactEnded, ContactOngoing, ContactStarted, EffectKind, ForceCompPlugin,
-        ForceComponent, HapticCollider, HapticDelegates, HapticDevice, HapticEffect, HapticStats, HapticStatus,
-        HapticTool, HapticoPlugin, HapticsPlugins, HapticsSystems, RenderingMode, SimulatedHand, SphereTree,
-        SphereTreeFromMesh, SphereTreeSettings, ToolMoved,
+        ForceComponent, HapticCollider, HapticDelegates, HapticDevice, HapticEffect, HapticFrame, HapticStats,
+        HapticStatus, HapticTool, HapticoPlugin, HapticsPlugins, HapticsSystems, RenderingMode, SimulatedHand,
+        SphereTree, SphereTreeFromMesh, SphereTreeSettings, SphereTreeSource, ToolMoved,
     };
     pub use haptic_common::{ForceOnHapticTick, ForceTorque};
     pub use haptico::steer::HandGoal;

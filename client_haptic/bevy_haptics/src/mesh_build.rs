@@ -16,6 +16,7 @@ use crate::tree::{SphereTree, SphereTreeError, tri_mesh};
 /// avian's `ColliderConstructor`: put it beside a mesh, on a glTF node or in a scene file.
 #[derive(Component, Reflect, Clone, Copy, Debug, PartialEq)]
 #[reflect(Component, Default)]
+#[type_path = "bevy_haptics"]
 pub struct SphereTreeFromMesh {
     /// Spheres to pack (default 2,000).
     pub spheres: usize,

@@ -10,6 +10,7 @@
 //!   delegates push the device.
 
 use bevy::app::PluginGroupBuilder;
+use bevy::asset::ReflectHandle;
 use bevy::prelude::*;
 use haptic_rig::ProxyRendering;
 
@@ -17,9 +18,11 @@ use crate::components::{CollisionVolume, ForceComponent, HapticCollider, HapticT
 use crate::device::HapticDevice;
 use crate::effects::{self, EffectKind, HapticEffect};
 use crate::events::{ContactData, ContactEnded, ContactOngoing, ContactStarted, ToolMoved};
+use crate::frame::HapticFrame;
 use crate::mesh_build::{self, SphereTreeFromMesh};
 use crate::runtime::{self, HapticDelegates, HapticStatus};
 use crate::settings::{CollisionSettings, ForceRendering, RenderingMode};
+use crate::source::{self, SphereTreeSource};
 use crate::stats::HapticStats;
 use crate::tree::{SphereTree, SphereTreeLoader};
 
@@ -63,6 +66,7 @@ impl Plugin for HapticoPlugin {
         app.init_resource::<HapticDelegates>()
             .init_resource::<HapticStatus>()
             .init_resource::<HapticStats>()
+            .init_resource::<HapticFrame>()
             .register_type::<HapticTool>()
             .register_type::<ForceComponent>()
             .register_type::<Ridges>()
@@ -73,7 +77,10 @@ impl Plugin for HapticoPlugin {
             .configure_sets(PostUpdate, HapticsSystems::Write.after(TransformSystems::Propagate))
             .add_systems(PostStartup, runtime::start)
             .add_systems(PostUpdate, effects::sync_effects.in_set(HapticsSystems::Write))
-            .add_systems(PreUpdate, (runtime::gather_stats, runtime::follow_device).in_set(HapticsSystems::Read))
+            .add_systems(
+                PreUpdate,
+                (runtime::read_threads, runtime::follow_device).chain().in_set(HapticsSystems::Read),
+            )
             .add_systems(Last, runtime::stop_on_exit);
     }
 }
@@ -95,6 +102,9 @@ impl Plugin for CollettePlugin {
             .register_type::<HapticCollider>()
             .register_type::<CollisionVolume>()
             .register_type::<SphereTreeFromMesh>()
+            .register_type::<SphereTreeSource>()
+            // A `Handle<SphereTree>` in a scene file (`tree: Path("trees/box.ist")`) loads that file.
+            .register_type_data::<Handle<SphereTree>, ReflectHandle>()
             .register_type::<ContactData>()
             .add_message::<ContactStarted>()
             .add_message::<ContactOngoing>()
@@ -104,6 +114,7 @@ impl Plugin for CollettePlugin {
             .add_systems(
                 PostUpdate,
                 (
+                    source::load_sources.before(runtime::sync_tool).before(runtime::send_colliders),
                     runtime::sync_tool,
                     (runtime::forget_colliders, runtime::send_colliders, runtime::move_colliders).chain(),
                     runtime::sync_volume,

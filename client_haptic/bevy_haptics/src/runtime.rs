@@ -13,12 +13,14 @@ use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use forcecomp::SafetyLayer;
 use haptic_common::{ForceOnHapticTick, Pose};
-use haptic_rig::{ForceSample, HapticRig, ObjectSpec, Rendering, RigConfig, StepTiming, ToolSpec};
-use haptico::{Device, DeviceSpecs, HapticClock, HapticEvents, HapticHandle, TickTiming};
+use haptic_rig::{ForceSample, HapticRig, ObjectSpec, Rendering, RigConfig, ToolSpec};
+use haptico::trace::TraceWriter;
+use haptico::{Device, DeviceSpecs, HapticClock, HapticEvents, HapticHandle};
 
 use crate::components::{CollisionVolume, ForceComponent, HapticCollider, HapticTool};
 use crate::device::{HapticDevice, HapticDeviceLink, SimulatedHand};
 use crate::events::{ContactData, ContactEnded, ContactOngoing, ContactStarted, ToolMoved};
+use crate::frame::HapticFrame;
 use crate::settings::{CollisionSettings, ForceRendering};
 use crate::stats::HapticStats;
 use crate::tree::SphereTree;
@@ -95,9 +97,11 @@ enum Engine {
 pub(crate) struct HapticRuntime {
     engine: Mutex<Engine>,
     map: haptic_rig::WorkspaceMap,
-    ticks: Vec<TickTiming>,
-    steps: Vec<StepTiming>,
-    samples: Vec<ForceSample>,
+    /// Writes the recorded ticks ([`HapticDevice::record`]); declared after the engine, so that it is
+    /// dropped after the haptic thread stopped and writes every tick.
+    recording: Option<TraceWriter>,
+    /// Ticks the recording had lost when last told.
+    recording_lost: u64,
 }
 
 impl HapticRuntime {
@@ -140,7 +144,16 @@ fn try_start(world: &mut World) -> Result<HapticStatus, String> {
     let user = world.get_resource_mut::<HapticDelegates>().map(|mut d| d.take()).unwrap_or_default();
     let device = world.get_resource::<HapticDevice>().ok_or("no HapticDevice resource")?;
     let haptico::choice::Opened { device: opened, hand, link } = device.kind.open().map_err(|e| e.to_string())?;
+    let (opened, recording): (Box<dyn Device>, _) = match &device.record {
+        Some(path) => {
+            let (recorded, writer) =
+                haptico::trace::record(opened, path).map_err(|e| format!("recording the device: {e}"))?;
+            (Box::new(recorded), Some(writer))
+        }
+        None => (opened, None),
+    };
     let specs: DeviceSpecs = opened.specs().clone();
+    let workspace = workspace_of(&link, &specs);
     let map = device.map();
     // Your delegates, then the effects (the force stage and the safety layer come after both).
     let (effects, run_effects) = crate::effects::delegate(map);
@@ -157,15 +170,15 @@ fn try_start(world: &mut World) -> Result<HapticStatus, String> {
     let clock = HapticClock::new();
     let (engine, rendering, clock) = match collision {
         None => {
-            let (handle, samples) = start_device(opened, events, haptic, &specs, clock)?;
+            let (handle, samples) = start_device(opened, events, haptic, &specs, workspace, clock)?;
             let clock = handle.clock();
             (Engine::Device { handle, samples }, Rendering::Off, clock)
         }
         Some(CollisionSettings(mut collision)) => {
             collision.realtime_priority = device.realtime_priority.map(|p| (p - 1).max(1));
             let (rendering, proxy) = rendering.unwrap_or((Rendering::Off, Default::default()));
-            let config = RigConfig { haptic, collision, map, rendering, proxy, ..RigConfig::default() };
-            let tool = ToolSpec::new(SphereTree::ball(HapticTool::default().tip_radius_m).0, rigid_tool());
+            let config = RigConfig { haptic, collision, map, rendering, proxy, workspace, ..RigConfig::default() };
+            let tool = ToolSpec::new(SphereTree::ball(HapticTool::default().tip_radius_m).tree, rigid_tool());
             let rig = HapticRig::start(opened, tool, config, events, Default::default()).map_err(|e| e.to_string())?;
             let clock = rig.clock();
             (Engine::Rig(Box::new(rig)), rendering, clock)
@@ -175,13 +188,8 @@ fn try_start(world: &mut World) -> Result<HapticStatus, String> {
         world.insert_resource(SimulatedHand::new(hand, clock));
     }
     world.insert_resource(HapticDeviceLink(link));
-    world.insert_resource(HapticRuntime {
-        engine: Mutex::new(engine),
-        map,
-        ticks: Vec::with_capacity(1 << 12),
-        steps: Vec::with_capacity(1 << 12),
-        samples: Vec::with_capacity(1 << 12),
-    });
+    world.insert_resource(HapticRuntime { engine: Mutex::new(engine), map, recording, recording_lost: 0 });
+    world.insert_resource(HapticFrame::with_capacity(1 << 12));
     world.init_resource::<Watched>();
     world.insert_resource(effects);
     info!("haptics: {} at {rate_hz} Hz, {rendering:?} rendering", specs.name);
@@ -191,6 +199,16 @@ fn try_start(world: &mut World) -> Result<HapticStatus, String> {
         torque: specs.renders_torque(),
         rendering,
     })
+}
+
+/// Where a real device's grip must be read for forces to engage: the ball of its published workspace
+/// around the device frame's origin (the Falcon's centre of travel, where an Inverse3 was centred).
+/// `None` for devices without a link to lose (simulated, replayed, HID), whose grip goes where the
+/// program puts it.
+fn workspace_of(link: &haptico::DeviceLink, specs: &DeviceSpecs) -> Option<forcecomp::Workspace> {
+    let real = !matches!(link, haptico::DeviceLink::Local);
+    (real && specs.workspace_radius_m > 0.0)
+        .then_some(forcecomp::Workspace { centre: Vec3::ZERO, radius_m: specs.workspace_radius_m })
 }
 
 fn rigid_tool() -> forcecomp::Material {
@@ -207,9 +225,10 @@ fn start_device(
     mut events: HapticEvents,
     config: haptico::HapticConfig,
     specs: &DeviceSpecs,
+    workspace: Option<forcecomp::Workspace>,
     clock: HapticClock,
 ) -> Result<DeviceOnly, String> {
-    let safety = haptic_rig::safety_for(specs);
+    let safety = forcecomp::SafetyConfig { workspace, ..haptic_rig::safety_for(specs) };
     safety.validate().map_err(|e| e.to_string())?;
     let mut safety = SafetyLayer::new(safety);
     let (mut samples_in, samples_out) = rtrb::RingBuffer::new(1 << 16);
@@ -236,63 +255,73 @@ pub(crate) fn stop_on_exit(mut commands: Commands, mut exit: MessageReader<AppEx
     }
 }
 
-/// Moves the tool to where the threads have it and tells the game (`PreUpdate`).
-pub(crate) fn follow_device(
-    runtime: Option<Res<HapticRuntime>>,
-    mut tools: Query<(Entity, &mut Transform), With<HapticTool>>,
-    mut moved: MessageWriter<ToolMoved>,
-    mut commands: Commands,
+/// Reads the threads into [`HapticFrame`]: their latest state, and every tick's and step's timing and
+/// force since the last frame; adds them to [`HapticStats`] (`PreUpdate`).
+pub(crate) fn read_threads(
+    runtime: Option<ResMut<HapticRuntime>>,
+    frame: Option<ResMut<HapticFrame>>,
+    mut stats: ResMut<HapticStats>,
 ) {
-    let Some(runtime) = runtime else { return };
-    let (pose, output) = match &*runtime.engine() {
-        Engine::Rig(rig) => {
-            let t = rig.telemetry();
-            (t.tool_pose, t.output)
-        }
-        Engine::Device { handle, .. } => {
-            let t = handle.telemetry();
-            (runtime.map.to_scene(&t.device.pose), t.command)
-        }
-    };
-    for (tool, mut transform) in &mut tools {
-        transform.translation = pose.translation;
-        transform.rotation = pose.rotation;
-        let event = ToolMoved { tool, transform: *transform, force_n: output.force, torque_nm: output.torque };
-        moved.write(event);
-        commands.trigger(event);
-    }
-}
-
-/// Drains the threads' timings and force samples into [`HapticStats`] (`PreUpdate`).
-pub(crate) fn gather_stats(runtime: Option<ResMut<HapticRuntime>>, mut stats: ResMut<HapticStats>) {
-    let Some(mut runtime) = runtime else { return };
-    let runtime = &mut *runtime;
-    runtime.ticks.clear();
-    runtime.steps.clear();
-    runtime.samples.clear();
+    let (Some(mut runtime), Some(mut frame)) = (runtime, frame) else { return };
+    let (runtime, frame) = (&mut *runtime, &mut *frame);
+    frame.ticks.clear();
+    frame.steps.clear();
+    frame.samples.clear();
     match &mut *runtime.engine.lock().unwrap_or_else(|p| p.into_inner()) {
         Engine::Rig(rig) => {
-            rig.drain_haptic_timings(&mut runtime.ticks);
-            rig.drain_collision_timings(&mut runtime.steps);
-            rig.drain_force_samples(&mut runtime.samples);
+            let t = rig.telemetry();
+            (frame.device, frame.tool, frame.output) = (t.device, t.tool_pose, t.output);
+            frame.outside_workspace = t.outside_workspace;
+            frame.now_us = rig.clock().now_us();
+            rig.drain_haptic_timings(&mut frame.ticks);
+            rig.drain_collision_timings(&mut frame.steps);
+            rig.drain_force_samples(&mut frame.samples);
             rig.collect_garbage();
         }
         Engine::Device { handle, samples } => {
-            handle.drain_timings(&mut runtime.ticks);
+            let t = handle.telemetry();
+            (frame.device, frame.tool, frame.output) = (t.device, runtime.map.to_scene(&t.device.pose), t.command);
+            frame.outside_workspace = false;
+            frame.now_us = handle.clock().now_us();
+            handle.drain_timings(&mut frame.ticks);
             while let Ok(s) = samples.pop() {
-                runtime.samples.push(s);
+                frame.samples.push(s);
             }
             handle.collect_garbage();
         }
     }
-    for t in &runtime.ticks {
+    if let Some(writer) = &runtime.recording
+        && writer.dropped() > runtime.recording_lost
+    {
+        runtime.recording_lost = writer.dropped();
+        warn!("the trace {} has lost {} ticks: the disk is too slow", writer.path().display(), runtime.recording_lost);
+    }
+    for t in &frame.ticks {
         stats.haptic.record(t.start_us);
     }
-    for s in &runtime.steps {
+    for s in &frame.steps {
         stats.collision.record(s.start_us);
     }
-    for s in &runtime.samples {
+    for s in &frame.samples {
         stats.record_force(s.force, s.torque);
+    }
+}
+
+/// Moves the tool to where the threads have it and tells the game (`PreUpdate`, after [`read_threads`]).
+pub(crate) fn follow_device(
+    frame: Option<Res<HapticFrame>>,
+    mut tools: Query<(Entity, &mut Transform), With<HapticTool>>,
+    mut moved: MessageWriter<ToolMoved>,
+    mut commands: Commands,
+) {
+    let Some(frame) = frame else { return };
+    for (tool, mut transform) in &mut tools {
+        transform.translation = frame.tool.translation;
+        transform.rotation = frame.tool.rotation;
+        let event =
+            ToolMoved { tool, transform: *transform, force_n: frame.output.force, torque_nm: frame.output.torque };
+        moved.write(event);
+        commands.trigger(event);
     }
 }
 
@@ -317,7 +346,7 @@ pub(crate) fn sync_tool(
     if watched.tool == Some(key) {
         return;
     }
-    let tree = tree.map_or_else(|| SphereTree::ball(tool.tip_radius_m).0, |(_, t)| t.0.clone());
+    let tree = tree.map_or_else(|| SphereTree::ball(tool.tip_radius_m).tree, |(_, t)| t.tree.clone());
     let spec = ToolSpec::new(tree, key.material.map_or_else(rigid_tool, |m| m.material()));
     match runtime.rig(|rig| rig.set_tool(spec)) {
         Some(Err(e)) => warn!("the tool's tree waits: {e}"),
@@ -406,8 +435,9 @@ pub(crate) fn send_colliders(
             }
         };
         let material = force.copied().unwrap_or_default().material();
-        let spec = ObjectSpec { id, tree: Arc::clone(&tree.0), pose: pose_of(transform), material };
-        match runtime.rig(|rig| rig.add_object(spec)) {
+        let spec = ObjectSpec { id, tree: Arc::clone(&tree.tree), pose: pose_of(transform), material };
+        let surface = tree.surface.clone();
+        match runtime.rig(|rig| rig.add_object(spec).and_then(|()| rig.set_surface(id, surface))) {
             Some(Err(e)) => warn!("{entity} waits for the collision thread: {e}"),
             _ => {
                 watched.ids.insert(entity, id);
@@ -482,4 +512,25 @@ pub(crate) fn report_contacts(
         }
     }
     watched.touching = now;
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use haptico::DeviceLink;
+
+    use super::*;
+
+    #[test]
+    fn real_devices_keep_forces_to_their_published_workspace_and_programs_steer_anywhere() {
+        let w =
+            workspace_of(&DeviceLink::Falcon(Arc::default()), &haptico::presets::falcon()).expect("a Falcon has one");
+        assert_eq!((w.centre, w.radius_m), (Vec3::ZERO, 0.04));
+        let inverse3 = haptico::presets::inverse3();
+        let haply = workspace_of(&DeviceLink::Haply(Arc::default()), &inverse3).expect("an Inverse3 has one");
+        // Where the Phantom client puts the grip (in front of its workbench) is inside the Inverse3's reach.
+        assert!(haply.holds(Vec3::new(0.0, 0.06, 0.07)), "{haply:?}");
+        assert_eq!(workspace_of(&DeviceLink::Local, &haptico::presets::phantom_desktop()), None);
+    }
 }

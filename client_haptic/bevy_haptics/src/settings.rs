@@ -14,6 +14,7 @@ pub struct CollisionSettings(pub haptic_rig::CollisionConfig);
 
 /// How contact forces are rendered.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Reflect)]
+#[type_path = "bevy_haptics"]
 pub enum RenderingMode {
     /// By the device: volumetric when it renders torque, else the 3-DOF proxy.
     #[default]

@@ -12,20 +12,39 @@ use bevy::asset::io::Reader;
 use bevy::asset::{AssetLoader, LoadContext};
 use bevy::mesh::{Indices, Mesh, VertexAttributeValues};
 use bevy::prelude::*;
-use collette::{BuildOptions, InnerSphereTree, Sphere, TriMesh};
+use collette::{BuildOptions, InnerSphereTree, SignedDistanceGrid, Sphere, TriMesh};
 use serde::{Deserialize, Serialize};
 
 /// An Inner Sphere Tree: the spheres packed inside a closed mesh, in the mesh's frame (metres), as the
-/// collision thread measures it (the paper's sphere-tree asset).
+/// collision thread measures it (the paper's sphere-tree asset); optionally with the mesh's surface as a
+/// signed distance grid, against which volumetric rendering measures the tool's spheres (the overlap
+/// within about 1 % of the true one, and no bumps of the packing under a smooth surface).
 #[derive(Asset, TypePath, Clone, Debug)]
-pub struct SphereTree(pub Arc<InnerSphereTree>);
+pub struct SphereTree {
+    /// The tree.
+    pub tree: Arc<InnerSphereTree>,
+    /// The mesh's surface, in the same frame (`None`: the tree's spheres stand for it).
+    pub surface: Option<Arc<SignedDistanceGrid>>,
+}
 
 impl SphereTree {
+    /// A tree built elsewhere (with collette).
+    pub fn new(tree: InnerSphereTree) -> Self {
+        Self { tree: Arc::new(tree), surface: None }
+    }
+
+    /// This tree with `surface` (a grid of the same mesh, built with collette's
+    /// [`SignedDistanceGrid::new`]: about half a second for 100 voxels along the longest side).
+    pub fn with_surface(mut self, surface: SignedDistanceGrid) -> Self {
+        self.surface = Some(Arc::new(surface));
+        self
+    }
+
     /// One sphere of `radius_m` at the origin: a ball tip.
     pub fn ball(radius_m: f32) -> Self {
         let r = radius_m.max(1e-6);
         let volume = 4.0 / 3.0 * std::f32::consts::PI * r * r * r;
-        Self(Arc::new(InnerSphereTree::from_spheres(vec![Sphere { center: Vec3::ZERO, radius: r }], volume)))
+        Self::new(InnerSphereTree::from_spheres(vec![Sphere { center: Vec3::ZERO, radius: r }], volume))
     }
 
     /// A brilliant-cut gemstone `diameter_m` wide (its table up, +Y), packed with `spheres` spheres: the
@@ -38,7 +57,7 @@ impl SphereTree {
     pub fn build(mesh: &TriMesh, spheres: usize) -> Result<Self, SphereTreeError> {
         let (tree, _) = collette::build(mesh, &BuildOptions::spheres(spheres.max(1)), &mut |_| {})
             .map_err(|e| SphereTreeError::Build(e.to_string()))?;
-        Ok(Self(Arc::new(tree)))
+        Ok(Self::new(tree))
     }
 
     /// Packs `spheres` spheres into a Bevy mesh (vertices times `scale`, to metres; see [`tri_mesh`]).
@@ -50,17 +69,17 @@ impl SphereTree {
 
     /// Writes the tree as an `.ist` file (what the asset loader and the `collette` tool read).
     pub fn save(&self, path: impl AsRef<std::path::Path>) -> Result<(), SphereTreeError> {
-        Ok(self.0.save(path)?)
+        Ok(self.tree.save(path)?)
     }
 
     /// Number of inner spheres.
     pub fn len(&self) -> usize {
-        self.0.spheres().len()
+        self.tree.spheres().len()
     }
 
     /// True for a tree without spheres.
     pub fn is_empty(&self) -> bool {
-        self.0.spheres().is_empty()
+        self.tree.spheres().is_empty()
     }
 }
 
@@ -115,7 +134,7 @@ impl AssetLoader for SphereTreeLoader {
         reader.read_to_end(&mut bytes).await?;
         let is_obj = context.path().path().extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
         if !is_obj {
-            return Ok(SphereTree(Arc::new(InnerSphereTree::from_bytes(&bytes)?)));
+            return Ok(SphereTree::new(InnerSphereTree::from_bytes(&bytes)?));
         }
         let mesh = TriMesh::from_obj_bytes(&bytes, context.path().path())
             .and_then(|m| m.map_vertices(|v| v * settings.scale))
