@@ -61,6 +61,13 @@ fn touch_bunny_strokes_the_bunny_through_the_3dof_proxy_headless() {
 }
 
 #[test]
+fn scene_file_sets_up_the_tool_and_the_bunny_from_a_scene_file_and_strokes_it_headless() {
+    // No set-up code: the tool, the bunny's tree source, material and place all come from the file.
+    let report = run("scene_file", 5.0);
+    check(&report, "scene_file", 5.0, 7.9, true);
+}
+
+#[test]
 fn custom_force_renders_its_own_floor_and_still_hears_of_contacts_headless() {
     let report = run("custom_force", 3.0);
     check(&report, "custom_force", 3.0, 3.3, true);

@@ -1,6 +1,6 @@
 //! A game written only against bevy_haptics' public API (no haptic_rig or collette import): a tool and
-//! three boxes, their trees from three sources (a Bevy mesh built on the async pool, an `.ist` file
-//! through the asset server, a tree added in code); the simulated hand presses into each box in turn and
+//! three boxes, two spawned in code (a Bevy mesh built on the async pool, a tree added in code) and one
+//! from a scene file (its tree an `.ist` file the scene names); the simulated hand presses into each box in turn and
 //! the contact observers name the right box, start before end, in that order. Real threads, real time,
 //! bounded.
 
@@ -8,6 +8,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use bevy::prelude::*;
+use bevy::world_serialization::{DynamicWorldRoot, WorldSerializationPlugin};
 use bevy_haptics::prelude::*;
 
 /// Box centres along x, m; each is 2 cm wide with its top at y = 0.01.
@@ -28,6 +29,31 @@ struct Log(Arc<Mutex<Vec<Seen>>>);
 #[derive(Resource, Clone, Default)]
 struct Tools(Arc<Mutex<Vec<Entity>>>);
 
+/// A scene file with one collider: its tree named by path (loaded through the asset server), its
+/// material and its place, in the middle of [`XS`].
+const SCENE: &str = r#"(
+  resources: {},
+  entities: {
+    4294967290: (
+      components: {
+        "bevy_haptics::HapticCollider": (tree: Path("box.ist")),
+        "bevy_haptics::ForceComponent": (
+          stiffness_n_per_m3: 2000000.0,
+          damping_ns_per_m: 2.0,
+          friction: 0.3,
+          ridges: None,
+          force_scale: 1.0,
+        ),
+        "bevy_transform::components::transform::Transform": (
+          translation: (0.0, 0.0, 0.0),
+          rotation: (0.0, 0.0, 0.0, 1.0),
+          scale: (1.0, 1.0, 1.0),
+        ),
+      },
+    ),
+  },
+)"#;
+
 /// A 2 cm box's tree.
 fn box_tree() -> SphereTree {
     SphereTree::from_mesh(&Cuboid::new(0.02, 0.02, 0.02).into(), 1.0, 300).expect("a box packs")
@@ -37,16 +63,21 @@ fn box_tree() -> SphereTree {
 fn contacts_with_three_colliders_start_and_end_in_the_order_the_hand_presses_them() {
     let dir = std::env::temp_dir().join(format!("bevy-haptics-api-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("a temp dir");
-    // A box's tree saved as an `.ist` file, as the `collette` tool writes them.
+    // A box's tree saved as an `.ist` file, as the `collette` tool writes them, and a scene file that
+    // places a collider with that tree and a soft material over the middle.
     box_tree().save(dir.join("box.ist")).expect("saves");
+    std::fs::write(dir.join("box.scn.ron"), SCENE).expect("writes the scene");
 
     let mut app = App::new();
     app.add_plugins((
         MinimalPlugins,
         AssetPlugin { file_path: dir.to_string_lossy().into_owned(), ..default() },
         HapticsPlugins,
+        WorldSerializationPlugin,
     ))
     .init_asset::<Mesh>()
+    // The scene's Bevy type (Bevy without its default `reflect_auto_register` registers none by itself).
+    .register_type::<Transform>()
     .insert_resource(HapticDevice::simulated("phantom desktop", Vec3::new(XS[0], ABOVE, 0.0)));
     let log = Log::default();
     app.insert_resource(log.clone());
@@ -66,8 +97,8 @@ fn contacts_with_three_colliders_start_and_end_in_the_order_the_hand_presses_the
     let mesh = world.resource_mut::<Assets<Mesh>>().add(Cuboid::new(0.02, 0.02, 0.02));
     let from_mesh =
         world.spawn((Mesh3d(mesh), SphereTreeFromMesh { spheres: 300 }, Transform::from_xyz(XS[0], 0.0, 0.0))).id();
-    let loaded = world.resource::<AssetServer>().load::<SphereTree>("box.ist");
-    let from_file = world.spawn((HapticCollider::new(loaded), Transform::from_xyz(XS[1], 0.0, 0.0))).id();
+    let scene = world.resource::<AssetServer>().load("box.scn.ron");
+    world.spawn(DynamicWorldRoot(scene));
     let added = world.resource_mut::<Assets<SphereTree>>().add(box_tree());
     let from_code =
         world.spawn((HapticCollider::new(added), ForceComponent::default(), Transform::from_xyz(XS[2], 0.0, 0.0))).id();
@@ -90,6 +121,16 @@ fn contacts_with_three_colliders_start_and_end_in_the_order_the_hand_presses_the
         assert!(Instant::now() < deadline, "the three trees were not ready in time");
         step(&mut app);
     }
+    // The scene's collider: the one neither spawned in code.
+    let mut colliders = app.world_mut().query_filtered::<Entity, With<HapticCollider>>();
+    let from_file =
+        colliders.iter(app.world()).find(|e| ![from_mesh, from_code].contains(e)).expect("the scene file's collider");
+    let soft = app.world().get::<ForceComponent>(from_file).expect("the scene gave it a material");
+    assert_eq!(soft.stiffness_n_per_m3, 2e6, "the scene's material, not the default");
+    assert_eq!(
+        app.world().get::<GlobalTransform>(from_file).expect("placed").translation(),
+        Vec3::new(XS[1], 0.0, 0.0)
+    );
     assert!(matches!(app.world().resource::<HapticStatus>(), HapticStatus::Running { .. }));
 
     for (i, x) in XS.into_iter().enumerate() {

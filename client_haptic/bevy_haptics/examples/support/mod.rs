@@ -57,7 +57,10 @@ impl Run {
         let mut app = App::new();
         if self.headless {
             let frame = Duration::from_secs_f64(1.0 / 60.0);
-            app.add_plugins((MinimalPlugins.set(ScheduleRunnerPlugin::run_loop(frame)), assets)).init_asset::<Mesh>();
+            // Warnings and errors to stderr (`RUST_LOG` to see more); stdout keeps the JSON line alone.
+            let log = bevy::log::LogPlugin { level: bevy::log::Level::WARN, ..default() };
+            app.add_plugins((MinimalPlugins.set(ScheduleRunnerPlugin::run_loop(frame)), assets, log))
+                .init_asset::<Mesh>();
         } else {
             // Pipelines compiled before the first frame: on a software renderer (lavapipe) the first
             // frames are black otherwise.

@@ -54,13 +54,13 @@ impl fmt::Display for SphereCounts {
     }
 }
 
-/// The bunny shipped with the project (`assets/meshes/bunny.obj`, the Stanford bunny, public domain), or
-/// `$COLLETTE_BUNNY` when set.
+/// The bunny shipped in this package (`data/bunny.obj`, the Stanford bunny, public domain; in the
+/// repository a link to the game's `assets/meshes/bunny.obj`), or `$COLLETTE_BUNNY` when set.
 pub fn default_bunny_path() -> PathBuf {
     if let Some(p) = std::env::var_os("COLLETTE_BUNNY") {
         return PathBuf::from(p);
     }
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/meshes/bunny.obj")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("data/bunny.obj")
 }
 
 /// Loads the bunny from an OBJ file, scaled by [`BUNNY_SCALE`] to metres and centred on its box centre.
