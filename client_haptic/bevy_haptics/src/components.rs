@@ -153,3 +153,28 @@ impl Default for CollisionVolume {
         Self { half_extents_m: Vec3::splat(0.5) }
     }
 }
+
+/// Watches two colliders against each other (the paper's AddCollisionWatcher between two actors): the
+/// collision thread measures their overlap every step, and [`PairContactStarted`](crate::PairContactStarted)
+/// / [`PairContactEnded`](crate::PairContactEnded) are triggered on this entity (and sent as messages).
+/// Objects do not push each other: this tells the game they touch. Put it on an entity of its own;
+/// it starts once both have reached the collision thread. One watcher per pair; at most
+/// `haptic_rig::MAX_PAIR_WATCHERS` at once.
+#[derive(Component, Reflect, Clone, Copy, Debug, PartialEq, Eq)]
+#[reflect(Component)]
+#[type_path = "bevy_haptics"]
+pub struct CollisionWatcher {
+    /// One collider.
+    #[entities]
+    pub a: Entity,
+    /// The other.
+    #[entities]
+    pub b: Entity,
+}
+
+impl CollisionWatcher {
+    /// Watches colliders `a` and `b` against each other.
+    pub fn new(a: Entity, b: Entity) -> Self {
+        Self { a, b }
+    }
+}

@@ -74,3 +74,33 @@ pub struct ContactData {
     /// Torque the object puts on the tool about the tool's centre of mass, world frame, N·m.
     pub torque_nm: Vec3,
 }
+
+/// Two colliders a [`CollisionWatcher`](crate::CollisionWatcher) watches began to overlap. Triggered on
+/// the watcher entity.
+#[derive(Message, EntityEvent, Clone, Copy, Debug, PartialEq)]
+pub struct PairContactStarted {
+    /// The watcher.
+    #[event_target]
+    pub watcher: Entity,
+    /// One collider.
+    pub a: Entity,
+    /// The other.
+    pub b: Entity,
+    /// Their overlap volume when it started, m³.
+    pub volume_m3: f32,
+    /// Overlapping sphere pairs when it started.
+    pub pairs: u32,
+}
+
+/// Two watched colliders stopped overlapping (or one of them stopped being collidable, or the watcher
+/// went). Triggered on the watcher entity when it still exists.
+#[derive(Message, EntityEvent, Clone, Copy, Debug, PartialEq)]
+pub struct PairContactEnded {
+    /// The watcher.
+    #[event_target]
+    pub watcher: Entity,
+    /// One collider.
+    pub a: Entity,
+    /// The other.
+    pub b: Entity,
+}

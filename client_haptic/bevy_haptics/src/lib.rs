@@ -16,12 +16,14 @@ mod source;
 mod stats;
 mod tree;
 
-pub use components::{CollisionVolume, ForceComponent, HapticCollider, HapticTool, Ridges};
+pub use components::{CollisionVolume, CollisionWatcher, ForceComponent, HapticCollider, HapticTool, Ridges};
 #[cfg(feature = "debug")]
 pub use debug::{HapticsDebugConfig, HapticsDebugPlugin};
 pub use device::{DeviceError, DeviceKind, HapticDevice, HapticDeviceLink, SimulatedHand};
 pub use effects::{EffectKind, HapticEffect, MAX_EFFECTS};
-pub use events::{ContactData, ContactEnded, ContactOngoing, ContactStarted, ToolMoved};
+pub use events::{
+    ContactData, ContactEnded, ContactOngoing, ContactStarted, PairContactEnded, PairContactStarted, ToolMoved,
+};
 pub use frame::HapticFrame;
 pub use mesh_build::SphereTreeFromMesh;
 pub use plugins::{CollettePlugin, ForceCompPlugin, HapticoPlugin, HapticsPlugins, HapticsSystems};
@@ -40,10 +42,11 @@ pub mod libs {
 /// Everything a game usually needs.
 pub mod prelude {
     pub use crate::{
-        CollettePlugin, CollisionVolume, ContactEnded, ContactOngoing, ContactStarted, EffectKind, ForceCompPlugin,
-        ForceComponent, HapticCollider, HapticDelegates, HapticDevice, HapticEffect, HapticFrame, HapticStats,
-        HapticStatus, HapticTool, HapticoPlugin, HapticsPlugins, HapticsSystems, RenderingMode, SimulatedHand,
-        SphereTree, SphereTreeFromMesh, SphereTreeSettings, SphereTreeSource, ToolMoved,
+        CollettePlugin, CollisionVolume, CollisionWatcher, ContactEnded, ContactOngoing, ContactStarted, EffectKind,
+        ForceCompPlugin, ForceComponent, HapticCollider, HapticDelegates, HapticDevice, HapticEffect, HapticFrame,
+        HapticStats, HapticStatus, HapticTool, HapticoPlugin, HapticsPlugins, HapticsSystems, PairContactEnded,
+        PairContactStarted, RenderingMode, SimulatedHand, SphereTree, SphereTreeFromMesh, SphereTreeSettings,
+        SphereTreeSource, ToolMoved,
     };
     pub use haptic_common::{ForceOnHapticTick, ForceTorque};
     pub use haptico::steer::HandGoal;

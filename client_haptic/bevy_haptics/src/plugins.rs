@@ -14,10 +14,12 @@ use bevy::asset::ReflectHandle;
 use bevy::prelude::*;
 use haptic_rig::ProxyRendering;
 
-use crate::components::{CollisionVolume, ForceComponent, HapticCollider, HapticTool, Ridges};
+use crate::components::{CollisionVolume, CollisionWatcher, ForceComponent, HapticCollider, HapticTool, Ridges};
 use crate::device::HapticDevice;
 use crate::effects::{self, EffectKind, HapticEffect};
-use crate::events::{ContactData, ContactEnded, ContactOngoing, ContactStarted, ToolMoved};
+use crate::events::{
+    ContactData, ContactEnded, ContactOngoing, ContactStarted, PairContactEnded, PairContactStarted, ToolMoved,
+};
 use crate::frame::HapticFrame;
 use crate::mesh_build::{self, SphereTreeFromMesh};
 use crate::runtime::{self, HapticDelegates, HapticStatus};
@@ -101,6 +103,7 @@ impl Plugin for CollettePlugin {
             .init_asset_loader::<SphereTreeLoader>()
             .register_type::<HapticCollider>()
             .register_type::<CollisionVolume>()
+            .register_type::<CollisionWatcher>()
             .register_type::<SphereTreeFromMesh>()
             .register_type::<SphereTreeSource>()
             // A `Handle<SphereTree>` in a scene file (`tree: Path("trees/box.ist")`) loads that file.
@@ -109,14 +112,25 @@ impl Plugin for CollettePlugin {
             .add_message::<ContactStarted>()
             .add_message::<ContactOngoing>()
             .add_message::<ContactEnded>()
-            .add_systems(PreUpdate, runtime::report_contacts.in_set(HapticsSystems::Read))
+            .add_message::<PairContactStarted>()
+            .add_message::<PairContactEnded>()
+            .add_systems(
+                PreUpdate,
+                (runtime::report_contacts, runtime::report_pair_contacts).in_set(HapticsSystems::Read),
+            )
             .add_systems(Update, (mesh_build::start_mesh_builds, mesh_build::finish_mesh_builds))
             .add_systems(
                 PostUpdate,
                 (
                     source::load_sources.before(runtime::sync_tool).before(runtime::send_colliders),
                     runtime::sync_tool,
-                    (runtime::forget_colliders, runtime::send_colliders, runtime::move_colliders).chain(),
+                    (
+                        runtime::forget_colliders,
+                        runtime::send_colliders,
+                        runtime::move_colliders,
+                        runtime::sync_watchers,
+                    )
+                        .chain(),
                     runtime::sync_volume,
                 )
                     .in_set(HapticsSystems::Write),

@@ -17,9 +17,11 @@ use haptic_rig::{ForceSample, HapticRig, ObjectSpec, Rendering, RigConfig, ToolS
 use haptico::trace::TraceWriter;
 use haptico::{Device, DeviceSpecs, HapticClock, HapticEvents, HapticHandle};
 
-use crate::components::{CollisionVolume, ForceComponent, HapticCollider, HapticTool};
+use crate::components::{CollisionVolume, CollisionWatcher, ForceComponent, HapticCollider, HapticTool};
 use crate::device::{HapticDevice, HapticDeviceLink, SimulatedHand};
-use crate::events::{ContactData, ContactEnded, ContactOngoing, ContactStarted, ToolMoved};
+use crate::events::{
+    ContactData, ContactEnded, ContactOngoing, ContactStarted, PairContactEnded, PairContactStarted, ToolMoved,
+};
 use crate::frame::HapticFrame;
 use crate::settings::{CollisionSettings, ForceRendering};
 use crate::stats::HapticStats;
@@ -124,8 +126,25 @@ pub(crate) struct Watched {
     entities: HashMap<u32, Entity>,
     next_id: u32,
     touching: HashSet<u32>,
+    /// Watchers between two colliders on the threads: the pair's ids and entities.
+    pairs: HashMap<Entity, WatchedPair>,
+    /// The watchers whose pair overlaps.
+    pairs_touching: HashSet<Entity>,
     tool: Option<ToolKey>,
     region: Option<(Vec3, Vec3)>,
+}
+
+/// A watcher's pair as the threads know it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct WatchedPair {
+    ids: (u32, u32),
+    entities: (Entity, Entity),
+}
+
+impl WatchedPair {
+    fn joins(&self, id: u32) -> bool {
+        self.ids.0 == id || self.ids.1 == id
+    }
 }
 
 /// Opens the device and starts the threads (`PostStartup`).
@@ -380,6 +399,24 @@ pub(crate) struct ContactWriters<'w, 's> {
     commands: Commands<'w, 's>,
 }
 
+/// What tells the game of watched pairs: the two messages and the observers.
+#[derive(SystemParam)]
+pub(crate) struct PairWriters<'w, 's> {
+    started: MessageWriter<'w, PairContactStarted>,
+    ended: MessageWriter<'w, PairContactEnded>,
+    commands: Commands<'w, 's>,
+}
+
+impl PairWriters<'_, '_> {
+    fn ended(&mut self, watcher: Entity, pair: WatchedPair) {
+        let event = PairContactEnded { watcher, a: pair.entities.0, b: pair.entities.1 };
+        self.ended.write(event);
+        if self.commands.get_entity(watcher).is_ok() {
+            self.commands.trigger(event);
+        }
+    }
+}
+
 impl ContactWriters<'_, '_> {
     fn ended(&mut self, object: Entity, tool: Entity) {
         let event = ContactEnded { object, tool };
@@ -398,10 +435,21 @@ pub(crate) fn forget_colliders(
     mut removed: RemovedComponents<HapticCollider>,
     tools: Query<Entity, With<HapticTool>>,
     mut writers: ContactWriters,
+    mut pair_writers: PairWriters,
 ) {
     let Some((runtime, watched)) = threads.get() else { return };
     let tool = tools.iter().next().unwrap_or(Entity::PLACEHOLDER);
     for entity in removed.read() {
+        // The rig ended the object's watchers with it; they start again if it comes back.
+        if let Some(&id) = watched.ids.get(&entity) {
+            let ended: Vec<_> = watched.pairs.iter().filter(|(_, p)| p.joins(id)).map(|(w, p)| (*w, *p)).collect();
+            for (watcher, pair) in ended {
+                watched.pairs.remove(&watcher);
+                if watched.pairs_touching.remove(&watcher) {
+                    pair_writers.ended(watcher, pair);
+                }
+            }
+        }
         let Some(id) = watched.ids.remove(&entity) else { continue };
         watched.entities.remove(&id);
         if let Some(Err(e)) = runtime.rig(|rig| rig.remove_object(id)) {
@@ -443,6 +491,74 @@ pub(crate) fn send_colliders(
                 watched.ids.insert(entity, id);
                 watched.entities.insert(id, entity);
             }
+        }
+    }
+}
+
+/// Starts the watchers between two colliders once both are on the threads, and stops those that went
+/// (`PostUpdate`, after the colliders are sent).
+pub(crate) fn sync_watchers(
+    mut threads: Threads,
+    watchers: Query<(Entity, &CollisionWatcher)>,
+    mut removed: RemovedComponents<CollisionWatcher>,
+    mut writers: PairWriters,
+) {
+    let Some((runtime, watched)) = threads.get() else { return };
+    for watcher in removed.read() {
+        let Some(pair) = watched.pairs.remove(&watcher) else { continue };
+        if let Some(Err(e)) = runtime.rig(|rig| rig.unwatch_pair(pair.ids.0, pair.ids.1)) {
+            warn!("stopping the watcher {watcher}: {e}");
+        }
+        if watched.pairs_touching.remove(&watcher) {
+            writers.ended(watcher, pair);
+        }
+    }
+    for (watcher, w) in &watchers {
+        // A watcher waits until both its colliders are on the threads.
+        let (Some(&a), Some(&b)) = (watched.ids.get(&w.a), watched.ids.get(&w.b)) else { continue };
+        let pair = WatchedPair { ids: (a, b), entities: (w.a, w.b) };
+        if watched.pairs.get(&watcher) == Some(&pair) {
+            continue;
+        }
+        if let Some(old) = watched.pairs.remove(&watcher)
+            && let Some(Err(e)) = runtime.rig(|rig| rig.unwatch_pair(old.ids.0, old.ids.1))
+        {
+            warn!("moving the watcher {watcher} to another pair: {e}");
+        }
+        match runtime.rig(|rig| rig.watch_pair(a, b)) {
+            Some(Err(e)) => warn!("the watcher {watcher} waits: {e}"),
+            _ => {
+                watched.pairs.insert(watcher, pair);
+            }
+        }
+    }
+}
+
+/// Reports watched pairs starting and ending to overlap (`PreUpdate`).
+pub(crate) fn report_pair_contacts(
+    mut threads: Threads,
+    mut latest: Local<Vec<haptic_rig::PairContact>>,
+    mut writers: PairWriters,
+) {
+    let Some((runtime, watched)) = threads.get() else { return };
+    latest.clear();
+    runtime.rig(|rig| rig.pair_contacts(&mut latest));
+    for (&watcher, &pair) in &watched.pairs {
+        let (a, b) = pair.ids;
+        let now = latest.iter().find(|p| p.touching && ((p.a, p.b) == (a, b) || (p.a, p.b) == (b, a)));
+        match (now, watched.pairs_touching.contains(&watcher)) {
+            (Some(p), false) => {
+                watched.pairs_touching.insert(watcher);
+                let (a, b) = pair.entities;
+                let event = PairContactStarted { watcher, a, b, volume_m3: p.volume_m3, pairs: p.pairs };
+                writers.started.write(event);
+                writers.commands.trigger(event);
+            }
+            (None, true) => {
+                watched.pairs_touching.remove(&watcher);
+                writers.ended(watcher, pair);
+            }
+            _ => {}
         }
     }
 }

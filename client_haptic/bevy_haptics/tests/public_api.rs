@@ -183,3 +183,74 @@ fn a_device_that_cannot_be_opened_is_reported_and_the_app_runs_on_without_haptic
     let err = HapticDevice::named("inverse3").expect_err("not a device name");
     assert!(err.contains("sim, trace:FILE, hid[:PATH], falcon[:FIRMWARE] or haply[:URL]"), "{err}");
 }
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum PairSeen {
+    Started(Entity, Entity, f32),
+    Ended(Entity, Entity),
+}
+
+#[derive(Resource, Clone, Default)]
+struct PairLog(Arc<Mutex<Vec<PairSeen>>>);
+
+/// Two boxes and a watcher between them (no tool near them): apart nothing is heard; moved half into
+/// each other by their `Transform`s, the watcher hears them meet (with their overlap); moved apart, part;
+/// together again, then one despawned: part once more.
+#[test]
+fn a_watcher_between_two_colliders_hears_them_meet_and_part_where_the_game_moves_them() {
+    let mut app = App::new();
+    app.add_plugins((MinimalPlugins, AssetPlugin::default(), HapticsPlugins))
+        .init_asset::<Mesh>()
+        .insert_resource(HapticDevice::simulated("phantom desktop", Vec3::new(0.0, 0.2, 0.0)));
+    let log = PairLog::default();
+    app.insert_resource(log.clone());
+    let world = app.world_mut();
+    let tree = world.resource_mut::<Assets<SphereTree>>().add(box_tree());
+    let a = world.spawn((HapticCollider::new(tree.clone()), Transform::from_xyz(-0.05, 0.0, 0.0))).id();
+    let b = world.spawn((HapticCollider::new(tree), Transform::from_xyz(0.05, 0.0, 0.0))).id();
+    let watcher = world
+        .spawn(CollisionWatcher::new(a, b))
+        .observe(|c: On<PairContactStarted>, log: Res<PairLog>| {
+            log.0.lock().unwrap().push(PairSeen::Started(c.a, c.b, c.volume_m3));
+        })
+        .observe(|c: On<PairContactEnded>, log: Res<PairLog>| {
+            log.0.lock().unwrap().push(PairSeen::Ended(c.a, c.b));
+        })
+        .id();
+    app.finish();
+    app.cleanup();
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let run_until = |app: &mut App, n: usize| {
+        while log.0.lock().unwrap().len() < n {
+            assert!(Instant::now() < deadline, "heard only {:?}", log.0.lock().unwrap());
+            app.update();
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    };
+    let place_b = |app: &mut App, x: f32| {
+        app.world_mut().get_mut::<Transform>(b).expect("b").translation.x = x;
+    };
+    // Apart for half a second: nothing.
+    let quiet = Instant::now() + Duration::from_millis(500);
+    while Instant::now() < quiet {
+        app.update();
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    assert!(log.0.lock().unwrap().is_empty(), "apart: {:?}", log.0.lock().unwrap());
+    // Half of b's 2 cm inside a: an overlap of 1 x 2 x 2 cm, 4e-6 m³.
+    place_b(&mut app, -0.04);
+    run_until(&mut app, 1);
+    place_b(&mut app, 0.05);
+    run_until(&mut app, 2);
+    place_b(&mut app, -0.04);
+    run_until(&mut app, 3);
+    app.world_mut().despawn(a);
+    run_until(&mut app, 4);
+    let seen = log.0.lock().unwrap().clone();
+    let PairSeen::Started(_, _, volume) = seen[0] else { panic!("{seen:?}") };
+    assert!((2e-6..8e-6).contains(&volume), "overlap {volume} m³");
+    let expected = [PairSeen::Started(a, b, volume), PairSeen::Ended(a, b)];
+    assert_eq!(seen[..2], expected, "watcher {watcher}: a {a}, b {b}");
+    assert!(matches!(seen[2], PairSeen::Started(x, y, _) if (x, y) == (a, b)), "{seen:?}");
+    assert_eq!(seen[3], PairSeen::Ended(a, b), "a despawned collider ends its watcher's contact");
+}

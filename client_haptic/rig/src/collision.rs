@@ -9,7 +9,7 @@ use std::time::Duration;
 use haptico::HapticClock;
 use haptico::timing::{make_current_thread_realtime, next_deadline, wait_until};
 
-use crate::spec::MAX_OBJECTS;
+use crate::spec::{MAX_OBJECTS, MAX_PAIR_WATCHERS};
 
 pub use collette::pipeline::StepTiming;
 
@@ -49,12 +49,13 @@ impl CollisionConfig {
         (1e9 / self.rate_hz.max(1.0) as f64) as u64
     }
 
-    /// collette's settings for these (objects: the tool and [`MAX_OBJECTS`], one watcher each; `budget`
+    /// collette's settings for these (objects: the tool and [`MAX_OBJECTS`], one watcher each against the
+    /// tool and [`MAX_PAIR_WATCHERS`] between objects; `budget`
     /// overrides `budget_us`).
     pub(crate) fn pipeline(&self, budget: Option<Duration>) -> collette::pipeline::CollisionConfig {
         collette::pipeline::CollisionConfig {
             max_objects: MAX_OBJECTS + 1,
-            max_watchers: MAX_OBJECTS,
+            max_watchers: MAX_OBJECTS + MAX_PAIR_WATCHERS,
             command_capacity: 64,
             period: Duration::from_nanos(self.period_ns()),
             step_budget: budget.unwrap_or(Duration::from_micros(self.budget_us as u64)),

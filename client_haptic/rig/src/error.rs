@@ -15,6 +15,12 @@ pub enum RigError {
     /// No room for another object.
     #[error("at most {0} objects can be watched at once")]
     TooManyObjects(usize),
+    /// No room for another watcher between two objects.
+    #[error("at most {0} watchers between objects can run at once")]
+    TooManyPairs(usize),
+    /// A watcher between an object and itself.
+    #[error("object {0} cannot be watched against itself")]
+    SamePair(u32),
     /// No watched object has this id.
     #[error("no watched object has id {0}")]
     UnknownObject(u32),

@@ -15,5 +15,5 @@ pub use collision::{CollisionConfig, StepTiming};
 pub use error::{Result, RigError};
 pub use force::{ForceSample, ObjectContact, ProxyRendering, Rendering, RigTelemetry};
 pub use rig::{HapticRig, RigConfig, safety_for};
-pub use spec::{MAX_OBJECTS, ObjectSpec, ToolSpec};
+pub use spec::{MAX_OBJECTS, MAX_PAIR_WATCHERS, ObjectSpec, PairContact, ToolSpec};
 pub use workspace::WorkspaceMap;

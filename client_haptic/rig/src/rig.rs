@@ -13,7 +13,7 @@ use haptico::{Device, HapticClock, HapticConfig, HapticEvents, HapticHandle, Hap
 use crate::collision::{CollisionConfig, RigPacer, StepTiming};
 use crate::force::{ForceSample, ForceStage, ProxyRendering, Rendering, RigTelemetry};
 use crate::scene::{FORCE_COMMANDS, Scene};
-use crate::spec::{MAX_OBJECTS, ObjectSpec, ToolSpec};
+use crate::spec::{MAX_OBJECTS, ObjectSpec, PairContact, ToolSpec};
 use crate::{Result, RigError, WorkspaceMap};
 
 /// Settings of the whole rig.
@@ -189,6 +189,27 @@ impl<D: Device + 'static> HapticRig<D> {
     /// The shared clock.
     pub fn clock(&self) -> HapticClock {
         self.haptic().clock()
+    }
+
+    /// Watches objects `a` and `b` against each other (the paper's AddCollisionWatcher between two
+    /// objects): the collision thread measures their overlap every step, read with
+    /// [`pair_contacts`](Self::pair_contacts). Objects do not push each other. Removing either object
+    /// ends the watch; replacing one keeps it.
+    pub fn watch_pair(&self, a: u32, b: u32) -> Result<()> {
+        self.with_scene(|s| s.watch_pair(a, b))
+    }
+
+    /// Stops watching objects `a` and `b` against each other.
+    pub fn unwatch_pair(&self, a: u32, b: u32) -> Result<()> {
+        self.with_scene(|s| s.unwatch_pair(a, b))
+    }
+
+    /// Appends to `out` what each watcher between two objects saw on the latest collision step.
+    pub fn pair_contacts(&self, out: &mut Vec<PairContact>) {
+        let _ = self.with_scene(|s| {
+            s.pair_contacts(out);
+            Ok(())
+        });
     }
 
     /// Replaces the tool (its tree, centre of mass and material).

@@ -7,12 +7,12 @@
 //! travel through fixed-capacity rings; whatever the threads replace or remove comes back here to be
 //! freed.
 
-use collette::pipeline::{CollisionHandle, ObjectId, PoseWriter, TimedPose, WatcherId};
+use collette::pipeline::{CollisionHandle, ContactReader, ObjectId, PoseWriter, TimedPose, WatcherId};
 use forcecomp::BodyMotion;
 use haptic_common::Pose;
 
 use crate::force::{ForceCommand, ObjectReader, WatchedObject};
-use crate::spec::{MAX_OBJECTS, ObjectSpec, ToolSpec, center_of_mass};
+use crate::spec::{MAX_OBJECTS, MAX_PAIR_WATCHERS, ObjectSpec, PairContact, ToolSpec, center_of_mass};
 use crate::{Result, RigError};
 
 /// Capacity of the ring of changes to the force stage.
@@ -29,11 +29,26 @@ struct Entry {
     center_of_mass: glam::Vec3,
 }
 
+/// A watcher between two objects, read on the game thread.
+struct PairEntry {
+    a: u32,
+    b: u32,
+    watcher: WatcherId,
+    reader: ContactReader,
+}
+
+impl PairEntry {
+    fn joins(&self, id: u32) -> bool {
+        self.a == id || self.b == id
+    }
+}
+
 /// What the rig watches, and the ends of the rings that change it.
 pub(crate) struct Scene {
     pub(crate) collision: CollisionHandle,
     tool: ObjectId,
     entries: Vec<Entry>,
+    pairs: Vec<PairEntry>,
     forces: rtrb::Producer<ForceCommand>,
     garbage: rtrb::Consumer<Box<WatchedObject>>,
     proxy: bool,
@@ -50,7 +65,8 @@ impl Scene {
         garbage: rtrb::Consumer<Box<WatchedObject>>,
         proxy: bool,
     ) -> Self {
-        Self { collision, tool, entries: Vec::with_capacity(MAX_OBJECTS), forces, garbage, proxy, freed: 0 }
+        let (entries, pairs) = (Vec::with_capacity(MAX_OBJECTS), Vec::with_capacity(MAX_PAIR_WATCHERS));
+        Self { collision, tool, entries, pairs, forces, garbage, proxy, freed: 0 }
     }
 
     /// Watches an object (replaces the one with the same id).
@@ -59,11 +75,15 @@ impl Scene {
         if self.forces.slots() == 0 {
             return Err(RigError::QueueFull("haptic"));
         }
-        // All or nothing: removing a replaced object and adding this one take four commands.
-        if self.collision.free_commands() < 4 {
+        // All or nothing: removing a replaced object and adding this one take four commands, and its
+        // watchers against other objects two each (taken down with it, set up again after).
+        let paired = self.pairs.iter().filter(|p| p.joins(spec.id)).count();
+        if self.collision.free_commands() < 4 + 2 * paired {
             return Err(RigError::QueueFull("collision"));
         }
+        let mut rewatch = Vec::new();
         if let Some(i) = self.entries.iter().position(|e| e.id == spec.id) {
+            rewatch = self.drop_pairs_of(spec.id);
             let old = self.entries.swap_remove(i);
             self.forget(&old)?;
         } else if self.entries.len() >= MAX_OBJECTS {
@@ -87,7 +107,68 @@ impl Scene {
         let object = Box::new(WatchedObject { id: spec.id, reader, material: spec.material, motion, added_us: 0 });
         self.forces.push(ForceCommand::Add(object)).map_err(|_| RigError::QueueFull("haptic"))?;
         self.entries.push(Entry { id: spec.id, object: pose.id(), watcher, pose, center_of_mass: local_center });
+        for (a, b) in rewatch {
+            self.watch_pair(a, b)?;
+        }
         Ok(())
+    }
+
+    /// Watches objects `a` and `b` against each other (nothing happens for a pair already watched).
+    pub(crate) fn watch_pair(&mut self, a: u32, b: u32) -> Result<()> {
+        self.free_returned();
+        if a == b {
+            return Err(RigError::SamePair(a));
+        }
+        if self.pairs.iter().any(|p| p.joins(a) && p.joins(b)) {
+            return Ok(());
+        }
+        if self.pairs.len() >= MAX_PAIR_WATCHERS {
+            return Err(RigError::TooManyPairs(MAX_PAIR_WATCHERS));
+        }
+        let object = |id| self.entries.iter().find(|e| e.id == id).map(|e| e.object).ok_or(RigError::UnknownObject(id));
+        let (oa, ob) = (object(a)?, object(b)?);
+        let reader = self.collision.add_watcher(oa, ob).ok_or(RigError::QueueFull("collision"))?;
+        self.pairs.push(PairEntry { a, b, watcher: reader.id(), reader });
+        Ok(())
+    }
+
+    /// Stops watching objects `a` and `b` against each other (nothing happens for a pair not watched).
+    pub(crate) fn unwatch_pair(&mut self, a: u32, b: u32) -> Result<()> {
+        self.free_returned();
+        let Some(i) = self.pairs.iter().position(|p| p.joins(a) && p.joins(b) && a != b) else { return Ok(()) };
+        if !self.collision.remove_watcher(self.pairs[i].watcher) {
+            return Err(RigError::QueueFull("collision"));
+        }
+        self.pairs.swap_remove(i);
+        Ok(())
+    }
+
+    /// Appends what every watcher between two objects saw on the latest collision step.
+    pub(crate) fn pair_contacts(&mut self, out: &mut Vec<PairContact>) {
+        for p in &mut self.pairs {
+            let set = p.reader.latest();
+            out.push(PairContact {
+                a: p.a,
+                b: p.b,
+                touching: !set.is_empty() || set.total_volume > 0.0,
+                pairs: set.len() as u32,
+                volume_m3: set.total_volume,
+                sequence: set.sequence,
+            });
+        }
+    }
+
+    /// Takes down the watchers between object `id` and others (before the object goes); returns their
+    /// pairs.
+    fn drop_pairs_of(&mut self, id: u32) -> Vec<(u32, u32)> {
+        let mut dropped = Vec::new();
+        while let Some(i) = self.pairs.iter().position(|p| p.joins(id)) {
+            let p = self.pairs.swap_remove(i);
+            // The queue was checked for room by the caller.
+            self.collision.remove_watcher(p.watcher);
+            dropped.push((p.a, p.b));
+        }
+        dropped
     }
 
     /// Moves object `id` to `pose`: its pose buffer on the collision thread, its motion in the force stage.
@@ -109,10 +190,12 @@ impl Scene {
     pub(crate) fn remove_object(&mut self, id: u32) -> Result<()> {
         self.free_returned();
         let Some(i) = self.entries.iter().position(|e| e.id == id) else { return Ok(()) };
-        if self.collision.free_commands() < 2 {
+        let paired = self.pairs.iter().filter(|p| p.joins(id)).count();
+        if self.collision.free_commands() < 2 + paired {
             return Err(RigError::QueueFull("collision"));
         }
         self.forces.push(ForceCommand::Remove(id)).map_err(|_| RigError::QueueFull("haptic"))?;
+        self.drop_pairs_of(id);
         let old = self.entries.swap_remove(i);
         self.forget(&old)
     }

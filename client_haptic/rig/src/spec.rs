@@ -12,6 +12,27 @@ use haptic_common::Pose;
 /// Most objects watched at once (each against the tool).
 pub const MAX_OBJECTS: usize = 16;
 
+/// Most watchers between two objects at once (besides each object's against the tool).
+pub const MAX_PAIR_WATCHERS: usize = 16;
+
+/// What a watcher between two objects saw on the collision thread's latest step (objects do not push
+/// each other: this is what the game learns of their contact).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PairContact {
+    /// The first object's id.
+    pub a: u32,
+    /// The second object's id.
+    pub b: u32,
+    /// Whether their trees overlap.
+    pub touching: bool,
+    /// Overlapping sphere pairs found.
+    pub pairs: u32,
+    /// Their overlap volume, m³.
+    pub volume_m3: f32,
+    /// The collision step that measured it (0: none yet).
+    pub sequence: u64,
+}
+
 /// The tool: its Inner Sphere Tree, centre of mass and material.
 #[derive(Clone, Debug)]
 pub struct ToolSpec {

@@ -189,3 +189,42 @@ fn objects_move_and_are_named(rendering: Rendering) {
     assert!(matches!(rig.set_object_pose(9, away(0.0)), Err(haptic_rig::RigError::UnknownObject(9))));
     assert!(rig.stop().is_some());
 }
+
+/// Two slabs watched against each other (no tool in it): apart, then one moved half into the other, then
+/// away; replacing one keeps the watch, removing one ends it; a pair with itself or an unknown object is
+/// refused.
+#[test]
+fn a_watcher_between_two_objects_sees_them_overlap_where_the_game_moved_them() {
+    let rig = resting_rig(Rendering::Coupled, HapticEvents::default());
+    let at = |x: f32| Pose::from_translation(Vec3::new(x, 0.2, 0.0));
+    rig.add_object(ObjectSpec { pose: at(0.5), ..utils::slab_object(1) }).expect("add");
+    rig.add_object(ObjectSpec { pose: at(-0.5), ..utils::slab_object(2) }).expect("add");
+    rig.watch_pair(1, 2).expect("watch");
+    rig.watch_pair(2, 1).expect("the same pair again is no new watcher");
+    assert!(matches!(rig.watch_pair(1, 1), Err(haptic_rig::RigError::SamePair(1))));
+    assert!(matches!(rig.watch_pair(1, 9), Err(haptic_rig::RigError::UnknownObject(9))));
+    let pairs = || {
+        let mut out = Vec::new();
+        rig.pair_contacts(&mut out);
+        out
+    };
+    let measured = |touching: bool| {
+        let p = pairs();
+        p.len() == 1 && p[0].sequence > 0 && p[0].touching == touching && (p[0].a, p[0].b) == (1, 2)
+    };
+    assert!(eventually(|| measured(false)), "apart: {:?}", pairs());
+    // Half of slab 2 (10 cm wide) inside slab 1: 5 x 2 x 10 cm overlap, 1e-4 m³.
+    rig.set_object_pose(2, at(0.45)).expect("move");
+    assert!(eventually(|| measured(true)), "overlapping: {:?}", pairs());
+    let volume = pairs()[0].volume_m3;
+    assert!((0.5e-4..2e-4).contains(&volume), "overlap {volume} m³");
+    rig.set_object_pose(2, at(-0.5)).expect("move");
+    assert!(eventually(|| measured(false)), "apart again: {:?}", pairs());
+    // Replaced (a new tree under the same id, placed over slab 1): still watched.
+    rig.add_object(ObjectSpec { pose: at(0.45), ..utils::slab_object(2) }).expect("replace");
+    assert!(eventually(|| measured(true)), "the replaced slab is still watched: {:?}", pairs());
+    rig.remove_object(1).expect("remove");
+    assert!(pairs().is_empty(), "removing an object ends its watchers");
+    rig.unwatch_pair(1, 2).expect("nothing left to unwatch is no error");
+    assert!(rig.stop().is_some());
+}
