@@ -280,7 +280,7 @@ impl Haptics<'_> {
     pub fn steer(&mut self, goal: HandGoal) {
         let map = self.bench.map;
         if let Some(hand) = self.hand.as_mut() {
-            hand.set(crate::explore::to_device(&map, goal));
+            hand.set(device::to_device(&map, goal));
         }
     }
 

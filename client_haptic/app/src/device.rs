@@ -184,6 +184,23 @@ pub fn open(choice: &DeviceChoice, specs: DeviceSpecs) -> Result<Opened, ClientE
     Ok(Opened { device: opened.device, hand: opened.hand, health: DeviceHealth(opened.link) })
 }
 
+/// The pose a goal asks for, in the device frame of `map`.
+pub fn to_device(map: &haptic_rig::WorkspaceMap, goal: HandGoal) -> HandGoal {
+    let d = |p: Vec3| map.to_device(&haptic_common::Pose::from_translation(p)).translation;
+    match goal {
+        HandGoal::Hold(p) => HandGoal::Hold(map.to_device(&p)),
+        HandGoal::Line { from, to, duration_s, start_us } => {
+            HandGoal::Line { from: d(from), to: d(to), duration_s, start_us }
+        }
+        HandGoal::Orbit { centre, radius, start_rad, period_s, turns, start_us } => {
+            HandGoal::Orbit { centre: d(centre), radius: radius / map.scale, start_rad, period_s, turns, start_us }
+        }
+        HandGoal::Taps { centre, r_out, r_in, n, tap_s, start_us } => {
+            HandGoal::Taps { centre: d(centre), r_out: r_out / map.scale, r_in: r_in / map.scale, n, tap_s, start_us }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -28,11 +28,10 @@
 use std::f32::consts::TAU;
 
 use glam::Vec3;
-use haptic_common::Pose;
 use haptic_rig::ForceSample;
 use heist_shared::artifact::{self, ArtifactKind, Briefing, MaterialClass};
 
-use crate::device::HandGoal;
+use crate::device::{HandGoal, to_device};
 use crate::haptics::TOOL_DIAMETER_M;
 use crate::touch_bench::TouchBench;
 
@@ -808,23 +807,6 @@ fn lowest_run_middle(profile: &[f32]) -> usize {
         }
     }
     if best.1 == 0 { 0 } else { (best.0 + best.1 / 2) % n }
-}
-
-/// The pose a goal asks for, in the device frame of `map`.
-pub fn to_device(map: &haptic_rig::WorkspaceMap, goal: HandGoal) -> HandGoal {
-    let d = |p: Vec3| map.to_device(&Pose::from_translation(p)).translation;
-    match goal {
-        HandGoal::Hold(p) => HandGoal::Hold(map.to_device(&p)),
-        HandGoal::Line { from, to, duration_s, start_us } => {
-            HandGoal::Line { from: d(from), to: d(to), duration_s, start_us }
-        }
-        HandGoal::Orbit { centre, radius, start_rad, period_s, turns, start_us } => {
-            HandGoal::Orbit { centre: d(centre), radius: radius / map.scale, start_rad, period_s, turns, start_us }
-        }
-        HandGoal::Taps { centre, r_out, r_in, n, tap_s, start_us } => {
-            HandGoal::Taps { centre: d(centre), r_out: r_out / map.scale, r_in: r_in / map.scale, n, tap_s, start_us }
-        }
-    }
 }
 
 #[cfg(test)]

@@ -34,7 +34,7 @@ fn main() {
         app.add_systems(Startup, |mut commands: Commands| {
             support::camera(&mut commands, Vec3::new(0.1, 0.08, 0.15), Vec3::ZERO)
         })
-        .add_systems(Update, (support::keyboard_hand, support::show_tool));
+        .add_systems(Update, (support::keyboard_hand, support::mouse_hand, support::show_tool));
     }
     app.add_observer(|c: On<ContactStarted>| info!("the tool reached the floor ({} sphere pairs)", c.contact.pairs));
     app.run();

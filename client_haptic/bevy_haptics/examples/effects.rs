@@ -27,7 +27,7 @@ fn main() {
         app.add_systems(Startup, |mut commands: Commands| {
             support::camera(&mut commands, Vec3::new(0.0, 0.12, 0.25), Vec3::new(0.0, HEIGHT, 0.0))
         })
-        .add_systems(Update, (support::keyboard_hand, support::show_tool));
+        .add_systems(Update, (support::keyboard_hand, support::mouse_hand, support::show_tool));
     }
     app.run();
 }

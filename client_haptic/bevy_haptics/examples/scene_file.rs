@@ -34,7 +34,7 @@ fn main() {
             .add_systems(Startup, |mut commands: Commands| {
                 support::camera(&mut commands, Vec3::new(0.08, -0.01, 0.15), Vec3::new(0.0, -0.08, 0.0));
             })
-            .add_systems(Update, (support::keyboard_hand, support::show_tool));
+            .add_systems(Update, (support::keyboard_hand, support::mouse_hand, support::show_tool));
     }
     app.run();
 }

@@ -24,7 +24,7 @@ fn main() {
         app.add_systems(Startup, |mut commands: Commands| {
             support::camera(&mut commands, Vec3::new(0.15, 0.15, 0.25), Vec3::new(0.0, 0.05, 0.0))
         })
-        .add_systems(Update, (support::keyboard_hand, support::show_tool));
+        .add_systems(Update, (support::keyboard_hand, support::mouse_hand, support::show_tool));
     }
     app.run();
 }

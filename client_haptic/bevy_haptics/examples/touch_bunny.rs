@@ -1,6 +1,7 @@
 //! Feel the Stanford bunny with a simulated Phantom Desktop (3-DOF: the tip is held on the surface by a
-//! proxy). With a window, move the hand with the arrows and PageUp / PageDown; the red line is the force
-//! on the device. `-- --headless --seconds 5` follows a scripted stroke over the bunny's back instead.
+//! proxy). With a window, move the hand with the arrows and PageUp / PageDown, or drag it with the left
+//! mouse button (the wheel moves it up and down); the red line is the force on the device.
+//! `-- --headless --seconds 5` follows a scripted stroke over the bunny's back instead.
 
 mod support;
 
@@ -25,7 +26,8 @@ fn main() {
         app.add_systems(Update, stroke);
     }
     if !run.headless {
-        app.add_systems(Startup, scenery).add_systems(Update, (support::keyboard_hand, support::show_tool));
+        app.add_systems(Startup, scenery)
+            .add_systems(Update, (support::keyboard_hand, support::mouse_hand, support::show_tool));
     }
     app.run();
 }

@@ -130,6 +130,28 @@ fn screenshot(run: Res<Run>, mut commands: Commands, mut frames: Local<u32>, mut
     }
 }
 
+/// Moves the simulated hand with the mouse (windowed): dragging with the left button moves it in the
+/// horizontal plane (a quarter of a millimetre a pixel, right and towards the viewer as the mouse goes
+/// right and down), the wheel up and down (5 mm a line).
+pub fn mouse_hand(
+    buttons: Res<ButtonInput<MouseButton>>,
+    motion: Res<bevy::input::mouse::AccumulatedMouseMotion>,
+    scroll: Res<bevy::input::mouse::AccumulatedMouseScroll>,
+    hand: Option<ResMut<SimulatedHand>>,
+) {
+    let Some(mut hand) = hand else { return };
+    let drag = if buttons.pressed(MouseButton::Left) { motion.delta } else { Vec2::ZERO };
+    let lines = match scroll.unit {
+        bevy::input::mouse::MouseScrollUnit::Line => scroll.delta.y,
+        bevy::input::mouse::MouseScrollUnit::Pixel => scroll.delta.y / 20.0,
+    };
+    let step = Vec3::new(drag.x * 0.000_25, lines * 0.005, drag.y * 0.000_25);
+    if step != Vec3::ZERO {
+        let at = hand.goal().sample(hand.now_us()).translation;
+        hand.set(HandGoal::Hold(bevy_haptics::libs::haptic_common::Pose::from_translation(at + step)));
+    }
+}
+
 /// Moves the simulated hand with the keyboard (windowed): arrows in the horizontal plane, PageUp and
 /// PageDown up and down, 5 cm/s.
 pub fn keyboard_hand(keys: Res<ButtonInput<KeyCode>>, hand: Option<ResMut<SimulatedHand>>, time: Res<Time>) {
