@@ -37,6 +37,12 @@ const WINDOW_US: u64 = 1_000_000;
 /// (with an `AssetPlugin` if the app has none), the gemstone tool, the [`Bench`] and the [`LoopRates`].
 /// The threads start with the app (`PostStartup`).
 pub fn add_haptics(app: &mut App, settings: &HapticsSettings) -> Result<(), ClientError> {
+    if let Some(path) = &settings.record {
+        // bevy_haptics writes the trace once the threads start; a file that cannot be written is said
+        // now, on one line, before anything starts.
+        std::fs::File::create(path)
+            .map_err(|e| ClientError::Device(format!("recording the device: trace file {}: {e}", path.display())))?;
+    }
     let preset = device::preset(settings.preset.as_deref())?;
     let device::Opened { device, hand, health } = device::open(&settings.device, preset)?;
     let specs = device.specs().clone();
@@ -236,13 +242,10 @@ fn count_rates(frame: Res<HapticFrame>, bench: Res<Bench>, mut rates: ResMut<Loo
     }
 }
 
-/// A client whose haptic threads could not start has nothing to play with: it exits with the reason
-/// (`bevy_haptics` logged it).
+/// A client whose haptic threads could not start has nothing to play with: it exits (`bevy_haptics`
+/// logged why).
 fn stop_without_haptics(status: Res<HapticStatus>, mut exit: MessageWriter<AppExit>) {
-    if status.is_changed()
-        && let HapticStatus::Failed(reason) = &*status
-    {
-        error!("the haptic loop did not start: {reason}");
+    if status.is_changed() && matches!(*status, HapticStatus::Failed(_)) {
         exit.write(AppExit::error());
     }
 }
@@ -294,4 +297,21 @@ impl Haptics<'_> {
 /// Where the stylus's tip is in `frame`, in the scene frame of `map`.
 pub fn stylus(map: &WorkspaceMap, frame: &HapticFrame) -> Vec3 {
     map.to_scene(&frame.device.pose).translation
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_trace_that_cannot_be_written_is_refused_before_anything_starts() {
+        let record = Some(PathBuf::from("/nonexistent-dir/trace.csv"));
+        let mut app = App::new();
+        let err = add_haptics(&mut app, &HapticsSettings { record, ..HapticsSettings::default() })
+            .expect_err("no such directory");
+        let line = err.to_string();
+        assert!(line.contains("recording the device: trace file /nonexistent-dir/trace.csv"), "{line}");
+        assert!(!line.contains('\n'), "one line: {line}");
+        assert!(app.world().get_resource::<Bench>().is_none(), "nothing was set up");
+    }
 }

@@ -1,5 +1,6 @@
 //! What every example shares: `--headless --seconds N` (no window; the simulated device follows the
-//! example's scripted path; one JSON line of the loop's figures at the end), or a window
+//! example's scripted path; one JSON line of the loop's figures at the end), `--realtime-priority P`
+//! (FIFO priority for the haptic and collision threads: needs the right to use it), or a window
 //! (`--screenshot PNG`: save the window after 120 frames and quit; T cycles the trees' depth).
 // Each example uses part of this module.
 #![allow(dead_code)]
@@ -21,12 +22,14 @@ pub struct Run {
     pub seconds: Option<f32>,
     /// Save the window to this PNG after 120 frames, then quit.
     pub screenshot: Option<&'static str>,
+    /// Real-time FIFO priority for the haptic thread (the collision thread gets one less), 1..=99.
+    pub realtime_priority: Option<i32>,
 }
 
 impl Run {
     /// Reads the command line; a bad argument ends the program with one line saying what is accepted.
     pub fn from_args(name: &'static str) -> Self {
-        let mut run = Self { name, headless: false, seconds: None, screenshot: None };
+        let mut run = Self { name, headless: false, seconds: None, screenshot: None, realtime_priority: None };
         let mut args = std::env::args().skip(1);
         while let Some(arg) = args.next() {
             match arg.as_str() {
@@ -39,9 +42,14 @@ impl Run {
                     Some(path) => run.screenshot = Some(Box::leak(path.into_boxed_str())),
                     None => fail("--screenshot takes the path of a PNG to write"),
                 },
-                other => {
-                    fail(&format!("unknown argument {other:?}: use [--headless] [--seconds N] [--screenshot PNG]"))
-                }
+                "--realtime-priority" => match args.next().and_then(|s| s.parse::<i32>().ok()) {
+                    Some(p) if (1..=99).contains(&p) => run.realtime_priority = Some(p),
+                    _ => fail("--realtime-priority takes a FIFO priority from 1 to 99"),
+                },
+                other => fail(&format!(
+                    "unknown argument {other:?}: use [--headless] [--seconds N] [--screenshot PNG] \
+                     [--realtime-priority 1-99]"
+                )),
             }
         }
         if run.headless && run.seconds.is_none() {
@@ -69,8 +77,15 @@ impl Run {
                 .insert_resource(bevy_haptics::HapticsDebugConfig { tree_depth: None, ..default() })
                 .add_systems(Update, (screenshot, toggle_trees));
         }
-        app.insert_resource(self).add_systems(Update, end);
+        app.insert_resource(self).add_systems(Startup, realtime).add_systems(Update, end);
         app
+    }
+}
+
+/// Gives the threads the real-time priority asked for (`Startup`: before they start in `PostStartup`).
+fn realtime(run: Res<Run>, device: Option<ResMut<HapticDevice>>) {
+    if let (Some(priority), Some(mut device)) = (run.realtime_priority, device) {
+        device.realtime_priority = Some(priority);
     }
 }
 
