@@ -24,7 +24,7 @@ use collette::SignedDistanceGrid;
 use haptic_rig::{ForceSample, Rendering, WorkspaceMap};
 use heist_shared::protocol::{ItemId, WorkbenchCopy};
 
-use crate::device::{self, DeviceHealth, HandGoal};
+use crate::device::{self, HandGoal};
 use crate::error::ClientError;
 use crate::haptics::{
     Built, BuiltCopy, HapticsSettings, OnBench, RateWindow, RigSetup, build_copy, haptic_material, proxy_hard_above,
@@ -44,8 +44,8 @@ pub fn add_haptics(app: &mut App, settings: &HapticsSettings) -> Result<(), Clie
             .map_err(|e| ClientError::Device(format!("recording the device: trace file {}: {e}", path.display())))?;
     }
     let preset = device::preset(settings.preset.as_deref())?;
-    let device::Opened { device, hand, health } = device::open(&settings.device, preset)?;
-    let specs = device.specs().clone();
+    let opened = device::open(&settings.device, preset)?;
+    let specs = opened.device.specs().clone();
     let setup = RigSetup::new(&specs, settings)?;
     let mode = match setup.rendering {
         Rendering::Proxy => RenderingMode::Proxy,
@@ -54,7 +54,6 @@ pub fn add_haptics(app: &mut App, settings: &HapticsSettings) -> Result<(), Clie
     if !app.is_plugin_added::<AssetPlugin>() {
         app.add_plugins(AssetPlugin::default());
     }
-    let opened = haptico::choice::Opened { device, hand, link: health.0 };
     app.insert_resource(HapticDevice {
         scale: setup.map.scale,
         realtime_priority: settings.realtime_priority,
@@ -86,8 +85,6 @@ pub struct Bench {
     pub stiffness_scale: f32,
     /// Device frame to scene (the workbench frame).
     pub map: WorkspaceMap,
-    /// Whether the device renders torque.
-    pub device_torque: bool,
     /// The gem's packed volume at the reference depth, m³ (see [`haptic_material`]).
     pub tool_reference_volume_m3: f32,
     spheres: usize,
@@ -112,7 +109,6 @@ impl Bench {
             rendering: setup.rendering,
             stiffness_scale: setup.stiffness_scale,
             map: setup.map,
-            device_torque: setup.device_torque,
             tool_reference_volume_m3: setup.tool_reference_volume_m3,
             spheres: settings.spheres,
             cache_dir: settings.cache_dir.clone(),
@@ -143,19 +139,9 @@ impl Bench {
         self.to_despawn.extend(self.copy.take());
     }
 
-    /// The copy whose tree is being built.
-    pub fn building(&self) -> Option<ItemId> {
-        self.building.as_ref().map(|b| b.item)
-    }
-
     /// Whether `item` is on the bench, ready to feel.
     pub fn holds(&self, item: ItemId) -> bool {
         self.on_bench.as_ref().is_some_and(|o| o.item == item)
-    }
-
-    /// Whether 6-DOF torques reach the device.
-    pub fn renders_torque(&self) -> bool {
-        self.device_torque && self.rendering != Rendering::Proxy
     }
 
     /// With proxy rendering, the resting force over depth (N/m) above which a copy feels hard; `None`
@@ -164,10 +150,6 @@ impl Bench {
         proxy_hard_above(self.rendering, self.stiffness_scale)
     }
 }
-
-/// The copy marker on its collider entity.
-#[derive(Component, Clone, Copy, Debug, PartialEq, Eq)]
-pub struct CopyOnBench(pub ItemId);
 
 /// A copy's tree reached the collision thread, or could not be built (why).
 #[derive(Message, Clone, Debug, PartialEq)]
@@ -198,7 +180,7 @@ fn land_copies(
         let surface_bytes = surface.as_ref().map(SignedDistanceGrid::memory_bytes);
         let tree = surface.into_iter().fold(SphereTree::new(tree), SphereTree::with_surface);
         let collider = HapticCollider::new(trees.add(tree));
-        let copy = (Name::new(format!("copy {}", item.0)), CopyOnBench(item), collider, material, Transform::IDENTITY);
+        let copy = (Name::new(format!("copy {}", item.0)), collider, material, Transform::IDENTITY);
         bench.copy = Some(commands.spawn(copy).id());
         let on = OnBench { item, since_us: frame.now_us, spheres, cached, surface_bytes };
         bench.on_bench = Some(on.clone());
@@ -289,8 +271,8 @@ impl Haptics<'_> {
 
     /// What the device's link and the safety layer say now, for the [`device::Guide`].
     pub fn device_reading(&self) -> device::Reading {
-        let link = self.link.as_ref().map(|l| DeviceHealth(l.0.clone())).unwrap_or_default();
-        device::Reading { outside_workspace: self.frame.outside_workspace, ..link.reading() }
+        let link = self.link.as_ref().map_or_else(device::Reading::default, |l| device::reading(&l.0));
+        device::Reading { outside_workspace: self.frame.outside_workspace, ..link }
     }
 }
 

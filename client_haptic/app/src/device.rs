@@ -2,11 +2,12 @@
 //!
 //! You need this module to open the device named on the command line (`sim`, `trace:FILE`,
 //! `hid[:PATH]`, `falcon[:FIRMWARE]`, `haply[:URL]`: haptico's [`DeviceChoice`], opened by haptico), to check a real one before a session and watch it
-//! during one ([`check`], [`DeviceHealth`]), and, with the sim device, to move its hand from the keyboard or from the bot through
+//! during one ([`check`], [`reading`], [`Guide`]), and, with the sim device, to move its hand from the keyboard or from the bot through
 //! a [`HandControl`] (latest [`HandGoal`] through a triple buffer: the haptic thread never waits).
 
 use glam::Vec3;
-use haptico::{Device, DeviceLink, DeviceSpecs};
+use haptico::choice::Opened;
+use haptico::{DeviceLink, DeviceSpecs};
 
 use crate::error::ClientError;
 
@@ -28,10 +29,6 @@ pub fn preset(name: Option<&str>) -> Result<DeviceSpecs, ClientError> {
     }
 }
 
-/// What a real device's I/O thread tells of its link (haptico's [`DeviceLink`]), watched during a session.
-#[derive(Clone, Debug, Default)]
-pub struct DeviceHealth(pub DeviceLink);
-
 /// What the link says now, for a [`Guide`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Reading {
@@ -51,28 +48,26 @@ pub const BACK_TO_THE_MIDDLE: &str =
 /// What the player hears when it is back.
 pub const BACK_IN_REACH: &str = "The grip is back in reach: you will feel the copies now.";
 
-impl DeviceHealth {
-    /// The link's state now.
-    pub fn reading(&self) -> Reading {
-        match &self.0 {
-            DeviceLink::Local => Reading::default(),
-            DeviceLink::Falcon(s) => Reading {
-                lost: s.disconnected().then_some(
-                    "The Falcon stopped answering: no force reaches it. Check its cable and power, then start again.",
-                ),
-                // Homing starts once the firmware answers.
-                homed: (s.replies() > 0).then(|| s.homed().iter().all(|&h| h)),
-                outside_workspace: false,
-            },
-            DeviceLink::Haply(s) => Reading {
-                lost: s.disconnected().then_some(
-                    "The Haply service went away: no force reaches the Inverse3. Check that the Haply Inverse \
+/// What a real device's I/O thread tells of its link (haptico's [`DeviceLink`]) now.
+pub fn reading(link: &DeviceLink) -> Reading {
+    match link {
+        DeviceLink::Local => Reading::default(),
+        DeviceLink::Falcon(s) => Reading {
+            lost: s.disconnected().then_some(
+                "The Falcon stopped answering: no force reaches it. Check its cable and power, then start again.",
+            ),
+            // Homing starts once the firmware answers.
+            homed: (s.replies() > 0).then(|| s.homed().iter().all(|&h| h)),
+            outside_workspace: false,
+        },
+        DeviceLink::Haply(s) => Reading {
+            lost: s.disconnected().then_some(
+                "The Haply service went away: no force reaches the Inverse3. Check that the Haply Inverse \
                      Service runs and the Inverse3 is on, then start again.",
-                ),
-                homed: None,
-                outside_workspace: false,
-            },
-        }
+            ),
+            homed: None,
+            outside_workspace: false,
+        },
     }
 }
 
@@ -131,16 +126,6 @@ impl Guide {
     }
 }
 
-/// A device opened for the haptic thread.
-pub struct Opened {
-    /// The device.
-    pub device: Box<dyn Device>,
-    /// With `sim`: what moves its hand.
-    pub hand: Option<HandControl>,
-    /// Its link, to watch.
-    pub health: DeviceHealth,
-}
-
 /// Looks for a real device before a session, quickly (a few seconds at most): what to tell the player to
 /// do when it is there (`None` for simulated, recorded and HID devices, opened as they are), or what is
 /// wrong, to be said before anything else happens.
@@ -177,11 +162,10 @@ pub fn check(choice: &DeviceChoice) -> Result<Option<String>, ClientError> {
     }
 }
 
-/// Opens the chosen device (haptico's [`haptico::choice::open`]). With `sim`, also returns the control
-/// that moves its hand.
+/// Opens the chosen device (haptico's [`haptico::choice::open`]), a simulated hand resting at [`START`]:
+/// the device, with `sim` the control that moves its hand, and its link to watch ([`reading`]).
 pub fn open(choice: &DeviceChoice, specs: DeviceSpecs) -> Result<Opened, ClientError> {
-    let opened = haptico::choice::open(choice, specs, START).map_err(|e| ClientError::Device(e.to_string()))?;
-    Ok(Opened { device: opened.device, hand: opened.hand, health: DeviceHealth(opened.link) })
+    haptico::choice::open(choice, specs, START).map_err(|e| ClientError::Device(e.to_string()))
 }
 
 /// The pose a goal asks for, in the device frame of `map`.
@@ -226,7 +210,7 @@ mod tests {
         let Err(opened) = open(&choice, haptico::presets::inverse3()) else { panic!("opened a closed port") };
         assert_eq!(opened.to_string(), e, "the check and the open say the same");
         assert!(!e.contains('\n') && start.elapsed() < std::time::Duration::from_secs(5), "{:?}", start.elapsed());
-        assert!(DeviceHealth::default().reading().lost.is_none());
+        assert!(reading(&DeviceLink::Local).lost.is_none());
     }
 
     #[test]
@@ -251,7 +235,7 @@ mod tests {
         // A device without homing only ever hears of a loss.
         let mut g = Guide::default();
         assert_eq!(g.next(Reading::default(), 0.0), None);
-        assert_eq!(DeviceHealth::default().reading(), Reading::default());
+        assert_eq!(reading(&DeviceLink::Local), Reading::default());
     }
 
     #[test]

@@ -159,8 +159,6 @@ pub(crate) struct RigSetup {
     pub map: WorkspaceMap,
     /// The gem's packed volume [`REFERENCE_DEPTH_M`] deep in a flat face, m³.
     pub tool_reference_volume_m3: f32,
-    /// Whether the device renders torque.
-    pub device_torque: bool,
 }
 
 impl RigSetup {
@@ -192,8 +190,7 @@ impl RigSetup {
         let mut config = RigConfig { map, rendering, proxy, ..RigConfig::default() };
         config.haptic.realtime_priority = settings.realtime_priority;
         config.collision.realtime_priority = settings.realtime_priority.map(|p| (p - 1).max(1));
-        let device_torque = specs.renders_torque();
-        Ok(Self { tool, config, rendering, stiffness_scale, map, tool_reference_volume_m3, device_torque })
+        Ok(Self { tool, config, rendering, stiffness_scale, map, tool_reference_volume_m3 })
     }
 }
 

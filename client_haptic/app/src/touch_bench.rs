@@ -169,7 +169,7 @@ impl LockstepHaptics {
         }
         let specs = device::preset(settings.preset.as_deref())?;
         let (sim, hand) = SteeredSim::new(specs.clone(), Pose::new(device::START, Quat::IDENTITY));
-        let RigSetup { tool, config, rendering, stiffness_scale, map, tool_reference_volume_m3, .. } =
+        let RigSetup { tool, config, rendering, stiffness_scale, map, tool_reference_volume_m3 } =
             RigSetup::new(&specs, &settings)?;
         let rig = Lockstep::new(sim, tool, &config, 1, None)?;
         let mut bench = Self {

@@ -440,17 +440,15 @@ pub(crate) fn forget_colliders(
     let Some((runtime, watched)) = threads.get() else { return };
     let tool = tools.iter().next().unwrap_or(Entity::PLACEHOLDER);
     for entity in removed.read() {
-        // The rig ended the object's watchers with it; they start again if it comes back.
-        if let Some(&id) = watched.ids.get(&entity) {
-            let ended: Vec<_> = watched.pairs.iter().filter(|(_, p)| p.joins(id)).map(|(w, p)| (*w, *p)).collect();
-            for (watcher, pair) in ended {
-                watched.pairs.remove(&watcher);
-                if watched.pairs_touching.remove(&watcher) {
-                    pair_writers.ended(watcher, pair);
-                }
+        let Some(id) = watched.ids.remove(&entity) else { continue };
+        // The rig ends the object's watchers with it; they start again if it comes back.
+        let ended: Vec<_> = watched.pairs.iter().filter(|(_, p)| p.joins(id)).map(|(w, p)| (*w, *p)).collect();
+        for (watcher, pair) in ended {
+            watched.pairs.remove(&watcher);
+            if watched.pairs_touching.remove(&watcher) {
+                pair_writers.ended(watcher, pair);
             }
         }
-        let Some(id) = watched.ids.remove(&entity) else { continue };
         watched.entities.remove(&id);
         if let Some(Err(e)) = runtime.rig(|rig| rig.remove_object(id)) {
             warn!("removing {entity} from the collision thread: {e}");
