@@ -9,14 +9,27 @@ use bevy::prelude::*;
 /// Length of a rate window, µs.
 pub const WINDOW_US: u64 = 100_000;
 
-/// Counts events per [`WINDOW_US`] window and keeps the smallest complete window's rate.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+/// Events in a window at or above which windows are counted together (2 kHz at 100 ms windows).
+const TOP_COUNT: usize = 200;
+
+/// Counts events per [`WINDOW_US`] window and keeps how many complete windows had each rate, so the
+/// slowest window, the median and any quantile can be read (exact below 2 kHz: a window's rate is its
+/// event count × 10 Hz).
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WindowedRate {
     window: Option<u64>,
     count: u32,
     started: bool,
     min_hz: Option<f32>,
     windows: u32,
+    /// Complete windows by their event count (the last entry: [`TOP_COUNT`] events or more).
+    by_count: [u32; TOP_COUNT + 1],
+}
+
+impl Default for WindowedRate {
+    fn default() -> Self {
+        WindowedRate { window: None, count: 0, started: false, min_hz: None, windows: 0, by_count: [0; TOP_COUNT + 1] }
+    }
 }
 
 impl WindowedRate {
@@ -47,6 +60,22 @@ impl WindowedRate {
         let hz = count as f32 * (1e6 / WINDOW_US as f32);
         self.min_hz = Some(self.min_hz.map_or(hz, |m| m.min(hz)));
         self.windows += 1;
+        self.by_count[(count as usize).min(TOP_COUNT)] += 1;
+    }
+
+    /// The rate at or below which a fraction `q` (0–1) of the complete windows ran, Hz (`None` before
+    /// one completed). `quantile_hz(0.5)` is the median window; windows of 2 kHz or more count as 2 kHz.
+    pub fn quantile_hz(&self, q: f32) -> Option<f32> {
+        if self.windows == 0 {
+            return None;
+        }
+        let rank = ((q.clamp(0.0, 1.0) * self.windows as f32).ceil() as u32).max(1);
+        let mut seen = 0;
+        let count = self.by_count.iter().position(|&n| {
+            seen += n;
+            seen >= rank
+        })?;
+        Some(count as f32 * (1e6 / WINDOW_US as f32))
     }
 
     /// The smallest rate of a complete window, Hz (`None` before one completed).
@@ -116,6 +145,10 @@ mod tests {
         (500..501).for_each(|ms| rate.record(ms * 1000));
         assert_eq!(rate.windows(), 4, "100-200, 200-300, 300-400 (silent) and 400-500");
         assert_eq!(rate.min_hz(), Some(0.0));
+        assert_eq!(rate.quantile_hz(0.0), Some(0.0), "the slowest");
+        assert_eq!(rate.quantile_hz(0.5), Some(500.0), "0, 500, 1000, 1000: the second");
+        assert_eq!(rate.quantile_hz(0.75), Some(1000.0));
+        assert_eq!(WindowedRate::default().quantile_hz(0.5), None);
     }
 
     #[test]

