@@ -1,7 +1,9 @@
 //! Steady-state queries and collision steps allocate nothing (the allocator aborts if they do).
 
 use assert_no_alloc::{AllocDisabler, assert_no_alloc};
-use collette::pipeline::{CollisionConfig, CollisionWorld, Command, ObjectId, TimedPose, WatcherId, WatcherOutput};
+use collette::pipeline::{
+    CollisionConfig, CollisionWorld, Command, ObjectId, ObjectPose, PoseTrack, TimedPose, WatcherId, WatcherOutput,
+};
 use collette::shape::box_buffers;
 use collette::{
     Budget, BuildOptions, CoherentOverlap, ContactSet, Pose, QueryWorkspace, SignedDistanceGrid, TriMesh, build,
@@ -52,8 +54,8 @@ fn queries_and_collision_steps_do_not_allocate_once_warmed_up() {
     let config = CollisionConfig::default();
     let mut world = CollisionWorld::new(&config);
     let shared = Arc::new(tree.clone());
-    let (mut tool_in, tool_out) = triple_buffer::triple_buffer(&TimedPose::default());
-    let (_, target_out) = triple_buffer::triple_buffer(&TimedPose::default());
+    let (mut tool_in, tool_out) = triple_buffer::triple_buffer(&ObjectPose::default());
+    let (mut target_in, target_out) = triple_buffer::triple_buffer(&ObjectPose::default());
     let (contacts_in, mut contacts_out) = triple_buffer::triple_buffer(&ContactSet::new());
     let mut retired = Vec::new();
     world.apply(Command::AddObject(ObjectId(0), shared.clone(), tool_out), &mut |r| retired.push(r));
@@ -62,19 +64,29 @@ fn queries_and_collision_steps_do_not_allocate_once_warmed_up() {
         Command::AddWatcher(WatcherId(0), ObjectId(0), ObjectId(1), WatcherOutput::Contacts(Box::new(contacts_in))),
         &mut |r| retired.push(r),
     );
-    tool_in.write(TimedPose { pose: pb, timestamp_us: 5, reach: 0.0 });
-    world.step(None);
+    tool_in.write(TimedPose { pose: pb, timestamp_us: 5, reach: 0.0 }.into());
+    world.step(10, None);
     assert_no_alloc(|| {
-        world.step(None);
-        world.step(Some(Instant::now() + Duration::from_micros(100)));
+        world.step(11, None);
+        world.step(12, Some(Instant::now() + Duration::from_micros(100)));
     });
     let latest = contacts_out.read();
     assert!(latest.total_volume > 0.0 && latest.sequence == 3 && latest.timestamp_us == 0);
     // The target measured against its surface grid.
     world.apply(Command::SetSurface(ObjectId(1), Some(Arc::new(grid.clone()))), &mut |r| retired.push(r));
     assert_no_alloc(|| {
-        world.step(None);
-        world.step(Some(Instant::now() + Duration::from_micros(100)));
+        world.step(13, None);
+        world.step(14, Some(Instant::now() + Duration::from_micros(100)));
     });
     assert!(contacts_out.read().total_volume > 0.0 && contacts_out.read().sequence == 5);
+    // The target moved by a track, read at each step's time.
+    let mut track = PoseTrack::default();
+    track.push(Pose::IDENTITY, 0);
+    track.push(Pose::from_translation(Vec3::X * 0.01), 16_000);
+    target_in.write(ObjectPose::Track(track));
+    assert_no_alloc(|| {
+        world.step(30_000, None);
+        world.step(31_000, Some(Instant::now() + Duration::from_micros(100)));
+    });
+    assert!(contacts_out.read().total_volume > 0.0 && contacts_out.read().sequence == 7);
 }

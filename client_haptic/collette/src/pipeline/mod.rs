@@ -9,19 +9,25 @@
 //! thread); objects, trees and watchers can be added, replaced and removed while it runs, and it can be
 //! paused. The thread never locks or allocates: commands and retired objects travel through
 //! fixed-capacity ring buffers (the return ring sized so that it cannot fill), poses and results through
-//! triple buffers, step timings through a bounded ring. The core, [`CollisionWorld`], takes the deadline
+//! triple buffers, step timings through a bounded ring. An object the game moves can be given its last
+//! poses with their times ([`PoseTrack`]): each step reads it at the step's time, so it moves smoothly
+//! between the game's frames. Each step first finds the objects whose bounds overlap (sweep and prune),
+//! so that watched pairs far apart cost no query. The core, [`CollisionWorld`], takes the deadline
 //! as input; [`pipeline`] gives a [`CollisionStepper`] to step by hand in tests and lockstep runs.
 
+mod broad;
 mod thread;
+mod track;
 mod world;
 
 pub use thread::{
     CollisionHandle, CollisionStepper, CollisionThread, ContactReader, FixedRate, NearReader, Pacer, PoseWriter,
     StepTiming, WatcherReader, pipeline,
 };
+pub use track::{PoseTrack, TRACK_SAMPLES, TrackTiming, TrackedMotion};
 pub use world::{
-    CollisionConfig, CollisionWorld, Command, MAX_NEAR_SPHERES, NearSphere, NearSpheres, ObjectId, Retired, StepReport,
-    TimedPose, WatcherId, WatcherOutput,
+    CollisionConfig, CollisionWorld, Command, MAX_NEAR_SPHERES, NearSphere, NearSpheres, ObjectId, ObjectPose, Retired,
+    StepReport, TimedPose, WatcherId, WatcherOutput,
 };
 
 pub use haptic_common::ContactSet;

@@ -5,9 +5,10 @@
 //! [`CollisionThread`] runs a stepper on its own thread, paced by a [`Pacer`]; tests and lockstep
 //! simulations call the stepper by hand.
 
+use super::track::PoseTrack;
 use super::world::{
-    CollisionConfig, CollisionWorld, Command, NearSpheres, ObjectId, Retired, StepReport, TimedPose, WatcherId,
-    WatcherOutput,
+    CollisionConfig, CollisionWorld, Command, NearSpheres, ObjectId, ObjectPose, Retired, StepReport, TimedPose,
+    WatcherId, WatcherOutput,
 };
 use crate::bounding_volume::Aabb;
 use crate::partitioning::InnerSphereTree;
@@ -21,7 +22,7 @@ use std::time::{Duration, Instant};
 /// Writes an object's latest pose (lock-free); give it to whichever thread moves the object.
 pub struct PoseWriter {
     id: ObjectId,
-    input: triple_buffer::Input<TimedPose>,
+    input: triple_buffer::Input<ObjectPose>,
 }
 
 impl PoseWriter {
@@ -32,12 +33,18 @@ impl PoseWriter {
 
     /// Publishes a new pose sampled at `timestamp_us`. Never blocks or allocates.
     pub fn set(&mut self, pose: Pose, timestamp_us: u64) {
-        self.input.write(TimedPose { pose, timestamp_us, reach: 0.0 });
+        self.input.write(TimedPose { pose, timestamp_us, reach: 0.0 }.into());
     }
 
     /// Publishes a new pose with the reach of the near watchers whose A object this is.
     pub fn set_with_reach(&mut self, pose: Pose, timestamp_us: u64, reach: f32) {
-        self.input.write(TimedPose { pose, timestamp_us, reach });
+        self.input.write(TimedPose { pose, timestamp_us, reach }.into());
+    }
+
+    /// Publishes a moving object's last poses with their times (on the stepper's clock): each step
+    /// reads the track at its own time. Never blocks or allocates.
+    pub fn set_track(&mut self, track: &PoseTrack) {
+        self.input.write(ObjectPose::Track(*track));
     }
 }
 
@@ -75,6 +82,12 @@ pub struct StepTiming {
     pub period_us: u32,
     /// Time spent applying commands and querying, µs.
     pub work_us: u32,
+    /// Part of it spent reading poses and in the broad phase, ns.
+    pub broad_ns: u32,
+    /// Watched pairs queried.
+    pub queried: u32,
+    /// Watched pairs the broad phase found apart.
+    pub culled: u32,
     /// Contacts (or near spheres) found.
     pub contacts: u32,
     /// True when the budget cut a query short.
@@ -154,7 +167,7 @@ impl CollisionStepper {
         if self.world.paused() {
             return StepReport::default();
         }
-        let report = self.world.step(budgeted.then(|| start + self.budget));
+        let report = self.world.step(start_us, budgeted.then(|| start + self.budget));
         let end_us = now_us().max(start_us);
         let period_us = self.last_start_us.map_or(0, |s| start_us.saturating_sub(s)) as u32;
         self.last_start_us = Some(start_us);
@@ -163,6 +176,9 @@ impl CollisionStepper {
             start_us,
             period_us,
             work_us: (end_us - start_us) as u32,
+            broad_ns: report.broad_ns,
+            queried: report.queried,
+            culled: report.culled,
             contacts: report.contacts,
             budget_hit: report.budget_hit,
         });
@@ -263,7 +279,7 @@ impl CollisionHandle {
     pub fn add_object_at(&mut self, tree: Arc<InnerSphereTree>, pose: TimedPose) -> Option<PoseWriter> {
         self.collect_retired();
         let id = ObjectId(self.free_objects.pop()?);
-        let (input, output) = triple_buffer::triple_buffer(&pose);
+        let (input, output) = triple_buffer::triple_buffer(&ObjectPose::Timed(pose));
         if self.commands.push(Command::AddObject(id, tree, output)).is_err() {
             self.free_objects.push(id.0);
             return None;

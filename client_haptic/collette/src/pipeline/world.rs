@@ -1,5 +1,9 @@
-//! The collision core: objects, watched pairs and one step of checks (no thread, no clock of its own).
+//! The collision core: objects, watched pairs and one step of checks (no thread, no clock of its own):
+//! each step reads every object's pose at the step's time, finds the objects whose bounds overlap (the
+//! broad phase), and queries only the watched pairs among them.
 
+use super::broad::BroadPhase;
+use super::track::PoseTrack;
 use crate::bounding_volume::Aabb;
 use crate::partitioning::InnerSphereTree;
 use crate::query::{Budget, QueryWorkspace, overlap_budgeted, overlap_field_budgeted, spheres_near};
@@ -28,6 +32,30 @@ pub struct TimedPose {
     /// For the A object of a near watcher: how far from its origin the partner's spheres are gathered,
     /// world units (0 otherwise).
     pub reach: f32,
+}
+
+/// What an object's pose buffer holds: a pose with its time (the tool, an object the game places), or
+/// a moving object's [`PoseTrack`], read at each step's time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ObjectPose {
+    /// A pose sampled at a time (see [`TimedPose`]).
+    Timed(TimedPose),
+    /// The last poses of an object the game moves, with their times on the stepper's clock; the step
+    /// uses the pose the track gives at its own time, which never ages (the game's pace is not a
+    /// reason to fade forces out).
+    Track(PoseTrack),
+}
+
+impl Default for ObjectPose {
+    fn default() -> Self {
+        ObjectPose::Timed(TimedPose::default())
+    }
+}
+
+impl From<TimedPose> for ObjectPose {
+    fn from(pose: TimedPose) -> Self {
+        ObjectPose::Timed(pose)
+    }
 }
 
 /// Most spheres a near watcher publishes per step (more are counted in `overflow`, not kept).
@@ -110,7 +138,7 @@ impl NearSpheres {
 /// Sizes and timing of a collision world.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CollisionConfig {
-    /// Object slots (default 64).
+    /// Object slots (default 64; the broad phase keeps a bit per pair of slots).
     pub max_objects: usize,
     /// Watcher slots (default 16).
     pub max_watchers: usize,
@@ -148,7 +176,7 @@ pub enum WatcherOutput {
 /// Changes sent to the world (built on the caller's thread, applied without allocation).
 pub enum Command {
     /// Puts a tree in slot `id`, with the reading end of its pose buffer.
-    AddObject(ObjectId, Arc<InnerSphereTree>, triple_buffer::Output<TimedPose>),
+    AddObject(ObjectId, Arc<InnerSphereTree>, triple_buffer::Output<ObjectPose>),
     /// Gives the object in slot `id` a new tree (its pose buffer stays).
     SetTree(ObjectId, Arc<InnerSphereTree>),
     /// Gives the object in slot `id` a distance grid of its surface (`None`: takes it away): pairs that
@@ -169,7 +197,7 @@ pub enum Command {
 /// What the world hands back to be freed off the real-time thread.
 pub enum Retired {
     /// A removed object (with its surface grid, if it had one).
-    Object(Arc<InnerSphereTree>, triple_buffer::Output<TimedPose>, Option<Arc<SignedDistanceGrid>>),
+    Object(Arc<InnerSphereTree>, triple_buffer::Output<ObjectPose>, Option<Arc<SignedDistanceGrid>>),
     /// A replaced tree.
     Tree(Arc<InnerSphereTree>),
     /// A replaced or taken surface grid.
@@ -181,8 +209,14 @@ pub enum Retired {
 /// What one step did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct StepReport {
-    /// Pairs queried (inside the region, both objects present).
+    /// Pairs queried (inside the region, both objects present, their bounds overlapping).
     pub queried: u32,
+    /// Watched pairs with both objects present that the broad phase found apart (not queried).
+    pub culled: u32,
+    /// Object pairs whose boxes overlap (the broad phase's candidates, watched or not).
+    pub overlapping: u32,
+    /// Time spent reading poses and in the broad phase, ns.
+    pub broad_ns: u32,
     /// Contacts (or near spheres) published over all pairs.
     pub contacts: u32,
     /// True when the deadline cut a query short.
@@ -191,8 +225,48 @@ pub struct StepReport {
 
 struct ObjectSlot {
     tree: Arc<InnerSphereTree>,
-    pose: triple_buffer::Output<TimedPose>,
+    pose: triple_buffer::Output<ObjectPose>,
     surface: Option<Arc<SignedDistanceGrid>>,
+    /// The pose this step uses (read from `pose` at the step's time).
+    now: TimedPose,
+}
+
+impl ObjectSlot {
+    fn new(tree: Arc<InnerSphereTree>, pose: triple_buffer::Output<ObjectPose>) -> Self {
+        Self { tree, pose, surface: None, now: TimedPose::default() }
+    }
+
+    /// Reads the newest pose buffer at `at_us` into `now` (an empty track keeps the last pose).
+    fn read_pose(&mut self, at_us: u64) {
+        self.pose.update();
+        match self.pose.output_buffer() {
+            ObjectPose::Timed(timed) => self.now = *timed,
+            ObjectPose::Track(track) => {
+                if let Some(motion) = track.at(at_us) {
+                    self.now = TimedPose { pose: motion.pose, timestamp_us: u64::MAX, reach: 0.0 };
+                }
+            }
+        }
+    }
+
+    /// A world sphere holding the object: its tree's root bound, or with a surface grid the grid's box
+    /// (the mesh's surface lies a little outside the inner spheres).
+    fn sphere(&self) -> (Vec3, f32) {
+        let (center, radius) = match &self.surface {
+            Some(grid) => (grid.bounds().center(), grid.bounds().extents().length() * 0.5),
+            None => (self.tree.root().bound.center, self.tree.root().bound.radius),
+        };
+        (self.now.pose.transform_point(center), radius)
+    }
+
+    /// The world box holding [`sphere`](Self::sphere) and, for a near watcher's point, its reach.
+    fn bounds(&self) -> Aabb {
+        let (center, radius) = self.sphere();
+        let tree = Aabb::new(center - Vec3::splat(radius), center + Vec3::splat(radius));
+        let (origin, reach) = (self.now.pose.translation, self.now.reach.max(0.0));
+        let reach = Aabb::new(origin - Vec3::splat(reach), origin + Vec3::splat(reach));
+        Aabb::new(tree.min.min(reach.min), tree.max.max(reach.max))
+    }
 }
 
 struct WatcherSlot {
@@ -205,6 +279,7 @@ struct WatcherSlot {
 pub struct CollisionWorld {
     objects: Vec<Option<ObjectSlot>>,
     watchers: Vec<Option<WatcherSlot>>,
+    broad: BroadPhase,
     region: Option<Aabb>,
     workspace: QueryWorkspace,
     on_collision: Delegator<OnCollision>,
@@ -224,6 +299,7 @@ impl CollisionWorld {
         Self {
             objects: (0..config.max_objects).map(|_| None).collect(),
             watchers: (0..config.max_watchers).map(|_| None).collect(),
+            broad: BroadPhase::new(config.max_objects),
             region: None,
             workspace: QueryWorkspace::new(),
             on_collision,
@@ -247,7 +323,7 @@ impl CollisionWorld {
         match command {
             Command::AddObject(id, tree, pose) => {
                 if let Some(slot) = self.objects.get_mut(id.0 as usize) {
-                    if let Some(old) = slot.replace(ObjectSlot { tree, pose, surface: None }) {
+                    if let Some(old) = slot.replace(ObjectSlot::new(tree, pose)) {
                         retire(Retired::Object(old.tree, old.pose, old.surface));
                     }
                 } else {
@@ -294,37 +370,54 @@ impl CollisionWorld {
         }
     }
 
-    /// Checks every watched pair once and publishes its result; stops refining at `deadline` (each
-    /// query gets an equal share of the time left and estimates what it did not traverse). Pairs outside
-    /// the region or with a missing object publish an empty set. A paused world does nothing.
-    pub fn step(&mut self, deadline: Option<Instant>) -> StepReport {
+    /// Checks every watched pair once at `at_us` (on the clock of the objects' tracks) and publishes its
+    /// result; stops refining at `deadline` (each query gets an equal share of the time left and
+    /// estimates what it did not traverse). Only pairs whose bounds overlap inside the region are
+    /// queried; the others, and pairs with a missing object, publish an empty set. A paused world does
+    /// nothing.
+    pub fn step(&mut self, at_us: u64, deadline: Option<Instant>) -> StepReport {
         let mut report = StepReport::default();
         if self.paused {
             return report;
         }
         self.sequence += 1;
-        for o in self.objects.iter_mut().flatten() {
-            o.pose.update();
-        }
-        let mut remaining = self.watchers.iter().flatten().count() as u32;
-        for w in self.watchers.iter_mut().flatten() {
-            // Each pair gets an equal share of what is left of the step, so one deep pair cannot starve the rest.
-            let share = deadline.map(|d| {
-                let now = Instant::now();
-                now + d.saturating_duration_since(now) / remaining.max(1)
+        let broad_start = Instant::now();
+        for (slot, object) in self.objects.iter_mut().enumerate() {
+            let bounds = object.as_mut().map(|o| {
+                o.read_pose(at_us);
+                o.bounds()
             });
-            remaining = remaining.saturating_sub(1);
-            let pair = match (self.objects.get(w.a.0 as usize), self.objects.get(w.b.0 as usize)) {
-                (Some(Some(a)), Some(Some(b))) => Some(Pair::of(a, b, self.region)),
+            self.broad.set(slot, bounds);
+        }
+        self.broad.update();
+        report.overlapping = self.broad.overlapping();
+        report.broad_ns = broad_start.elapsed().as_nanos().min(u32::MAX as u128) as u32;
+        let (objects, broad, region) = (&self.objects, &self.broad, self.region);
+        let mut remaining = self.watchers.iter().flatten().filter(|w| close(objects, broad, region, w)).count() as u32;
+        for w in self.watchers.iter_mut().flatten() {
+            let pair = match (objects.get(w.a.0 as usize), objects.get(w.b.0 as usize)) {
+                (Some(Some(a)), Some(Some(b))) => Some(Pair::of(a, b)),
                 _ => None,
             };
             let timestamp_us = pair.as_ref().map_or(0, |p| p.timestamp_us);
+            let pair = if close(objects, broad, region, w) {
+                pair
+            } else {
+                report.culled += pair.is_some() as u32;
+                None
+            };
+            // Each pair gets an equal share of what is left of the step, so one deep pair cannot starve the rest.
+            let share = pair.as_ref().and(deadline).map(|d| {
+                let now = Instant::now();
+                now + d.saturating_duration_since(now) / remaining.max(1)
+            });
+            remaining = remaining.saturating_sub(pair.is_some() as u32);
             let (ids, sequence) = ((w.a.0, w.b.0), self.sequence);
             match &mut w.out {
                 WatcherOutput::Contacts(out) => {
                     let set = out.input_buffer_mut();
                     set.clear();
-                    if let Some(Pair { a, pa, b, pb, b_surface, inside: true, .. }) = pair {
+                    if let Some(Pair { a, pa, b, pb, b_surface, .. }) = pair {
                         let budget = share.map_or(Budget::Unlimited, Budget::Deadline);
                         let ws = &mut self.workspace;
                         let result = match b_surface {
@@ -345,7 +438,7 @@ impl CollisionWorld {
                 WatcherOutput::Near(out) => {
                     let set = out.input_buffer_mut();
                     set.clear();
-                    if let Some(Pair { pa, b, pb, inside: true, .. }) = pair {
+                    if let Some(Pair { pa, b, pb, .. }) = pair {
                         gather_near(b, &pb.pose, pa.pose.translation, pa.reach, &mut self.workspace, set);
                         report.queried += 1;
                     }
@@ -360,8 +453,26 @@ impl CollisionWorld {
     }
 }
 
-/// A watched pair whose two objects are present: their trees and latest poses, the older pose's time,
-/// and whether both lie in the region.
+/// Whether watcher `w`'s pair must be queried: both objects present, their boxes overlapping (the
+/// broad phase), their bounds close enough for the watcher's kind, and both inside the region.
+fn close(objects: &[Option<ObjectSlot>], broad: &BroadPhase, region: Option<Aabb>, w: &WatcherSlot) -> bool {
+    let (ia, ib) = (w.a.0 as usize, w.b.0 as usize);
+    let (Some(Some(a)), Some(Some(b))) = (objects.get(ia), objects.get(ib)) else { return false };
+    if !broad.overlaps(ia, ib) {
+        return false;
+    }
+    let ((ca, ra), (cb, rb)) = (a.sphere(), b.sphere());
+    let near = match w.out {
+        // B's spheres within reach of A's origin.
+        WatcherOutput::Near(_) => a.now.pose.translation.distance(cb) <= a.now.reach.max(0.0) + rb,
+        WatcherOutput::Contacts(_) => ca.distance(cb) <= ra + rb,
+    };
+    let inside = |(c, r): (Vec3, f32)| region.is_none_or(|box_| box_.intersects_sphere(c, r));
+    near && inside((ca, ra)) && inside((cb, rb))
+}
+
+/// A watched pair whose two objects are present: their trees and this step's poses, and the older
+/// pose's time.
 struct Pair<'a> {
     a: &'a InnerSphereTree,
     pa: TimedPose,
@@ -369,17 +480,11 @@ struct Pair<'a> {
     pb: TimedPose,
     b_surface: Option<&'a SignedDistanceGrid>,
     timestamp_us: u64,
-    inside: bool,
 }
 
 impl<'a> Pair<'a> {
-    fn of(a: &'a ObjectSlot, b: &'a ObjectSlot, region: Option<Aabb>) -> Self {
-        let (pa, pb) = (*a.pose.output_buffer(), *b.pose.output_buffer());
-        let inside = |tree: &InnerSphereTree, pose: &Pose| {
-            region.is_none_or(|r| {
-                r.intersects_sphere(pose.transform_point(tree.root().bound.center), tree.root().bound.radius)
-            })
-        };
+    fn of(a: &'a ObjectSlot, b: &'a ObjectSlot) -> Self {
+        let (pa, pb) = (a.now, b.now);
         Self {
             a: &a.tree,
             pa,
@@ -387,7 +492,6 @@ impl<'a> Pair<'a> {
             pb,
             b_surface: b.surface.as_deref(),
             timestamp_us: pa.timestamp_us.min(pb.timestamp_us),
-            inside: inside(&a.tree, &pa.pose) && inside(&b.tree, &pb.pose),
         }
     }
 }

@@ -45,6 +45,11 @@ impl SignedDistanceGrid {
     /// Largest accepted resolution (voxels along the longest side of the mesh's box).
     pub const MAX_RESOLUTION: usize = 1024;
 
+    /// The box the grid covers (the mesh's box and the margin), in the mesh's frame.
+    pub fn bounds(&self) -> crate::bounding_volume::Aabb {
+        crate::bounding_volume::Aabb::new(self.origin, self.last)
+    }
+
     /// Samples `mesh` with `resolution` voxels along the longest side of its box (150 matches the
     /// packing grid of a 10k-sphere tree). Each value is exact (parry's projection with pseudo-normals).
     pub fn new(mesh: &TriMesh, resolution: usize) -> Result<Self, BuildError> {
