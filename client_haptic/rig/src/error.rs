@@ -21,6 +21,14 @@ pub enum RigError {
     /// A watcher between an object and itself.
     #[error("object {0} cannot be watched against itself")]
     SamePair(u32),
+    /// A pose sample older than the object's newest, or not a number.
+    #[error("object {id}'s pose at {t_us} µs is older than its newest or not finite")]
+    BadSample {
+        /// The object.
+        id: u32,
+        /// The sample's time, µs on the rig's clock.
+        t_us: u64,
+    },
     /// No watched object has this id.
     #[error("no watched object has id {0}")]
     UnknownObject(u32),

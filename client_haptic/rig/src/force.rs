@@ -6,7 +6,7 @@
 //! Everything it touches per tick is preallocated: the watchers' triple buffers, the objects' slots and
 //! the sphere buffer, the rings of changes, the force-sample ring, the coupling and safety state.
 
-use collette::pipeline::{ContactReader, NearReader, PoseWriter};
+use collette::pipeline::{ContactReader, NearReader, PoseTrack, PoseWriter};
 use forcecomp::{
     Ball, BodyMotion, GodObject, Material, ProxyConfig, SafetyLayer, SafetyPhase, SafetyStats, VirtualCoupling,
     volumetric_penalty,
@@ -161,6 +161,10 @@ pub(crate) struct WatchedObject {
     pub(crate) reader: ObjectReader,
     pub(crate) material: Material,
     pub(crate) motion: BodyMotion,
+    /// Its centre of mass in its own frame.
+    pub(crate) center_of_mass: Vec3,
+    /// Its last poses while the game moves it: `motion` is read from it every tick.
+    pub(crate) track: Option<PoseTrack>,
     /// Device time of the tick that started watching it (set by the haptic thread): until its watcher
     /// first publishes, its data is as old as the time since then.
     pub(crate) added_us: u64,
@@ -180,11 +184,16 @@ pub(crate) enum ForceCommand {
         center_of_mass: Vec3,
         material: Material,
     },
-    /// An object the game moved: its new centre of mass and orientation (scene frame).
+    /// An object the game placed: its new centre of mass and orientation (scene frame), at rest.
     Move {
         id: u32,
         center_of_mass: Vec3,
         orientation: glam::Quat,
+    },
+    /// An object the game moves: its track, read every tick.
+    Track {
+        id: u32,
+        track: PoseTrack,
     },
 }
 
@@ -222,6 +231,7 @@ impl ForceStage {
     /// tick's total with the safety layer's output. Allocation-free.
     pub fn on_tick(&mut self, tick: &ForceOnHapticTick) {
         self.apply_commands(tick.device.timestamp_us);
+        self.follow_tracks(tick.device.timestamp_us);
         if self.rendering == Rendering::Proxy {
             return self.on_proxy_tick(tick);
         }
@@ -317,11 +327,31 @@ impl ForceStage {
                 }
                 ForceCommand::Move { id, center_of_mass, orientation } => {
                     if let Some(o) = self.objects.iter_mut().find(|o| o.id == id) {
-                        o.motion.center_of_mass = center_of_mass;
-                        o.motion.orientation = orientation;
+                        o.motion = BodyMotion { orientation, ..BodyMotion::at_rest(center_of_mass) };
+                        o.track = None;
+                    }
+                }
+                ForceCommand::Track { id, track } => {
+                    if let Some(o) = self.objects.iter_mut().find(|o| o.id == id) {
+                        o.track = Some(track);
                     }
                 }
             }
+        }
+    }
+
+    /// Reads every moving object's track at `now_us`: its centre of mass, orientation and velocities
+    /// (the damping and friction see the contact point's velocity).
+    fn follow_tracks(&mut self, now_us: u64) {
+        for o in &mut self.objects {
+            let Some(motion) = o.track.and_then(|t| t.at(now_us)) else { continue };
+            let center_of_mass = motion.pose.transform_point(o.center_of_mass);
+            o.motion = BodyMotion {
+                center_of_mass,
+                orientation: motion.pose.rotation,
+                linear_velocity: motion.velocity_at(center_of_mass),
+                angular_velocity: motion.angular_velocity,
+            };
         }
     }
 
@@ -371,7 +401,9 @@ impl ForceStage {
             tip_radius: self.proxy.tip_radius,
         };
         let scale = self.map.scale.max(f32::MIN_POSITIVE);
-        let velocity = self.map.velocity_to_scene(device.linear_velocity) / scale;
+        // The tip's speed against the surface it is near (a moving object's surface moves too).
+        let surface = nearest.map_or(Vec3::ZERO, |o| o.motion.velocity_at(near));
+        let velocity = (self.map.velocity_to_scene(device.linear_velocity) - surface) / scale;
         let mut force_scene = self.god.update(&config, tip.translation, velocity, balls, scale);
         // Ridges: the spring's push along the surface normal becomes that of the ridged surface.
         let texture = material.and_then(|m| m.texture);

@@ -17,3 +17,5 @@ pub use force::{ForceSample, ObjectContact, ProxyRendering, Rendering, RigTeleme
 pub use rig::{HapticRig, RigConfig, safety_for};
 pub use spec::{MAX_OBJECTS, MAX_PAIR_WATCHERS, ObjectSpec, PairContact, ToolSpec};
 pub use workspace::WorkspaceMap;
+
+pub use collette::pipeline::TrackTiming;

@@ -64,6 +64,12 @@ impl<D: Device> Lockstep<D> {
         self.scene.move_object(id, pose)
     }
 
+    /// Tells where watched object `id` was at `t_us` (see
+    /// [`HapticRig::set_object_pose_at`](crate::HapticRig::set_object_pose_at)).
+    pub fn set_object_pose_at(&mut self, id: u32, pose: haptic_common::Pose, t_us: u64) -> Result<()> {
+        self.scene.move_object_at(id, pose, t_us)
+    }
+
     /// Stops watching object `id`.
     pub fn remove_object(&mut self, id: u32) -> Result<()> {
         self.scene.remove_object(id)

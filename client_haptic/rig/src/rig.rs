@@ -5,7 +5,7 @@
 
 use std::sync::Mutex;
 
-use collette::pipeline::{CollisionHandle, CollisionThread};
+use collette::pipeline::{CollisionHandle, CollisionThread, TrackTiming};
 use forcecomp::{CouplingConfig, GodObject, SafetyConfig, SafetyLayer, VirtualCoupling, Workspace};
 use haptic_common::{Delegator, OnCollision, Pose};
 use haptico::{Device, HapticClock, HapticConfig, HapticEvents, HapticHandle, HapticTelemetry, TickTiming};
@@ -39,6 +39,10 @@ pub struct RigConfig {
     pub proxy: ProxyRendering,
     /// Capacity of the per-tick force-sample ring (default 65 536).
     pub force_sample_capacity: usize,
+    /// How the tracks of objects the game moves are read (see
+    /// [`set_object_pose_at`](HapticRig::set_object_pose_at)): by default 20 ms behind, which suits a
+    /// game sending poses at 60 Hz or faster.
+    pub tracks: TrackTiming,
 }
 
 impl Default for RigConfig {
@@ -53,6 +57,7 @@ impl Default for RigConfig {
             rendering: Rendering::Coupled,
             proxy: ProxyRendering::default(),
             force_sample_capacity: 1 << 16,
+            tracks: TrackTiming::default(),
         }
     }
 }
@@ -102,7 +107,7 @@ impl Parts {
         let (samples_tx, samples_rx) = rtrb::RingBuffer::new(config.force_sample_capacity.max(1));
         let proxy = config.rendering == Rendering::Proxy;
         let balls = if proxy { MAX_OBJECTS * collette::pipeline::MAX_NEAR_SPHERES } else { 0 };
-        let scene = Scene::new(collision, tool_pose.id(), forces_tx, garbage_rx, proxy);
+        let scene = Scene::new(collision, tool_pose.id(), forces_tx, garbage_rx, proxy, config.tracks);
         let stage = ForceStage {
             map: config.map,
             rendering: config.rendering,
@@ -227,6 +232,16 @@ impl<D: Device + 'static> HapticRig<D> {
     /// placement, not a sample of a moving body: it does not age (the data's age stays the tool's).
     pub fn set_object_pose(&self, id: u32, pose: Pose) -> Result<()> {
         self.with_scene(|s| s.move_object(id, pose))
+    }
+
+    /// Tells where watched object `id` was at `t_us` (on [`clock`](Self::clock), scene frame), for an
+    /// object the game moves every frame: both threads read its last poses at their own time (20 ms
+    /// behind by default, [`RigConfig::tracks`]), so a 60 Hz game gives a force that changes every tick,
+    /// not a step per frame, and the object's velocity at the contact feeds the damping. A sample older
+    /// than the newest is refused ([`RigError::BadSample`]); [`set_object_pose`](Self::set_object_pose)
+    /// places it at rest again.
+    pub fn set_object_pose_at(&self, id: u32, pose: Pose, t_us: u64) -> Result<()> {
+        self.with_scene(|s| s.move_object_at(id, pose, t_us))
     }
 
     /// Stops watching object `id`.

@@ -7,7 +7,9 @@
 //! travel through fixed-capacity rings; whatever the threads replace or remove comes back here to be
 //! freed.
 
-use collette::pipeline::{CollisionHandle, ContactReader, ObjectId, PoseWriter, TimedPose, WatcherId};
+use collette::pipeline::{
+    CollisionHandle, ContactReader, ObjectId, PoseTrack, PoseWriter, TimedPose, TrackTiming, WatcherId,
+};
 use forcecomp::BodyMotion;
 use haptic_common::Pose;
 
@@ -27,6 +29,8 @@ struct Entry {
     pose: PoseWriter,
     /// Its centre of mass in its own frame.
     center_of_mass: glam::Vec3,
+    /// Its last poses with their times, while the game moves it (empty: placed).
+    track: PoseTrack,
 }
 
 /// A watcher between two objects, read on the game thread.
@@ -52,6 +56,8 @@ pub(crate) struct Scene {
     forces: rtrb::Producer<ForceCommand>,
     garbage: rtrb::Consumer<Box<WatchedObject>>,
     proxy: bool,
+    /// How moving objects' tracks are read.
+    timing: TrackTiming,
     /// Objects freed since the last `collect_garbage` (the other methods free too, before sending).
     freed: usize,
 }
@@ -64,9 +70,10 @@ impl Scene {
         forces: rtrb::Producer<ForceCommand>,
         garbage: rtrb::Consumer<Box<WatchedObject>>,
         proxy: bool,
+        timing: TrackTiming,
     ) -> Self {
         let (entries, pairs) = (Vec::with_capacity(MAX_OBJECTS), Vec::with_capacity(MAX_PAIR_WATCHERS));
-        Self { collision, tool, entries, pairs, forces, garbage, proxy, freed: 0 }
+        Self { collision, tool, entries, pairs, forces, garbage, proxy, timing, freed: 0 }
     }
 
     /// Watches an object (replaces the one with the same id).
@@ -104,9 +111,18 @@ impl Scene {
             orientation: spec.pose.rotation,
             ..BodyMotion::at_rest(spec.pose.transform_point(local_center))
         };
-        let object = Box::new(WatchedObject { id: spec.id, reader, material: spec.material, motion, added_us: 0 });
+        let object = Box::new(WatchedObject {
+            id: spec.id,
+            reader,
+            material: spec.material,
+            motion,
+            center_of_mass: local_center,
+            track: None,
+            added_us: 0,
+        });
         self.forces.push(ForceCommand::Add(object)).map_err(|_| RigError::QueueFull("haptic"))?;
-        self.entries.push(Entry { id: spec.id, object: pose.id(), watcher, pose, center_of_mass: local_center });
+        let track = PoseTrack::new(self.timing);
+        self.entries.push(Entry { id: spec.id, object: pose.id(), watcher, pose, center_of_mass: local_center, track });
         for (a, b) in rewatch {
             self.watch_pair(a, b)?;
         }
@@ -183,6 +199,22 @@ impl Scene {
         self.forces.push(command).map_err(|_| RigError::QueueFull("haptic"))?;
         // A placement, not a sample: it never ages (see `TimedPose`).
         entry.pose.set(pose, u64::MAX);
+        entry.track.clear();
+        Ok(())
+    }
+
+    /// Adds the pose object `id` had at `t_us` (rig clock) to its track: both threads read the track at
+    /// their own time, so the object moves smoothly between the game's frames, with its velocity.
+    pub(crate) fn move_object_at(&mut self, id: u32, pose: Pose, t_us: u64) -> Result<()> {
+        self.free_returned();
+        let entry = self.entries.iter_mut().find(|e| e.id == id).ok_or(RigError::UnknownObject(id))?;
+        let mut track = entry.track;
+        if !track.push(pose, t_us) {
+            return Err(RigError::BadSample { id, t_us });
+        }
+        self.forces.push(ForceCommand::Track { id, track }).map_err(|_| RigError::QueueFull("haptic"))?;
+        entry.track = track;
+        entry.pose.set_track(&track);
         Ok(())
     }
 
