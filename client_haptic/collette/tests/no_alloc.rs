@@ -2,7 +2,8 @@
 
 use assert_no_alloc::{AllocDisabler, assert_no_alloc};
 use collette::pipeline::{
-    CollisionConfig, CollisionWorld, Command, ObjectId, ObjectPose, PoseTrack, TimedPose, WatcherId, WatcherOutput,
+    CollisionConfig, CollisionWorld, Command, NearSpheres, ObjectId, ObjectPose, PairSummary, PoseTrack, SceneContacts,
+    TimedPose, WatcherId, WatcherOutput,
 };
 use collette::shape::box_buffers;
 use collette::{
@@ -64,7 +65,21 @@ fn queries_and_collision_steps_do_not_allocate_once_warmed_up() {
         Command::AddWatcher(WatcherId(0), ObjectId(0), ObjectId(1), WatcherOutput::Contacts(Box::new(contacts_in))),
         &mut |r| retired.push(r),
     );
-    tool_in.write(TimedPose { pose: pb, timestamp_us: 5, reach: 0.0 }.into());
+    // The same pair through a scene watcher, a scene near watcher and a summary watcher.
+    let (scene_in, mut scene_out) = triple_buffer::triple_buffer(&SceneContacts::default());
+    let (near_in, mut near_out) = triple_buffer::triple_buffer(&NearSpheres::default());
+    let (summary_in, mut summary_out) = triple_buffer::triple_buffer(&PairSummary::default());
+    let outputs = [
+        WatcherOutput::SceneContacts(Box::new(scene_in)),
+        WatcherOutput::SceneNear(Box::new(near_in)),
+        WatcherOutput::Summary(Box::new(summary_in)),
+    ];
+    for (i, out) in outputs.into_iter().enumerate() {
+        world.apply(Command::AddWatcher(WatcherId(1 + i as u32), ObjectId(0), ObjectId(1), out), &mut |r| {
+            retired.push(r)
+        });
+    }
+    tool_in.write(TimedPose { pose: pb, timestamp_us: 5, reach: 0.05 }.into());
     world.step(10, None);
     assert_no_alloc(|| {
         world.step(11, None);
@@ -72,6 +87,9 @@ fn queries_and_collision_steps_do_not_allocate_once_warmed_up() {
     });
     let latest = contacts_out.read();
     assert!(latest.total_volume > 0.0 && latest.sequence == 3 && latest.timestamp_us == 0);
+    // (each with its own share of the last step's time budget)
+    assert!(scene_out.read().total_volume() > 0.0 && summary_out.read().total_volume > 0.0);
+    assert!(!near_out.read().is_empty());
     // The target measured against its surface grid.
     world.apply(Command::SetSurface(ObjectId(1), Some(Arc::new(grid.clone()))), &mut |r| retired.push(r));
     assert_no_alloc(|| {

@@ -1,7 +1,8 @@
 //! A whole scene in the collision pipeline: 256 objects, some moved by the game through pose tracks, a
 //! tool sweeping through them, watchers between the tool and every object and between objects. Every
 //! step's published result is compared with the same query run directly on the same poses, pair by
-//! pair: the broad phase may skip only pairs that have nothing to report.
+//! pair: the broad phase may skip only pairs that have nothing to report. The scene watchers (the tool
+//! against everything, in one buffer) and the summary watchers must say what the per-pair ones say.
 
 use std::sync::Arc;
 
@@ -68,7 +69,7 @@ fn a_tool_sweeping_through_256_objects_finds_every_contact_the_direct_queries_fi
     let tool_tree = tree(box_buffers(Vec3::new(0.06, 0.015, 0.015)));
     let config = CollisionConfig {
         max_objects: OBJECTS + 1,
-        max_watchers: OBJECTS + 64,
+        max_watchers: 2 * OBJECTS + 2 * 64 + 2,
         command_capacity: 1024,
         ..Default::default()
     };
@@ -94,21 +95,31 @@ fn a_tool_sweeping_through_256_objects_finds_every_contact_the_direct_queries_fi
     // The tool against every object, and each object against its right-hand neighbour for 64 of them.
     let mut tool_watchers: Vec<ContactReader> =
         placed.iter().map(|p| handle.add_watcher(tool.id(), p.writer.id()).expect("a watcher slot")).collect();
+    // The same through one scene watcher, and the tool's origin's near spheres per object and for the
+    // whole scene.
+    let mut scene = handle.add_scene_watcher(tool.id()).expect("a watcher slot");
+    let mut near: Vec<_> =
+        placed.iter().map(|p| handle.add_near_watcher(tool.id(), p.writer.id()).expect("a watcher slot")).collect();
+    let mut scene_near = handle.add_scene_near_watcher(tool.id()).expect("a watcher slot");
     let pairs: Vec<(usize, usize)> = (0..64).map(|k| (k * 4, k * 4 + 1)).collect();
     let mut pair_watchers: Vec<ContactReader> = pairs
         .iter()
         .map(|&(a, b)| handle.add_watcher(placed[a].writer.id(), placed[b].writer.id()).expect("a watcher slot"))
         .collect();
+    let mut summaries: Vec<_> = pairs
+        .iter()
+        .map(|&(a, b)| handle.add_summary_watcher(placed[a].writer.id(), placed[b].writer.id()).expect("a slot"))
+        .collect();
 
     let (mut ws, mut direct) = (QueryWorkspace::new(), ContactSet::new());
-    let (mut touched, mut pair_touches, mut culled, mut queried) = (0, 0, 0u64, 0u64);
+    let (mut touched, mut pair_touches, mut culled, mut queried, mut near_spheres) = (0, 0, 0u64, 0u64, 0);
     // The tool sweeps along each row in turn (0.5 m/s), the moving objects bob at 60 Hz frames.
     for step in 0..1500u64 {
         let t_us = step * 1000;
         let row = (step / 100) as f32;
         let x = (step % 100) as f32 * 0.016;
         let tool_pose = Pose::new(Vec3::new(x, row * 0.1 + 0.02, 0.005), Quat::from_rotation_z(0.3));
-        tool.set(tool_pose, t_us);
+        tool.set_with_reach(tool_pose, t_us, 0.02);
         if step % 16 == 0 {
             for p in placed.iter_mut() {
                 if let Some(track) = &mut p.track {
@@ -121,26 +132,45 @@ fn a_tool_sweeping_through_256_objects_finds_every_contact_the_direct_queries_fi
         let report = stepper.step(t_us, false, || t_us);
         culled += report.culled as u64;
         queried += report.queried as u64;
-        for (p, reader) in placed.iter().zip(&mut tool_watchers) {
+        let (scene, scene_near) = (scene.latest(), scene_near.latest());
+        assert_eq!((scene.sequence, scene.overflow, scene_near.overflow), (step + 1, 0, 0));
+        let mut listed = scene.touched().iter();
+        for ((p, reader), near) in placed.iter().zip(&mut tool_watchers).zip(&mut near) {
             let got = reader.latest();
+            if !got.is_empty() || got.total_volume > 0.0 {
+                let touched = listed.next().expect("every touched object is in the scene watcher's set");
+                assert_eq!(touched.object, p.writer.id().0);
+                assert_eq!(scene.contacts_of(touched), got.as_slice(), "step {step}");
+                assert_eq!(touched.total_volume, got.total_volume);
+            }
+            let mine: Vec<_> = scene_near.as_slice().iter().filter(|s| s.object == p.writer.id().0).collect();
+            let theirs: Vec<_> = near.latest().as_slice().iter().collect();
+            assert_eq!(mine, theirs, "step {step}: the scene's near spheres of each object are its own");
+            near_spheres += theirs.len();
             let want = query(&tool_tree, &tool_pose, &p.tree, &p.pose_at(t_us), &mut ws, &mut direct);
             assert_eq!((got.len(), got.total_volume), (direct.len(), want.total_volume), "step {step}");
             assert_eq!(got.sequence, step + 1);
             touched += !got.is_empty() as u32;
         }
-        for (&(a, b), reader) in pairs.iter().zip(&mut pair_watchers) {
+        assert!(listed.next().is_none(), "and no other");
+        for ((&(a, b), reader), summary) in pairs.iter().zip(&mut pair_watchers).zip(&mut summaries) {
             let (pa, pb) = (placed[a].pose_at(t_us), placed[b].pose_at(t_us));
             let want = query(&placed[a].tree, &pa, &placed[b].tree, &pb, &mut ws, &mut direct);
             let got = reader.latest();
             assert_eq!((got.len(), got.total_volume), (direct.len(), want.total_volume), "step {step}: {a}-{b}");
             pair_touches += !got.is_empty() as u32;
+            let summary = summary.latest();
+            assert_eq!((summary.pairs, summary.total_volume), (got.len() as u32, got.total_volume));
         }
     }
     assert!(touched > 300, "the sweep touches objects: {touched} contacts found over the sweep");
     assert!(pair_touches > 1000, "neighbours touch: {pair_touches}");
-    let watched = 1500 * (OBJECTS + pairs.len()) as u64;
+    assert!(near_spheres > 1000, "the tool's origin passes near objects: {near_spheres} spheres over the sweep");
+    // Per step: the tool against each object three times (one watcher each, the scene watcher, the
+    // near watchers and the scene near watcher: four), and each pair twice (contacts and summary).
+    let watched = 1500 * (4 * OBJECTS + 2 * pairs.len()) as u64;
     assert_eq!(culled + queried, watched, "every pair was either queried or culled");
     // The neighbours lean on each other (always queried); the tool is near a few objects at a time.
-    let tool_pairs = 1500 * OBJECTS as u64;
+    let tool_pairs = 4 * 1500 * OBJECTS as u64;
     assert!(culled > tool_pairs * 9 / 10, "most of the tool's pairs are never queried: {culled} of {watched} culled");
 }

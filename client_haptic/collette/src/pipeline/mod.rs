@@ -12,17 +12,21 @@
 //! triple buffers, step timings through a bounded ring. An object the game moves can be given its last
 //! poses with their times ([`PoseTrack`]): each step reads it at the step's time, so it moves smoothly
 //! between the game's frames. Each step first finds the objects whose bounds overlap (sweep and prune),
-//! so that watched pairs far apart cost no query. The core, [`CollisionWorld`], takes the deadline
+//! so that watched pairs far apart cost no query. A scene watcher watches one object (the tool) against
+//! every other in one buffer ([`SceneContacts`]); a summary watcher tells only whether and how much two
+//! objects overlap ([`PairSummary`]). The core, [`CollisionWorld`], takes the deadline
 //! as input; [`pipeline`] gives a [`CollisionStepper`] to step by hand in tests and lockstep runs.
 
 mod broad;
+mod scene;
 mod thread;
 mod track;
 mod world;
 
+pub use scene::{MAX_TOUCHED, PairSummary, SceneContacts, Touched};
 pub use thread::{
     CollisionHandle, CollisionStepper, CollisionThread, ContactReader, FixedRate, NearReader, Pacer, PoseWriter,
-    StepTiming, WatcherReader, pipeline,
+    SceneReader, StepTiming, SummaryReader, WatcherReader, pipeline,
 };
 pub use track::{PoseTrack, TRACK_SAMPLES, TrackTiming, TrackedMotion};
 pub use world::{

@@ -5,6 +5,7 @@
 //! [`CollisionThread`] runs a stepper on its own thread, paced by a [`Pacer`]; tests and lockstep
 //! simulations call the stepper by hand.
 
+use super::scene::{PairSummary, SceneContacts};
 use super::track::PoseTrack;
 use super::world::{
     CollisionConfig, CollisionWorld, Command, NearSpheres, ObjectId, ObjectPose, Retired, StepReport, TimedPose,
@@ -56,8 +57,12 @@ pub struct WatcherReader<T: Send> {
 
 /// Reads a watcher's overlapping sphere pairs.
 pub type ContactReader = WatcherReader<ContactSet>;
-/// Reads a near watcher's spheres.
+/// Reads a near watcher's spheres (or a scene near watcher's).
 pub type NearReader = WatcherReader<NearSpheres>;
+/// Reads a scene watcher's contacts.
+pub type SceneReader = WatcherReader<SceneContacts>;
+/// Reads a summary watcher's overlap.
+pub type SummaryReader = WatcherReader<PairSummary>;
 
 impl<T: Send> WatcherReader<T> {
     /// The watcher this reader belongs to.
@@ -323,6 +328,24 @@ impl CollisionHandle {
     /// reader of the spheres.
     pub fn add_near_watcher(&mut self, a: ObjectId, b: ObjectId) -> Option<NearReader> {
         self.add_any_watcher(a, b, NearSpheres::default(), |input| WatcherOutput::Near(Box::new(input)))
+    }
+
+    /// Watches A against every other object (a tool against a scene): each step queries the objects
+    /// whose bounds touch A's and publishes all their contacts, grouped by object.
+    pub fn add_scene_watcher(&mut self, a: ObjectId) -> Option<SceneReader> {
+        self.add_any_watcher(a, a, SceneContacts::default(), |input| WatcherOutput::SceneContacts(Box::new(input)))
+    }
+
+    /// Watches every other object's spheres near A's origin (A = a point tool, its reach set with its
+    /// pose); each sphere names its object.
+    pub fn add_scene_near_watcher(&mut self, a: ObjectId) -> Option<NearReader> {
+        self.add_any_watcher(a, a, NearSpheres::default(), |input| WatcherOutput::SceneNear(Box::new(input)))
+    }
+
+    /// Watches whether and how much A and B overlap, without their contacts (a few bytes a watcher
+    /// instead of a contact set's 128 kB).
+    pub fn add_summary_watcher(&mut self, a: ObjectId, b: ObjectId) -> Option<SummaryReader> {
+        self.add_any_watcher(a, b, PairSummary::default(), |input| WatcherOutput::Summary(Box::new(input)))
     }
 
     fn add_any_watcher<T: Clone + Send>(

@@ -3,6 +3,7 @@
 //! broad phase), and queries only the watched pairs among them.
 
 use super::broad::BroadPhase;
+use super::scene::{PairSummary, SceneContacts};
 use super::track::PoseTrack;
 use crate::bounding_volume::Aabb;
 use crate::partitioning::InnerSphereTree;
@@ -68,10 +69,13 @@ pub struct NearSphere {
     pub center: Vec3,
     /// Radius.
     pub radius: f32,
+    /// The object whose sphere it is (its slot, as in [`ObjectId`]).
+    pub object: u32,
 }
 
 /// What a near watcher publishes: the B object's inner spheres within reach of the A object's origin
-/// (what a 3-DOF proxy at a point tool's tip needs). Fixed capacity, allocated once.
+/// (what a 3-DOF proxy at a point tool's tip needs), or for a scene near watcher every object's. Fixed
+/// capacity, allocated once.
 #[derive(Clone, Debug)]
 pub struct NearSpheres {
     spheres: Box<[NearSphere]>,
@@ -110,6 +114,7 @@ impl NearSpheres {
     }
 
     /// Adds a sphere; counts it as overflow when full.
+    #[inline]
     pub fn push(&mut self, sphere: NearSphere) {
         if self.len == self.spheres.len() {
             self.overflow += 1;
@@ -171,6 +176,24 @@ pub enum WatcherOutput {
     Contacts(Box<triple_buffer::Input<ContactSet>>),
     /// B's spheres within A's reach of A's origin (3-DOF proxy rendering).
     Near(Box<triple_buffer::Input<NearSpheres>>),
+    /// Whether and how much A and B overlap (no contacts kept).
+    Summary(Box<triple_buffer::Input<PairSummary>>),
+    /// The overlapping sphere pairs of A and every other object (B unused): a tool against a scene.
+    SceneContacts(Box<triple_buffer::Input<SceneContacts>>),
+    /// Every other object's spheres within A's reach of A's origin (B unused).
+    SceneNear(Box<triple_buffer::Input<NearSpheres>>),
+}
+
+impl WatcherOutput {
+    /// True for the kinds that watch A against the whole scene.
+    fn is_scene(&self) -> bool {
+        matches!(self, WatcherOutput::SceneContacts(_) | WatcherOutput::SceneNear(_))
+    }
+
+    /// True for the kinds that gather spheres near A's origin.
+    fn is_near(&self) -> bool {
+        matches!(self, WatcherOutput::Near(_) | WatcherOutput::SceneNear(_))
+    }
 }
 
 /// Changes sent to the world (built on the caller's thread, applied without allocation).
@@ -184,7 +207,8 @@ pub enum Command {
     SetSurface(ObjectId, Option<Arc<SignedDistanceGrid>>),
     /// Empties slot `id`.
     RemoveObject(ObjectId),
-    /// Watches the pair (A, B) in slot `id`, publishing into the writing end of its buffer.
+    /// Watches the pair (A, B) in slot `id` (for a scene output: A against every other object),
+    /// publishing into the writing end of its buffer.
     AddWatcher(WatcherId, ObjectId, ObjectId, WatcherOutput),
     /// Stops watching slot `id`.
     RemoveWatcher(WatcherId),
@@ -282,6 +306,9 @@ pub struct CollisionWorld {
     broad: BroadPhase,
     region: Option<Aabb>,
     workspace: QueryWorkspace,
+    /// One pair's contacts or near spheres, before they join a scene watcher's set.
+    scratch: ContactSet,
+    scratch_near: NearSpheres,
     on_collision: Delegator<OnCollision>,
     paused: bool,
     sequence: u64,
@@ -302,6 +329,8 @@ impl CollisionWorld {
             broad: BroadPhase::new(config.max_objects),
             region: None,
             workspace: QueryWorkspace::new(),
+            scratch: ContactSet::new(),
+            scratch_near: NearSpheres::default(),
             on_collision,
             paused: false,
             sequence: 0,
@@ -392,124 +421,208 @@ impl CollisionWorld {
         self.broad.update();
         report.overlapping = self.broad.overlapping();
         report.broad_ns = broad_start.elapsed().as_nanos().min(u32::MAX as u128) as u32;
-        let (objects, broad, region) = (&self.objects, &self.broad, self.region);
-        let mut remaining = self.watchers.iter().flatten().filter(|w| close(objects, broad, region, w)).count() as u32;
-        for w in self.watchers.iter_mut().flatten() {
-            let pair = match (objects.get(w.a.0 as usize), objects.get(w.b.0 as usize)) {
-                (Some(Some(a)), Some(Some(b))) => Some(Pair::of(a, b)),
+        let sequence = self.sequence;
+        let Self { objects, watchers, broad, region, workspace, scratch, scratch_near, on_collision, .. } = self;
+        let (objects, broad, region) = (&*objects, &*broad, *region);
+        let is_close = |ia: usize, ib: usize, near: bool| close(objects, broad, region, ia, ib, near);
+        // Pairs to query this step, for the budget's shares.
+        let mut remaining: u32 = watchers
+            .iter()
+            .flatten()
+            .map(|w| match w.out.is_scene() {
+                true => (0..objects.len())
+                    .filter(|&b| b != w.a.0 as usize && is_close(w.a.0 as usize, b, w.out.is_near()))
+                    .count() as u32,
+                false => is_close(w.a.0 as usize, w.b.0 as usize, w.out.is_near()) as u32,
+            })
+            .sum();
+        // Each pair gets an equal share of what is left of the step, so one deep pair cannot starve the rest.
+        let share = |remaining: &mut u32| {
+            let d = deadline?;
+            let now = Instant::now();
+            let end = now + d.saturating_duration_since(now) / (*remaining).max(1);
+            *remaining = remaining.saturating_sub(1);
+            Some(end)
+        };
+        for w in watchers.iter_mut().flatten() {
+            let ia = w.a.0 as usize;
+            if w.out.is_scene() {
+                let Some(Some(a)) = objects.get(ia) else {
+                    publish_empty_scene(&mut w.out, w.a.0, sequence, 0);
+                    continue;
+                };
+                let (mut oldest, mut culled, near) = (a.now.timestamp_us, 0, w.out.is_near());
+                match &mut w.out {
+                    WatcherOutput::SceneContacts(out) => {
+                        let set = out.input_buffer_mut();
+                        set.clear();
+                        for (ib, b) in objects.iter().enumerate() {
+                            let Some(b) = b.as_ref().filter(|_| ib != ia) else { continue };
+                            if !is_close(ia, ib, near) {
+                                culled += 1;
+                                continue;
+                            }
+                            let budget = share(&mut remaining).map_or(Budget::Unlimited, Budget::Deadline);
+                            report.budget_hit |= !measure(a, b, budget, workspace, scratch);
+                            report.queried += 1;
+                            oldest = oldest.min(b.now.timestamp_us);
+                            (scratch.object_a, scratch.object_b, scratch.sequence) = (w.a.0, ib as u32, sequence);
+                            scratch.timestamp_us = a.now.timestamp_us.min(b.now.timestamp_us);
+                            if !scratch.is_empty() {
+                                on_collision.broadcast(scratch);
+                            }
+                            set.add(ib as u32, scratch);
+                        }
+                        (set.object, set.sequence, set.timestamp_us) = (w.a.0, sequence, oldest);
+                        report.contacts += set.contacts().len() as u32;
+                        out.publish();
+                    }
+                    WatcherOutput::SceneNear(out) => {
+                        let set = out.input_buffer_mut();
+                        set.clear();
+                        for (ib, b) in objects.iter().enumerate() {
+                            let Some(b) = b.as_ref().filter(|_| ib != ia) else { continue };
+                            if !is_close(ia, ib, near) {
+                                culled += 1;
+                                continue;
+                            }
+                            gather_near(b, a.now.pose.translation, a.now.reach, ib as u32, workspace, scratch_near);
+                            report.queried += 1;
+                            oldest = oldest.min(b.now.timestamp_us);
+                            set.overflow += scratch_near.overflow;
+                            scratch_near.as_slice().iter().for_each(|s| set.push(*s));
+                        }
+                        (set.object_a, set.object_b) = (w.a.0, w.a.0);
+                        (set.sequence, set.timestamp_us) = (sequence, oldest);
+                        report.contacts += set.len() as u32;
+                        out.publish();
+                    }
+                    _ => {}
+                }
+                report.culled += culled;
+                continue;
+            }
+            let ib = w.b.0 as usize;
+            let pair = match (objects.get(ia), objects.get(ib)) {
+                (Some(Some(a)), Some(Some(b))) => Some((a, b)),
                 _ => None,
             };
-            let timestamp_us = pair.as_ref().map_or(0, |p| p.timestamp_us);
-            let pair = if close(objects, broad, region, w) {
+            let timestamp_us = pair.map_or(0, |(a, b)| a.now.timestamp_us.min(b.now.timestamp_us));
+            let pair = if is_close(ia, ib, w.out.is_near()) {
                 pair
             } else {
                 report.culled += pair.is_some() as u32;
                 None
             };
-            // Each pair gets an equal share of what is left of the step, so one deep pair cannot starve the rest.
-            let share = pair.as_ref().and(deadline).map(|d| {
-                let now = Instant::now();
-                now + d.saturating_duration_since(now) / remaining.max(1)
-            });
-            remaining = remaining.saturating_sub(pair.is_some() as u32);
-            let (ids, sequence) = ((w.a.0, w.b.0), self.sequence);
+            report.queried += pair.is_some() as u32;
+            let ids = (w.a.0, w.b.0);
             match &mut w.out {
                 WatcherOutput::Contacts(out) => {
                     let set = out.input_buffer_mut();
                     set.clear();
-                    if let Some(Pair { a, pa, b, pb, b_surface, .. }) = pair {
-                        let budget = share.map_or(Budget::Unlimited, Budget::Deadline);
-                        let ws = &mut self.workspace;
-                        let result = match b_surface {
-                            Some(grid) => overlap_field_budgeted(a, &pa.pose, b, grid, &pb.pose, budget, ws, set),
-                            None => overlap_budgeted(a, &pa.pose, b, &pb.pose, budget, ws, set),
-                        };
-                        report.budget_hit |= !result.complete;
-                        report.queried += 1;
+                    if let Some((a, b)) = pair {
+                        let budget = share(&mut remaining).map_or(Budget::Unlimited, Budget::Deadline);
+                        report.budget_hit |= !measure(a, b, budget, workspace, set);
                     }
                     (set.object_a, set.object_b) = ids;
                     (set.sequence, set.timestamp_us) = (sequence, timestamp_us);
                     report.contacts += set.len() as u32;
                     if !set.is_empty() {
-                        self.on_collision.broadcast(set);
+                        on_collision.broadcast(set);
                     }
                     out.publish();
+                }
+                WatcherOutput::Summary(out) => {
+                    scratch.clear();
+                    if let Some((a, b)) = pair {
+                        let budget = share(&mut remaining).map_or(Budget::Unlimited, Budget::Deadline);
+                        report.budget_hit |= !measure(a, b, budget, workspace, scratch);
+                    }
+                    let (object_a, object_b) = ids;
+                    let (pairs, total_volume) = (scratch.len() as u32, scratch.total_volume);
+                    out.write(PairSummary { object_a, object_b, pairs, total_volume, sequence, timestamp_us });
                 }
                 WatcherOutput::Near(out) => {
                     let set = out.input_buffer_mut();
                     set.clear();
-                    if let Some(Pair { pa, b, pb, .. }) = pair {
-                        gather_near(b, &pb.pose, pa.pose.translation, pa.reach, &mut self.workspace, set);
-                        report.queried += 1;
+                    if let Some((a, b)) = pair {
+                        gather_near(b, a.now.pose.translation, a.now.reach, ids.1, workspace, set);
                     }
                     (set.object_a, set.object_b) = ids;
                     (set.sequence, set.timestamp_us) = (sequence, timestamp_us);
                     report.contacts += set.len() as u32;
                     out.publish();
                 }
+                WatcherOutput::SceneContacts(_) | WatcherOutput::SceneNear(_) => {}
             }
         }
         report
     }
 }
 
-/// Whether watcher `w`'s pair must be queried: both objects present, their boxes overlapping (the
-/// broad phase), their bounds close enough for the watcher's kind, and both inside the region.
-fn close(objects: &[Option<ObjectSlot>], broad: &BroadPhase, region: Option<Aabb>, w: &WatcherSlot) -> bool {
-    let (ia, ib) = (w.a.0 as usize, w.b.0 as usize);
+/// Publishes an empty result for a scene watcher whose object is missing.
+fn publish_empty_scene(out: &mut WatcherOutput, object: u32, sequence: u64, timestamp_us: u64) {
+    match out {
+        WatcherOutput::SceneContacts(out) => {
+            let set = out.input_buffer_mut();
+            set.clear();
+            (set.object, set.sequence, set.timestamp_us) = (object, sequence, timestamp_us);
+            out.publish();
+        }
+        WatcherOutput::SceneNear(out) => {
+            let set = out.input_buffer_mut();
+            set.clear();
+            (set.sequence, set.timestamp_us) = (sequence, timestamp_us);
+            out.publish();
+        }
+        _ => {}
+    }
+}
+
+/// A's spheres against B's tree, or against B's surface grid when it has one, into `set`; false when
+/// the budget cut the query short.
+fn measure(a: &ObjectSlot, b: &ObjectSlot, budget: Budget, ws: &mut QueryWorkspace, set: &mut ContactSet) -> bool {
+    let (pa, pb) = (&a.now.pose, &b.now.pose);
+    let result = match b.surface.as_deref() {
+        Some(grid) => overlap_field_budgeted(&a.tree, pa, &b.tree, grid, pb, budget, ws, set),
+        None => overlap_budgeted(&a.tree, pa, &b.tree, pb, budget, ws, set),
+    };
+    result.complete
+}
+
+/// Whether objects `ia` and `ib` must be queried: both present, their boxes overlapping (the broad
+/// phase), their bounds close enough (`near`: B within A's reach of A's origin; otherwise the two
+/// bounds touching), and both inside the region.
+fn close(
+    objects: &[Option<ObjectSlot>],
+    broad: &BroadPhase,
+    region: Option<Aabb>,
+    ia: usize,
+    ib: usize,
+    near: bool,
+) -> bool {
     let (Some(Some(a)), Some(Some(b))) = (objects.get(ia), objects.get(ib)) else { return false };
     if !broad.overlaps(ia, ib) {
         return false;
     }
     let ((ca, ra), (cb, rb)) = (a.sphere(), b.sphere());
-    let near = match w.out {
-        // B's spheres within reach of A's origin.
-        WatcherOutput::Near(_) => a.now.pose.translation.distance(cb) <= a.now.reach.max(0.0) + rb,
-        WatcherOutput::Contacts(_) => ca.distance(cb) <= ra + rb,
+    let touching = match near {
+        true => a.now.pose.translation.distance(cb) <= a.now.reach.max(0.0) + rb,
+        false => ca.distance(cb) <= ra + rb,
     };
     let inside = |(c, r): (Vec3, f32)| region.is_none_or(|box_| box_.intersects_sphere(c, r));
-    near && inside((ca, ra)) && inside((cb, rb))
+    touching && inside((ca, ra)) && inside((cb, rb))
 }
 
-/// A watched pair whose two objects are present: their trees and this step's poses, and the older
-/// pose's time.
-struct Pair<'a> {
-    a: &'a InnerSphereTree,
-    pa: TimedPose,
-    b: &'a InnerSphereTree,
-    pb: TimedPose,
-    b_surface: Option<&'a SignedDistanceGrid>,
-    timestamp_us: u64,
-}
-
-impl<'a> Pair<'a> {
-    fn of(a: &'a ObjectSlot, b: &'a ObjectSlot) -> Self {
-        let (pa, pb) = (a.now, b.now);
-        Self {
-            a: &a.tree,
-            pa,
-            b: &b.tree,
-            pb,
-            b_surface: b.surface.as_deref(),
-            timestamp_us: pa.timestamp_us.min(pb.timestamp_us),
-        }
-    }
-}
-
-/// Gathers `tree`'s spheres within `reach` of `point` into `set`; when there are more than it holds (a
-/// fine packing), gathers again nearer, so that the nearest are never the ones left out.
-fn gather_near(
-    tree: &InnerSphereTree,
-    pose: &Pose,
-    point: Vec3,
-    reach: f32,
-    ws: &mut QueryWorkspace,
-    set: &mut NearSpheres,
-) {
+/// Gathers object `b`'s spheres within `reach` of `point` into `set` (named `object`); when there are
+/// more than it holds (a fine packing), gathers again nearer, so that the nearest are never the ones
+/// left out.
+fn gather_near(b: &ObjectSlot, point: Vec3, reach: f32, object: u32, ws: &mut QueryWorkspace, set: &mut NearSpheres) {
+    let (tree, pose) = (&b.tree, &b.now.pose);
     let mut reach = reach;
     for _ in 0..4 {
         set.clear();
-        spheres_near(tree, pose, point, reach, ws, |center, radius| set.push(NearSphere { center, radius }));
+        spheres_near(tree, pose, point, reach, ws, |center, radius| set.push(NearSphere { center, radius, object }));
         if set.overflow == 0 {
             break;
         }
