@@ -12,7 +12,7 @@ pub mod texture;
 pub use coupling::{CouplingConfig, VirtualCoupling};
 pub use error::{ForceCompError, Result};
 pub use material::{BodyMotion, Material};
-pub use penalty::volumetric_penalty;
+pub use penalty::{volumetric_penalty, volumetric_penalty_of};
 pub use proxy::{Ball, GodObject, ProxyConfig};
 pub use safety::{SafetyConfig, SafetyLayer, SafetyPhase, SafetyStats, Workspace};
 pub use texture::Texture;

@@ -14,7 +14,7 @@
 //! listing its pairs, the force is scaled by `total_volume / listed volume` (at most ×4).
 
 use glam::Vec3;
-use haptic_common::{ContactSet, ForceTorque};
+use haptic_common::{Contact, ContactSet, ForceTorque};
 
 use crate::{BodyMotion, Material};
 
@@ -34,10 +34,22 @@ pub fn volumetric_penalty(
     object: &BodyMotion,
     material: &Material,
 ) -> ForceTorque {
-    let valid = |c: &&haptic_common::Contact| {
+    volumetric_penalty_of(contacts.as_slice(), contacts.total_volume, tool, object, material)
+}
+
+/// [`volumetric_penalty`] of a slice of contacts whose query measured `total_volume` (e.g. one object's
+/// share of a scene watcher's contacts).
+pub fn volumetric_penalty_of(
+    contacts: &[Contact],
+    total_volume: f32,
+    tool: &BodyMotion,
+    object: &BodyMotion,
+    material: &Material,
+) -> ForceTorque {
+    let valid = |c: &&Contact| {
         c.point.is_finite() && c.normal.is_finite() && c.volume.is_finite() && c.volume > 0.0 && c.normal != Vec3::ZERO
     };
-    let listed: f32 = contacts.as_slice().iter().filter(valid).map(|c| c.volume).sum();
+    let listed: f32 = contacts.iter().filter(valid).map(|c| c.volume).sum();
     if !(listed > 0.0 && listed.is_finite()) {
         return ForceTorque::ZERO;
     }
@@ -47,7 +59,7 @@ pub fn volumetric_penalty(
     let eps_d = material.damping_ns_per_m.max(0.0);
     let mu = material.friction.max(0.0);
     // The normal push of pair `c` and the relative velocity it was computed from.
-    let push = |c: &haptic_common::Contact| {
+    let push = |c: &Contact| {
         let n = c.normal.try_normalize()?;
         let v_rel = tool.velocity_at(c.point) - object.velocity_at(c.point);
         let magnitude = (c.volume * (eps_c - v_rel.dot(n) * eps_d / listed)).max(0.0);
@@ -60,7 +72,7 @@ pub fn volumetric_penalty(
     let mut ridge = None;
     if let Some(t) = material.texture.filter(|t| t.amplitude > 0.0) {
         let (mut normal, mut total, mut centre) = (Vec3::ZERO, 0.0f32, Vec3::ZERO);
-        for c in contacts.as_slice().iter().filter(valid) {
+        for c in contacts.iter().filter(valid) {
             if let Some((n, _, magnitude)) = push(c) {
                 normal += n * magnitude;
                 total += magnitude;
@@ -77,7 +89,7 @@ pub fn volumetric_penalty(
     }
     let mut force = Vec3::ZERO;
     let mut torque = Vec3::ZERO;
-    for c in contacts.as_slice().iter().filter(valid) {
+    for c in contacts.iter().filter(valid) {
         let Some((n, v_rel, magnitude)) = push(c) else { continue };
         let magnitude = magnitude * scale_push;
         let mut f = n * magnitude;
@@ -99,8 +111,8 @@ pub fn volumetric_penalty(
         force += slope;
         torque += (at - tool.center_of_mass).cross(slope);
     }
-    let scale = if contacts.total_volume.is_finite() && contacts.total_volume > listed {
-        (contacts.total_volume / listed).min(MAX_ESTIMATE_SCALE)
+    let scale = if total_volume.is_finite() && total_volume > listed {
+        (total_volume / listed).min(MAX_ESTIMATE_SCALE)
     } else {
         1.0
     };

@@ -49,14 +49,13 @@ impl CollisionConfig {
         (1e9 / self.rate_hz.max(1.0) as f64) as u64
     }
 
-    /// collette's settings for these (objects: the tool and [`MAX_OBJECTS`], one watcher each against the
-    /// tool and [`MAX_PAIR_WATCHERS`] between objects; `budget`
-    /// overrides `budget_us`).
+    /// collette's settings for these (objects: the tool and [`MAX_OBJECTS`]; watchers: the tool's
+    /// against the scene and [`MAX_PAIR_WATCHERS`] between objects; `budget` overrides `budget_us`).
     pub(crate) fn pipeline(&self, budget: Option<Duration>) -> collette::pipeline::CollisionConfig {
         collette::pipeline::CollisionConfig {
             max_objects: MAX_OBJECTS + 1,
-            max_watchers: MAX_OBJECTS + MAX_PAIR_WATCHERS,
-            command_capacity: 64,
+            max_watchers: 1 + MAX_PAIR_WATCHERS,
+            command_capacity: 1024,
             period: Duration::from_nanos(self.period_ns()),
             step_budget: budget.unwrap_or(Duration::from_micros(self.budget_us as u64)),
             timing_capacity: self.timing_capacity.max(1),

@@ -6,16 +6,15 @@
 //! Everything it touches per tick is preallocated: the watchers' triple buffers, the objects' slots and
 //! the sphere buffer, the rings of changes, the force-sample ring, the coupling and safety state.
 
-use collette::pipeline::{ContactReader, NearReader, PoseTrack, PoseWriter};
+use collette::pipeline::{MAX_TOUCHED, NearReader, PoseTrack, PoseWriter, SceneReader};
 use forcecomp::{
     Ball, BodyMotion, GodObject, Material, ProxyConfig, SafetyLayer, SafetyPhase, SafetyStats, VirtualCoupling,
-    volumetric_penalty,
+    volumetric_penalty_of,
 };
 use glam::Vec3;
 use haptic_common::{DeviceState, ForceOnHapticTick, ForceTorque, Pose};
 
 use crate::WorkspaceMap;
-use crate::spec::MAX_OBJECTS;
 
 /// One tick's forces, recorded for plots (preallocated ring; lost when full).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -39,7 +38,7 @@ pub struct ForceSample {
     pub collision_sequence: u64,
 }
 
-/// What the tool felt of one watched object on the last tick.
+/// What the tool felt of one object it touched on the last tick.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ObjectContact {
     /// The object's id (as given in its [`ObjectSpec`](crate::ObjectSpec)).
@@ -81,17 +80,18 @@ pub struct RigTelemetry {
     pub outside_workspace: bool,
     /// Safety counters.
     pub safety: SafetyStats,
-    /// Each watched object's contact with the tool, the first [`RigTelemetry::object_count`] in use
-    /// (see [`RigTelemetry::objects`]).
-    pub object_contacts: [ObjectContact; MAX_OBJECTS],
+    /// The contact of each object the tool touched (volumetric) or had spheres near its tip (3-DOF
+    /// proxy), the first [`RigTelemetry::object_count`] in use (see [`RigTelemetry::objects`]).
+    pub object_contacts: [ObjectContact; MAX_TOUCHED],
     /// How many of `object_contacts` are in use.
     pub object_count: u32,
 }
 
 impl RigTelemetry {
-    /// Each watched object's contact with the tool on the last tick.
+    /// The objects the tool touched (volumetric) or had spheres near its tip (3-DOF proxy) on the last
+    /// tick, at most [`MAX_TOUCHED`]; the objects it is far from are not listed.
     pub fn objects(&self) -> &[ObjectContact] {
-        &self.object_contacts[..(self.object_count as usize).min(MAX_OBJECTS)]
+        &self.object_contacts[..(self.object_count as usize).min(MAX_TOUCHED)]
     }
 }
 
@@ -108,7 +108,7 @@ impl Default for RigTelemetry {
             safety_gain: 0.0,
             outside_workspace: false,
             safety: SafetyStats::default(),
-            object_contacts: [ObjectContact::default(); MAX_OBJECTS],
+            object_contacts: [ObjectContact::default(); MAX_TOUCHED],
             object_count: 0,
         }
     }
@@ -155,30 +155,32 @@ impl Default for ProxyRendering {
     }
 }
 
-/// A watched object as the haptic thread sees it: the reader of its watcher, its material and motion.
+/// A watched object as the haptic thread sees it: its slot in the collision pipeline, its material and
+/// motion.
 pub(crate) struct WatchedObject {
     pub(crate) id: u32,
-    pub(crate) reader: ObjectReader,
+    /// Its object slot in the collision pipeline (how the tool's scene watcher names it).
+    pub(crate) slot: u32,
     pub(crate) material: Material,
     pub(crate) motion: BodyMotion,
     /// Its centre of mass in its own frame.
     pub(crate) center_of_mass: Vec3,
     /// Its last poses while the game moves it: `motion` is read from it every tick.
     pub(crate) track: Option<PoseTrack>,
-    /// Device time of the tick that started watching it (set by the haptic thread): until its watcher
-    /// first publishes, its data is as old as the time since then.
-    pub(crate) added_us: u64,
 }
 
-/// The reader of an object's watcher: overlaps (volumetric) or spheres near the tip (proxy).
-pub(crate) enum ObjectReader {
-    Contacts(ContactReader),
+/// The reader of the tool's scene watcher: overlaps with every object (volumetric) or every object's
+/// spheres near the tip (proxy).
+pub(crate) enum SceneInput {
+    Contacts(SceneReader),
     Near(NearReader),
 }
 
 /// Changes the game thread sends the force stage (boxed there; the replaced boxes come back).
 pub(crate) enum ForceCommand {
+    /// Watches an object in its slot.
     Add(Box<WatchedObject>),
+    /// Stops watching the object in a slot.
     Remove(u32),
     SetTool {
         center_of_mass: Vec3,
@@ -186,13 +188,13 @@ pub(crate) enum ForceCommand {
     },
     /// An object the game placed: its new centre of mass and orientation (scene frame), at rest.
     Move {
-        id: u32,
+        slot: u32,
         center_of_mass: Vec3,
         orientation: glam::Quat,
     },
     /// An object the game moves: its track, read every tick.
     Track {
-        id: u32,
+        slot: u32,
         track: PoseTrack,
     },
 }
@@ -211,19 +213,24 @@ pub struct ForceStage {
     pub(crate) tool: PoseWriter,
     pub(crate) tool_center_of_mass: Vec3,
     pub(crate) tool_material: Material,
-    // Boxed so that objects move in and out through the rings whole: unboxing here would free the box
-    // on this thread.
-    #[allow(clippy::vec_box)]
-    pub(crate) objects: Vec<Box<WatchedObject>>,
+    /// The tool against every object.
+    pub(crate) scene: SceneInput,
+    /// The watched objects by their slot in the collision pipeline. Boxed so that objects move in and
+    /// out through the rings whole: unboxing here would free the box on this thread.
+    pub(crate) objects: Vec<Option<Box<WatchedObject>>>,
+    /// How many objects are watched, and since when (device time) there has been one.
+    pub(crate) watched: usize,
+    pub(crate) watched_since_us: u64,
     pub(crate) commands: rtrb::Consumer<ForceCommand>,
     pub(crate) garbage: rtrb::Producer<Box<WatchedObject>>,
-    /// Proxy rendering: every object's spheres near the tip this tick, with the object's index.
+    /// Proxy rendering: every object's spheres near the tip this tick, with the object's slot.
     pub(crate) balls: Vec<Ball>,
-    pub(crate) ball_objects: Vec<u8>,
+    pub(crate) ball_objects: Vec<u32>,
     pub(crate) telemetry: triple_buffer::Input<RigTelemetry>,
     pub(crate) samples: rtrb::Producer<ForceSample>,
-    /// This tick's contact with each watched object (in the order of `objects`).
-    pub(crate) object_contacts: [ObjectContact; MAX_OBJECTS],
+    /// This tick's contact with each object touched, the first `touched` in use.
+    pub(crate) object_contacts: [ObjectContact; MAX_TOUCHED],
+    pub(crate) touched: usize,
 }
 
 impl ForceStage {
@@ -255,28 +262,35 @@ impl ForceStage {
             angular_velocity: self.map.angular_velocity_to_scene(w),
         };
         let mut contact = ForceTorque::ZERO;
-        let mut freshness = Freshness::new(self.objects.len());
-        for (slot, object) in self.objects.iter_mut().enumerate() {
-            let ObjectReader::Contacts(reader) = &mut object.reader else { continue };
-            let set = reader.latest();
-            freshness.saw(set.sequence, set.timestamp_us, set.len(), object.added_us);
+        self.touched = 0;
+        let SceneInput::Contacts(reader) = &mut self.scene else { return };
+        let set = reader.latest();
+        let (watched, since_us, contacts) = (self.watched, self.watched_since_us, set.contacts().len());
+        let used = Published { sequence: set.sequence, timestamp_us: set.timestamp_us, contacts, watched, since_us }
+            .at(device.timestamp_us);
+        for touched in set.touched() {
+            let Some(object) = self.objects.get(touched.object as usize).and_then(Option::as_ref) else { continue };
+            let contacts = set.contacts_of(touched);
             let ft = if self.rendering == Rendering::Off {
                 ForceTorque::ZERO
             } else {
-                volumetric_penalty(set, &tool_motion, &object.motion, &self.tool_material.combine(&object.material))
+                let material = self.tool_material.combine(&object.material);
+                volumetric_penalty_of(contacts, touched.total_volume, &tool_motion, &object.motion, &material)
             };
             contact.force += ft.force;
             contact.torque += ft.torque;
-            self.object_contacts[slot] = ObjectContact {
-                id: object.id,
-                touching: !set.is_empty(),
-                contacts: set.len() as u32,
-                volume: set.total_volume,
-                force: ft.force,
-                torque: ft.torque,
-            };
+            if let Some(slot) = self.object_contacts.get_mut(self.touched) {
+                *slot = ObjectContact {
+                    id: object.id,
+                    touching: !contacts.is_empty(),
+                    contacts: contacts.len() as u32,
+                    volume: touched.total_volume,
+                    force: ft.force,
+                    torque: ft.torque,
+                };
+                self.touched += 1;
+            }
         }
-        let used = freshness.used(device.timestamp_us);
         // Torque about the tool frame's origin (where the coupling acts) instead of the centre of mass.
         contact.torque += (com - tool_scene.translation).cross(contact.force);
         let contact_device = self.map.wrench_to_device(contact);
@@ -304,20 +318,21 @@ impl ForceStage {
     fn apply_commands(&mut self, now_us: u64) {
         while let Ok(command) = self.commands.pop() {
             match command {
-                ForceCommand::Add(mut object) => {
-                    object.added_us = now_us;
-                    if let Some(i) = self.objects.iter().position(|o| o.id == object.id) {
-                        let old = std::mem::replace(&mut self.objects[i], object);
-                        self.discard(old);
-                    } else if self.objects.len() < self.objects.capacity() {
-                        self.objects.push(object);
-                    } else {
-                        self.discard(object);
+                ForceCommand::Add(object) => match self.objects.get_mut(object.slot as usize) {
+                    Some(place) => {
+                        if self.watched == 0 {
+                            self.watched_since_us = now_us;
+                        }
+                        match place.replace(object) {
+                            Some(old) => self.discard(old),
+                            None => self.watched += 1,
+                        }
                     }
-                }
-                ForceCommand::Remove(id) => {
-                    if let Some(i) = self.objects.iter().position(|o| o.id == id) {
-                        let old = self.objects.remove(i);
+                    None => self.discard(object),
+                },
+                ForceCommand::Remove(slot) => {
+                    if let Some(old) = self.objects.get_mut(slot as usize).and_then(Option::take) {
+                        self.watched -= 1;
                         self.discard(old);
                     }
                 }
@@ -325,14 +340,14 @@ impl ForceStage {
                     self.tool_center_of_mass = center_of_mass;
                     self.tool_material = material;
                 }
-                ForceCommand::Move { id, center_of_mass, orientation } => {
-                    if let Some(o) = self.objects.iter_mut().find(|o| o.id == id) {
+                ForceCommand::Move { slot, center_of_mass, orientation } => {
+                    if let Some(o) = self.objects.get_mut(slot as usize).and_then(Option::as_mut) {
                         o.motion = BodyMotion { orientation, ..BodyMotion::at_rest(center_of_mass) };
                         o.track = None;
                     }
                 }
-                ForceCommand::Track { id, track } => {
-                    if let Some(o) = self.objects.iter_mut().find(|o| o.id == id) {
+                ForceCommand::Track { slot, track } => {
+                    if let Some(o) = self.objects.get_mut(slot as usize).and_then(Option::as_mut) {
                         o.track = Some(track);
                     }
                 }
@@ -343,7 +358,7 @@ impl ForceStage {
     /// Reads every moving object's track at `now_us`: its centre of mass, orientation and velocities
     /// (the damping and friction see the contact point's velocity).
     fn follow_tracks(&mut self, now_us: u64) {
-        for o in &mut self.objects {
+        for o in self.objects.iter_mut().flatten() {
             let Some(motion) = o.track.and_then(|t| t.at(now_us)) else { continue };
             let center_of_mass = motion.pose.transform_point(o.center_of_mass);
             o.motion = BodyMotion {
@@ -367,16 +382,26 @@ impl ForceStage {
         let tip = self.map.to_scene(&device.pose);
         self.balls.clear();
         self.ball_objects.clear();
-        let mut freshness = Freshness::new(self.objects.len());
-        for (slot, object) in self.objects.iter_mut().enumerate() {
-            let ObjectReader::Near(reader) = &mut object.reader else { continue };
-            let set = reader.latest();
-            freshness.saw(set.sequence, set.timestamp_us, set.len(), object.added_us);
-            self.object_contacts[slot] =
-                ObjectContact { id: object.id, contacts: set.len() as u32, ..Default::default() };
-            for s in set.as_slice().iter().take(self.balls.capacity() - self.balls.len()) {
-                self.balls.push(Ball { center: s.center, radius: s.radius });
-                self.ball_objects.push(slot as u8);
+        self.touched = 0;
+        let SceneInput::Near(reader) = &mut self.scene else { return };
+        let set = reader.latest();
+        let (watched, since_us, contacts) = (self.watched, self.watched_since_us, set.len());
+        let used = Published { sequence: set.sequence, timestamp_us: set.timestamp_us, contacts, watched, since_us }
+            .at(device.timestamp_us);
+        for s in set.as_slice().iter().take(self.balls.capacity()) {
+            let Some(object) = self.objects.get(s.object as usize).and_then(Option::as_ref) else { continue };
+            self.balls.push(Ball { center: s.center, radius: s.radius });
+            self.ball_objects.push(s.object);
+            // Each object near the tip once, with its count of spheres.
+            let listed = &mut self.object_contacts[..self.touched];
+            match listed.iter_mut().find(|c| c.id == object.id) {
+                Some(c) => c.contacts += 1,
+                None if self.touched < MAX_TOUCHED => {
+                    self.object_contacts[self.touched] =
+                        ObjectContact { id: object.id, contacts: 1, ..Default::default() };
+                    self.touched += 1;
+                }
+                None => {}
             }
         }
         let balls = self.balls.as_slice();
@@ -388,8 +413,8 @@ impl ForceStage {
             .min_by(|a, b| {
                 (a.1.center.distance(near) - a.1.radius).total_cmp(&(b.1.center.distance(near) - b.1.radius))
             })
-            .map(|(i, _)| usize::from(self.ball_objects[i]));
-        let nearest = nearest_slot.map(|slot| &self.objects[slot]);
+            .map(|(i, _)| self.ball_objects[i] as usize);
+        let nearest = nearest_slot.and_then(|slot| self.objects.get(slot)).and_then(Option::as_deref);
         let material = nearest.map(|o| self.tool_material.combine(&o.material));
         let config = ProxyConfig {
             stiffness_n_per_m: material
@@ -419,12 +444,13 @@ impl ForceStage {
             );
             force_scene += ridged - push;
         }
-        if let Some(slot) = nearest_slot.filter(|_| self.god.in_contact()) {
-            self.object_contacts[slot].touching = true;
-            self.object_contacts[slot].force = force_scene;
+        if let Some(object) = nearest.filter(|_| self.god.in_contact())
+            && let Some(c) = self.object_contacts[..self.touched].iter_mut().find(|c| c.id == object.id)
+        {
+            c.touching = true;
+            c.force = force_scene;
         }
         let contact_device = self.map.wrench_to_device(ForceTorque { force: force_scene, torque: Vec3::ZERO });
-        let used = freshness.used(device.timestamp_us);
         let before = tick.total();
         let requested = ForceTorque { force: before.force + contact_device.force, torque: before.torque };
         let out = self.safety.apply_at(requested, tick.dt_s, used.age_s(), device.pose.translation);
@@ -456,10 +482,9 @@ impl ForceStage {
             data_age_us: age_us.min(u32::MAX as u64) as u32,
             collision_sequence: sequence,
         });
-        let object_count = self.objects.len().min(MAX_OBJECTS);
         self.telemetry.write(RigTelemetry {
             object_contacts: self.object_contacts,
-            object_count: object_count as u32,
+            object_count: self.touched as u32,
             device,
             tool_pose,
             output: out,
@@ -474,48 +499,8 @@ impl ForceStage {
     }
 }
 
-/// What a tick learns about the watchers' data while reading it: the newest step, the oldest pose.
-struct Freshness {
-    objects: usize,
-    sequence: u64,
-    oldest_us: Option<u64>,
-    contacts: u32,
-}
-
-impl Freshness {
-    fn new(objects: usize) -> Self {
-        Self { objects, sequence: 0, oldest_us: None, contacts: 0 }
-    }
-
-    /// Notes one watcher's result: its step, the timestamp of the pose it used, its size; a watcher
-    /// that has published nothing yet counts as data from `added_us`, when the object was added (so
-    /// placing an object does not trip the watchdog unless the collision thread stays silent past it).
-    fn saw(&mut self, sequence: u64, timestamp_us: u64, len: usize, added_us: u64) {
-        self.contacts += len as u32;
-        let from_us = if sequence == 0 {
-            added_us
-        } else {
-            self.sequence = self.sequence.max(sequence);
-            timestamp_us
-        };
-        self.oldest_us = Some(self.oldest_us.map_or(from_us, |t| t.min(from_us)));
-    }
-
-    /// The data used at `now_us`: its age is that of the oldest tool pose a watcher's result rests on
-    /// (for a watcher that has published nothing yet, the time since its object was added; 0 with
-    /// nothing watched: no data can be stale).
-    fn used(&self, now_us: u64) -> Used {
-        let age_us = match (self.objects, self.oldest_us) {
-            (0, _) => 0,
-            (_, None) => u64::MAX,
-            (_, Some(t)) => now_us.saturating_sub(t),
-        };
-        Used { contacts: self.contacts, sequence: self.sequence, age_us }
-    }
-}
-
 /// The contact data a tick used: how many contacts (or spheres near the tip), the collision step's
-/// sequence, and its age in µs (`u64::MAX` when no watcher could be read).
+/// sequence, and its age in µs.
 #[derive(Clone, Copy)]
 struct Used {
     contacts: u32,
@@ -523,9 +508,34 @@ struct Used {
     age_us: u64,
 }
 
+/// The scene watcher's data as published (its step, the tool pose's time, its size), and how many
+/// objects are watched, since when (device time).
+struct Published {
+    sequence: u64,
+    timestamp_us: u64,
+    contacts: usize,
+    watched: usize,
+    since_us: u64,
+}
+
+impl Published {
+    /// The data used at `now_us`: its age is that of the tool pose the scene watcher's last step rests
+    /// on; before its first step, the time since an object was first watched (so placing an object
+    /// does not trip the watchdog unless the collision thread stays silent past it); 0 with nothing
+    /// watched (no data can be stale).
+    fn at(&self, now_us: u64) -> Used {
+        let age_us = match (self.watched, self.sequence) {
+            (0, _) => 0,
+            (_, 0) => now_us.saturating_sub(self.since_us),
+            _ => now_us.saturating_sub(self.timestamp_us),
+        };
+        Used { contacts: self.contacts as u32, sequence: self.sequence, age_us }
+    }
+}
+
 impl Used {
-    /// The data's age for the safety layer's watchdog, seconds (infinite when no watcher could be read).
+    /// The data's age for the safety layer's watchdog, seconds.
     fn age_s(&self) -> f32 {
-        if self.age_us == u64::MAX { f32::INFINITY } else { self.age_us as f32 * 1e-6 }
+        self.age_us as f32 * 1e-6
     }
 }

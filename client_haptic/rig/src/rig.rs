@@ -11,7 +11,7 @@ use haptic_common::{Delegator, OnCollision, Pose};
 use haptico::{Device, HapticClock, HapticConfig, HapticEvents, HapticHandle, HapticTelemetry, TickTiming};
 
 use crate::collision::{CollisionConfig, RigPacer, StepTiming};
-use crate::force::{ForceSample, ForceStage, ProxyRendering, Rendering, RigTelemetry};
+use crate::force::{ForceSample, ForceStage, ProxyRendering, Rendering, RigTelemetry, SceneInput};
 use crate::scene::{FORCE_COMMANDS, Scene};
 use crate::spec::{MAX_OBJECTS, ObjectSpec, PairContact, ToolSpec};
 use crate::{Result, RigError, WorkspaceMap};
@@ -98,16 +98,22 @@ impl Parts {
         let mut safety = config.safety.unwrap_or_else(|| safety_for(specs));
         safety.workspace = config.workspace.or(safety.workspace);
         safety.validate()?;
-        let tool_pose = collision.add_object(tool.tree, Pose::IDENTITY).ok_or(RigError::QueueFull("collision"))?;
+        let full = || RigError::QueueFull("collision");
+        let tool_pose = collision.add_object(tool.tree, Pose::IDENTITY).ok_or_else(full)?;
+        let proxy = config.rendering == Rendering::Proxy;
+        // The tool against every object, in one buffer.
+        let scene_input = match proxy {
+            true => SceneInput::Near(collision.add_scene_near_watcher(tool_pose.id()).ok_or_else(full)?),
+            false => SceneInput::Contacts(collision.add_scene_watcher(tool_pose.id()).ok_or_else(full)?),
+        };
         let (telemetry_in, telemetry_out) = triple_buffer::triple_buffer(&RigTelemetry::default());
         let (forces_tx, forces_rx) = rtrb::RingBuffer::new(FORCE_COMMANDS);
         // Cannot fill: every command returns at most one object, and the scene empties this ring before
         // each command it sends (see collette's pipeline for the same argument).
         let (garbage_tx, garbage_rx) = rtrb::RingBuffer::new(FORCE_COMMANDS + MAX_OBJECTS);
         let (samples_tx, samples_rx) = rtrb::RingBuffer::new(config.force_sample_capacity.max(1));
-        let proxy = config.rendering == Rendering::Proxy;
-        let balls = if proxy { MAX_OBJECTS * collette::pipeline::MAX_NEAR_SPHERES } else { 0 };
-        let scene = Scene::new(collision, tool_pose.id(), forces_tx, garbage_rx, proxy, config.tracks);
+        let balls = if proxy { collette::pipeline::MAX_NEAR_SPHERES } else { 0 };
+        let scene = Scene::new(collision, tool_pose.id(), forces_tx, garbage_rx, config.tracks);
         let stage = ForceStage {
             map: config.map,
             rendering: config.rendering,
@@ -119,14 +125,19 @@ impl Parts {
             tool: tool_pose,
             tool_center_of_mass: tool.center_of_mass,
             tool_material: tool.material,
-            objects: Vec::with_capacity(MAX_OBJECTS),
+            scene: scene_input,
+            // Indexed by object slot: the tool's and one per object.
+            objects: (0..=MAX_OBJECTS).map(|_| None).collect(),
+            watched: 0,
+            watched_since_us: 0,
             commands: forces_rx,
             garbage: garbage_tx,
             balls: Vec::with_capacity(balls),
             ball_objects: Vec::with_capacity(balls),
             telemetry: telemetry_in,
             samples: samples_tx,
-            object_contacts: [crate::force::ObjectContact::default(); MAX_OBJECTS],
+            object_contacts: [crate::force::ObjectContact::default(); collette::pipeline::MAX_TOUCHED],
+            touched: 0,
         };
         Ok(Self { stage, scene, outputs: Outputs { samples: samples_rx, telemetry: telemetry_out } })
     }

@@ -2,29 +2,29 @@
 //! force stage.
 //!
 //! You need this module to see how an object reaches both threads: its tree goes to the collision
-//! pipeline (with one watcher against the tool: overlaps for volumetric rendering, spheres near the tip
-//! for the proxy), the watcher's reader with the object's material and motion to the force stage. Both
-//! travel through fixed-capacity rings; whatever the threads replace or remove comes back here to be
-//! freed.
+//! pipeline (where the tool's one scene watcher finds it when their bounds touch: overlaps for
+//! volumetric rendering, spheres near the tip for the proxy), its slot there with its material and
+//! motion to the force stage. Both travel through fixed-capacity rings; whatever the threads replace or
+//! remove comes back here to be freed.
 
 use collette::pipeline::{
-    CollisionHandle, ContactReader, ObjectId, PoseTrack, PoseWriter, TimedPose, TrackTiming, WatcherId,
+    CollisionHandle, ObjectId, PoseTrack, PoseWriter, SummaryReader, TimedPose, TrackTiming, WatcherId,
 };
 use forcecomp::BodyMotion;
 use haptic_common::Pose;
 
-use crate::force::{ForceCommand, ObjectReader, WatchedObject};
+use crate::force::{ForceCommand, WatchedObject};
 use crate::spec::{MAX_OBJECTS, MAX_PAIR_WATCHERS, ObjectSpec, PairContact, ToolSpec, center_of_mass};
 use crate::{Result, RigError};
 
-/// Capacity of the ring of changes to the force stage.
-pub(crate) const FORCE_COMMANDS: usize = 64;
+/// Capacity of the ring of changes to the force stage (a game moving every object each frame sends
+/// one per object).
+pub(crate) const FORCE_COMMANDS: usize = 1024;
 
 /// A watched object's place in the collision pipeline.
 struct Entry {
     id: u32,
     object: ObjectId,
-    watcher: WatcherId,
     /// Moves the object on the collision thread.
     pose: PoseWriter,
     /// Its centre of mass in its own frame.
@@ -38,7 +38,7 @@ struct PairEntry {
     a: u32,
     b: u32,
     watcher: WatcherId,
-    reader: ContactReader,
+    reader: SummaryReader,
 }
 
 impl PairEntry {
@@ -55,7 +55,6 @@ pub(crate) struct Scene {
     pairs: Vec<PairEntry>,
     forces: rtrb::Producer<ForceCommand>,
     garbage: rtrb::Consumer<Box<WatchedObject>>,
-    proxy: bool,
     /// How moving objects' tracks are read.
     timing: TrackTiming,
     /// Objects freed since the last `collect_garbage` (the other methods free too, before sending).
@@ -69,11 +68,10 @@ impl Scene {
         tool: ObjectId,
         forces: rtrb::Producer<ForceCommand>,
         garbage: rtrb::Consumer<Box<WatchedObject>>,
-        proxy: bool,
         timing: TrackTiming,
     ) -> Self {
         let (entries, pairs) = (Vec::with_capacity(MAX_OBJECTS), Vec::with_capacity(MAX_PAIR_WATCHERS));
-        Self { collision, tool, entries, pairs, forces, garbage, proxy, timing, freed: 0 }
+        Self { collision, tool, entries, pairs, forces, garbage, timing, freed: 0 }
     }
 
     /// Watches an object (replaces the one with the same id).
@@ -82,11 +80,14 @@ impl Scene {
         if self.forces.slots() == 0 {
             return Err(RigError::QueueFull("haptic"));
         }
-        // All or nothing: removing a replaced object and adding this one take four commands, and its
+        // All or nothing: removing a replaced object and adding this one take two commands, and its
         // watchers against other objects two each (taken down with it, set up again after).
         let paired = self.pairs.iter().filter(|p| p.joins(spec.id)).count();
-        if self.collision.free_commands() < 4 + 2 * paired {
+        if self.collision.free_commands() < 2 + 2 * paired {
             return Err(RigError::QueueFull("collision"));
+        }
+        if self.forces.slots() < 2 {
+            return Err(RigError::QueueFull("haptic"));
         }
         let mut rewatch = Vec::new();
         if let Some(i) = self.entries.iter().position(|e| e.id == spec.id) {
@@ -99,13 +100,6 @@ impl Scene {
         let full = || RigError::QueueFull("collision");
         let still = TimedPose { pose: spec.pose, timestamp_us: u64::MAX, reach: 0.0 };
         let pose = self.collision.add_object_at(spec.tree.clone(), still).ok_or_else(full)?;
-        let (watcher, reader) = if self.proxy {
-            let r = self.collision.add_near_watcher(self.tool, pose.id()).ok_or_else(full)?;
-            (r.id(), ObjectReader::Near(r))
-        } else {
-            let r = self.collision.add_watcher(self.tool, pose.id()).ok_or_else(full)?;
-            (r.id(), ObjectReader::Contacts(r))
-        };
         let local_center = center_of_mass(&spec.tree);
         let motion = BodyMotion {
             orientation: spec.pose.rotation,
@@ -113,16 +107,15 @@ impl Scene {
         };
         let object = Box::new(WatchedObject {
             id: spec.id,
-            reader,
+            slot: pose.id().0,
             material: spec.material,
             motion,
             center_of_mass: local_center,
             track: None,
-            added_us: 0,
         });
         self.forces.push(ForceCommand::Add(object)).map_err(|_| RigError::QueueFull("haptic"))?;
         let track = PoseTrack::new(self.timing);
-        self.entries.push(Entry { id: spec.id, object: pose.id(), watcher, pose, center_of_mass: local_center, track });
+        self.entries.push(Entry { id: spec.id, object: pose.id(), pose, center_of_mass: local_center, track });
         for (a, b) in rewatch {
             self.watch_pair(a, b)?;
         }
@@ -143,7 +136,7 @@ impl Scene {
         }
         let object = |id| self.entries.iter().find(|e| e.id == id).map(|e| e.object).ok_or(RigError::UnknownObject(id));
         let (oa, ob) = (object(a)?, object(b)?);
-        let reader = self.collision.add_watcher(oa, ob).ok_or(RigError::QueueFull("collision"))?;
+        let reader = self.collision.add_summary_watcher(oa, ob).ok_or(RigError::QueueFull("collision"))?;
         self.pairs.push(PairEntry { a, b, watcher: reader.id(), reader });
         Ok(())
     }
@@ -162,14 +155,14 @@ impl Scene {
     /// Appends what every watcher between two objects saw on the latest collision step.
     pub(crate) fn pair_contacts(&mut self, out: &mut Vec<PairContact>) {
         for p in &mut self.pairs {
-            let set = p.reader.latest();
+            let seen = p.reader.latest();
             out.push(PairContact {
                 a: p.a,
                 b: p.b,
-                touching: !set.is_empty() || set.total_volume > 0.0,
-                pairs: set.len() as u32,
-                volume_m3: set.total_volume,
-                sequence: set.sequence,
+                touching: seen.pairs > 0 || seen.total_volume > 0.0,
+                pairs: seen.pairs,
+                volume_m3: seen.total_volume,
+                sequence: seen.sequence,
             });
         }
     }
@@ -192,7 +185,7 @@ impl Scene {
         self.free_returned();
         let entry = self.entries.iter_mut().find(|e| e.id == id).ok_or(RigError::UnknownObject(id))?;
         let command = ForceCommand::Move {
-            id,
+            slot: entry.object.0,
             center_of_mass: pose.transform_point(entry.center_of_mass),
             orientation: pose.rotation,
         };
@@ -212,7 +205,8 @@ impl Scene {
         if !track.push(pose, t_us) {
             return Err(RigError::BadSample { id, t_us });
         }
-        self.forces.push(ForceCommand::Track { id, track }).map_err(|_| RigError::QueueFull("haptic"))?;
+        let command = ForceCommand::Track { slot: entry.object.0, track };
+        self.forces.push(command).map_err(|_| RigError::QueueFull("haptic"))?;
         entry.track = track;
         entry.pose.set_track(&track);
         Ok(())
@@ -223,22 +217,22 @@ impl Scene {
         self.free_returned();
         let Some(i) = self.entries.iter().position(|e| e.id == id) else { return Ok(()) };
         let paired = self.pairs.iter().filter(|p| p.joins(id)).count();
-        if self.collision.free_commands() < 2 + paired {
+        if self.collision.free_commands() < 1 + paired {
             return Err(RigError::QueueFull("collision"));
         }
-        self.forces.push(ForceCommand::Remove(id)).map_err(|_| RigError::QueueFull("haptic"))?;
+        if self.forces.slots() == 0 {
+            return Err(RigError::QueueFull("haptic"));
+        }
         self.drop_pairs_of(id);
         let old = self.entries.swap_remove(i);
         self.forget(&old)
     }
 
-    /// Takes an object out of the collision pipeline (its watcher first: the slot is reused).
+    /// Takes an object out of the force stage and the collision pipeline (room in both rings checked by
+    /// the caller).
     fn forget(&mut self, entry: &Entry) -> Result<()> {
-        if self.collision.remove_watcher(entry.watcher) && self.collision.remove_object(entry.object) {
-            Ok(())
-        } else {
-            Err(RigError::QueueFull("collision"))
-        }
+        self.forces.push(ForceCommand::Remove(entry.object.0)).map_err(|_| RigError::QueueFull("haptic"))?;
+        if self.collision.remove_object(entry.object) { Ok(()) } else { Err(RigError::QueueFull("collision")) }
     }
 
     /// Replaces the tool's tree, centre of mass and material.

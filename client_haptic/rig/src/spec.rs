@@ -9,11 +9,12 @@ use forcecomp::Material;
 use glam::Vec3;
 use haptic_common::Pose;
 
-/// Most objects watched at once (each against the tool).
-pub const MAX_OBJECTS: usize = 16;
+/// Most objects watched at once (all against the tool: the collision thread's broad phase queries only
+/// those whose bounds touch the tool's).
+pub const MAX_OBJECTS: usize = 256;
 
-/// Most watchers between two objects at once (besides each object's against the tool).
-pub const MAX_PAIR_WATCHERS: usize = 16;
+/// Most watchers between two objects at once (besides the tool's against every object).
+pub const MAX_PAIR_WATCHERS: usize = 1024;
 
 /// What a watcher between two objects saw on the collision thread's latest step (objects do not push
 /// each other: this is what the game learns of their contact).

@@ -117,7 +117,7 @@ fn objects_come_and_go_in_the_one_pipeline(rendering: Rendering) {
         rig.add_object(ObjectSpec { pose: Pose::from_translation(Vec3::X * id as f32), ..utils::slab_object(id) })
             .expect("room for MAX_OBJECTS");
     }
-    let full = rig.add_object(utils::slab_object(99));
+    let full = rig.add_object(utils::slab_object(9999));
     assert!(matches!(full, Err(haptic_rig::RigError::TooManyObjects(haptic_rig::MAX_OBJECTS))), "{full:?}");
     rig.remove_object(4).expect("remove");
     let s = now();
@@ -177,10 +177,8 @@ fn objects_move_and_are_named(rendering: Rendering) {
         let ids: Vec<u32> = t.objects().iter().filter(|c| c.touching).map(|c| c.id).collect();
         ids == [id] && t.objects().iter().any(|c| c.id == id && c.force.y > 0.0)
     };
-    let nothing = || {
-        let t = rig.telemetry();
-        t.objects().len() == 2 && t.objects().iter().all(|c| !c.touching)
-    };
+    // Objects far from the tool are not listed (the broad phase never queries them).
+    let nothing = || rig.telemetry().objects().iter().all(|c| !c.touching);
     assert!(eventually(nothing), "both slabs far away: {:?}", rig.telemetry().objects());
     rig.set_object_pose(2, away(0.0)).expect("move");
     assert!(eventually(|| touching(2)), "the moved slab is under the tool: {:?}", rig.telemetry().objects());
