@@ -28,6 +28,9 @@ pub struct CollisionConfig {
     pub catch_up_periods: u32,
     /// Real-time FIFO priority, 1..=99 (default None); keep it below the haptic thread's.
     pub realtime_priority: Option<i32>,
+    /// Query only the objects whose bounds touch the tool's (default true); false queries every object
+    /// every step, for comparison.
+    pub broad_phase: bool,
 }
 
 impl Default for CollisionConfig {
@@ -39,6 +42,7 @@ impl Default for CollisionConfig {
             timing_capacity: 1 << 16,
             catch_up_periods: 5,
             realtime_priority: None,
+            broad_phase: true,
         }
     }
 }
@@ -59,6 +63,7 @@ impl CollisionConfig {
             period: Duration::from_nanos(self.period_ns()),
             step_budget: budget.unwrap_or(Duration::from_micros(self.budget_us as u64)),
             timing_capacity: self.timing_capacity.max(1),
+            broad_phase: self.broad_phase,
         }
     }
 }

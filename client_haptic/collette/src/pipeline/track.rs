@@ -5,9 +5,12 @@
 //! You need this module to move objects from a game loop ([`PoseWriter::set_track`]
 //! (super::PoseWriter::set_track)), or to read such an object's motion on another thread. The track is
 //! read `delay_us` behind the reader's clock, so that the time read lies between two samples the game
-//! has already sent (entity interpolation, as networked games draw other players); past the newest
-//! sample it is extrapolated with the last segment's velocity for at most `max_extrapolation_us`, then
-//! held. Plain `Copy` data: it travels through the lock-free buffers whole.
+//! has already sent (entity interpolation, as networked games draw other players). Past the newest
+//! sample the object rests there (or, with `max_extrapolation_us`, goes on with the last segment's
+//! velocity for that long first); a sample that comes more than `delay_us` after the newest starts
+//! from rest (the newest pose is repeated `delay_us` before it), so a game that stops moving an object,
+//! or starts again, or hitches, never makes it jump. Plain `Copy` data: it travels through the
+//! lock-free buffers whole.
 
 use glam::{Quat, Vec3};
 use haptic_common::Pose;
@@ -21,14 +24,16 @@ pub struct TrackTiming {
     /// The track is read this long before now, µs (default 20 000: a little more than a 60 Hz frame,
     /// so that the time read has a sample on each side; a faster game can use less).
     pub delay_us: u32,
-    /// Longest extrapolation past the newest sample when the game is late, µs (default 50 000); after
-    /// it the object stays where the extrapolation left it.
+    /// Longest extrapolation past the newest sample when the game is late, µs (default 0: the object
+    /// rests at its newest pose until the next one comes). After it the object stays where the
+    /// extrapolation left it, which is not where the game last put it: use it only with a game that
+    /// sends a pose every frame, stops included.
     pub max_extrapolation_us: u32,
 }
 
 impl Default for TrackTiming {
     fn default() -> Self {
-        Self { delay_us: 20_000, max_extrapolation_us: 50_000 }
+        Self { delay_us: 20_000, max_extrapolation_us: 0 }
     }
 }
 
@@ -74,7 +79,9 @@ impl PoseTrack {
     }
 
     /// Adds the pose the object had at `t_us`; a sample at the newest sample's time replaces it, an
-    /// older one or a pose that is not finite is ignored (returns false).
+    /// older one or a pose that is not finite is ignored (returns false). A sample more than
+    /// `delay_us` after the newest starts from rest: the newest pose is repeated at `t_us - delay_us`
+    /// first (with a delay of 0, the track is read at the newest sample and nothing is repeated).
     pub fn push(&mut self, pose: Pose, t_us: u64) -> bool {
         if !pose.is_finite() {
             return false;
@@ -85,15 +92,23 @@ impl PoseTrack {
                 self.samples[self.len - 1] = (pose, t_us);
                 return true;
             }
+            Some((resting, newest)) if self.timing.delay_us > 0 && t_us - newest > self.timing.delay_us as u64 => {
+                self.append(resting, t_us - self.timing.delay_us as u64);
+            }
             _ => {}
         }
+        self.append(pose, t_us);
+        true
+    }
+
+    /// Appends a sample, dropping the oldest when full.
+    fn append(&mut self, pose: Pose, t_us: u64) {
         if self.len == TRACK_SAMPLES {
             self.samples.copy_within(1.., 0);
             self.len -= 1;
         }
         self.samples[self.len] = (pose, t_us);
         self.len += 1;
-        true
     }
 
     /// Forgets every sample (keeps the timing).
@@ -208,6 +223,29 @@ mod tests {
         assert!((stopped.pose.translation.x - 0.06).abs() < 1e-6, "50 ms of extrapolation at most: {stopped:?}");
         assert_eq!(stopped.linear_velocity, Vec3::ZERO, "then at rest");
         assert_eq!(track.at(5_000).expect("samples").pose, at_x(0.0), "before the oldest: at the oldest");
+    }
+
+    #[test]
+    fn an_object_the_game_stops_rests_where_it_was_left_and_starts_again_without_a_jump() {
+        // Default timing: read 20 ms behind, no extrapolation. 0.5 m/s at 60 Hz until 100 ms, then no
+        // pose for 200 ms, then moving again from where it stopped.
+        let mut track = PoseTrack::default();
+        let mut positions = Vec::new();
+        for now_us in (0..600_000u64).step_by(1000) {
+            let frame_us = now_us / 16_667 * 16_667;
+            let sending = frame_us <= 100_000 || frame_us >= 300_000;
+            if sending && now_us % 16_667 < 1000 {
+                // Where the game puts it: stopped at its last pose before 100 ms, on from there at 300 ms.
+                let moved_us = frame_us.min(83_335) + frame_us.saturating_sub(300_006);
+                track.push(at_x(0.5 * moved_us as f32 * 1e-6), frame_us);
+            }
+            positions.push(track.at(now_us).expect("samples").pose.translation.x);
+        }
+        let last_sent = 0.5 * 83_335.0 * 1e-6;
+        assert!((positions[250] - last_sent).abs() < 1e-6, "at rest where it was last put: {}", positions[250]);
+        let biggest = positions.windows(2).map(|w| (w[1] - w[0]).abs()).fold(0.0f32, f32::max);
+        assert!(biggest < 0.001, "no jump when it stops or starts again: {biggest}");
+        assert!(positions[599] > 0.1, "and it moved on: {}", positions[599]);
     }
 
     #[test]

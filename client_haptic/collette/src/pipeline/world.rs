@@ -155,6 +155,9 @@ pub struct CollisionConfig {
     pub step_budget: Duration,
     /// Capacity of the step-timing ring (default 65 536; timings are dropped while it is full).
     pub timing_capacity: usize,
+    /// Filter pairs by their bounds before querying them (default true); false queries every watched
+    /// pair whose objects are present and inside the region, for comparison (`haptic-bench`).
+    pub broad_phase: bool,
 }
 
 impl Default for CollisionConfig {
@@ -166,6 +169,7 @@ impl Default for CollisionConfig {
             period: Duration::from_millis(1),
             step_budget: Duration::from_micros(700),
             timing_capacity: 1 << 16,
+            broad_phase: true,
         }
     }
 }
@@ -304,6 +308,8 @@ pub struct CollisionWorld {
     objects: Vec<Option<ObjectSlot>>,
     watchers: Vec<Option<WatcherSlot>>,
     broad: BroadPhase,
+    /// False: every pair is queried (see [`CollisionConfig::broad_phase`]).
+    broad_enabled: bool,
     region: Option<Aabb>,
     workspace: QueryWorkspace,
     /// One pair's contacts or near spheres, before they join a scene watcher's set.
@@ -327,6 +333,7 @@ impl CollisionWorld {
             objects: (0..config.max_objects).map(|_| None).collect(),
             watchers: (0..config.max_watchers).map(|_| None).collect(),
             broad: BroadPhase::new(config.max_objects),
+            broad_enabled: config.broad_phase,
             region: None,
             workspace: QueryWorkspace::new(),
             scratch: ContactSet::new(),
@@ -418,12 +425,14 @@ impl CollisionWorld {
             });
             self.broad.set(slot, bounds);
         }
-        self.broad.update();
+        if self.broad_enabled {
+            self.broad.update();
+        }
         report.overlapping = self.broad.overlapping();
         report.broad_ns = broad_start.elapsed().as_nanos().min(u32::MAX as u128) as u32;
         let sequence = self.sequence;
         let Self { objects, watchers, broad, region, workspace, scratch, scratch_near, on_collision, .. } = self;
-        let (objects, broad, region) = (&*objects, &*broad, *region);
+        let (objects, broad, region) = (&*objects, self.broad_enabled.then_some(&*broad), *region);
         let is_close = |ia: usize, ib: usize, near: bool| close(objects, broad, region, ia, ib, near);
         // Pairs to query this step, for the budget's shares.
         let mut remaining: u32 = watchers
@@ -592,23 +601,23 @@ fn measure(a: &ObjectSlot, b: &ObjectSlot, budget: Budget, ws: &mut QueryWorkspa
 
 /// Whether objects `ia` and `ib` must be queried: both present, their boxes overlapping (the broad
 /// phase), their bounds close enough (`near`: B within A's reach of A's origin; otherwise the two
-/// bounds touching), and both inside the region.
+/// bounds touching), and both inside the region. Without a broad phase, every present pair inside the
+/// region.
 fn close(
     objects: &[Option<ObjectSlot>],
-    broad: &BroadPhase,
+    broad: Option<&BroadPhase>,
     region: Option<Aabb>,
     ia: usize,
     ib: usize,
     near: bool,
 ) -> bool {
     let (Some(Some(a)), Some(Some(b))) = (objects.get(ia), objects.get(ib)) else { return false };
-    if !broad.overlaps(ia, ib) {
-        return false;
-    }
     let ((ca, ra), (cb, rb)) = (a.sphere(), b.sphere());
-    let touching = match near {
-        true => a.now.pose.translation.distance(cb) <= a.now.reach.max(0.0) + rb,
-        false => ca.distance(cb) <= ra + rb,
+    let touching = match (broad, near) {
+        (None, _) => true,
+        (Some(broad), _) if !broad.overlaps(ia, ib) => false,
+        (Some(_), true) => a.now.pose.translation.distance(cb) <= a.now.reach.max(0.0) + rb,
+        (Some(_), false) => ca.distance(cb) <= ra + rb,
     };
     let inside = |(c, r): (Vec3, f32)| region.is_none_or(|box_| box_.intersects_sphere(c, r));
     touching && inside((ca, ra)) && inside((cb, rb))
