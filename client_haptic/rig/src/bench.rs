@@ -196,6 +196,48 @@ pub fn summary(
     }
 }
 
+/// What the collision steps cost: their work time's median and 99th percentile, the broad phase's part
+/// of it, and how many pairs a step queried and skipped.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepCosts {
+    /// Median work time of a step, µs.
+    pub work_p50_us: u32,
+    /// 99th percentile of a step's work time, µs.
+    pub work_p99_us: u32,
+    /// 99th percentile of the time spent reading poses and in the broad phase, µs.
+    pub broad_p99_us: f32,
+    /// The broad phase's share of all the steps' work (0–1).
+    pub broad_share: f32,
+    /// Pairs queried per step, on average.
+    pub queried_mean: f32,
+    /// Pairs the broad phase skipped per step, on average.
+    pub culled_mean: f32,
+}
+
+/// The costs of the recorded collision steps.
+pub fn step_costs(collision: &[StepTiming]) -> StepCosts {
+    if collision.is_empty() {
+        return StepCosts::default();
+    }
+    let percentile = |mut values: Vec<u32>, q: f64| {
+        values.sort_unstable();
+        values[((values.len() - 1) as f64 * q).round() as usize]
+    };
+    let work: Vec<u32> = collision.iter().map(|s| s.work_us).collect();
+    let broad: Vec<u32> = collision.iter().map(|s| s.broad_ns).collect();
+    let n = collision.len() as f32;
+    let work_ns: f64 = collision.iter().map(|s| s.work_us as f64 * 1000.0).sum();
+    let broad_ns: f64 = collision.iter().map(|s| s.broad_ns as f64).sum();
+    StepCosts {
+        work_p50_us: percentile(work.clone(), 0.5),
+        work_p99_us: percentile(work, 0.99),
+        broad_p99_us: percentile(broad, 0.99) as f32 / 1000.0,
+        broad_share: if work_ns > 0.0 { (broad_ns / work_ns) as f32 } else { 0.0 },
+        queried_mean: collision.iter().map(|s| s.queried as f32).sum::<f32>() / n,
+        culled_mean: collision.iter().map(|s| s.culled as f32).sum::<f32>() / n,
+    }
+}
+
 /// Writes the windows as CSV (header + one line per window).
 pub fn write_csv(out: &mut impl Write, windows: &[Window]) -> std::io::Result<()> {
     writeln!(
@@ -302,6 +344,19 @@ mod tests {
                 work_us: 10,
             })
             .collect()
+    }
+
+    #[test]
+    fn step_costs_are_percentiles_of_the_work_and_the_broad_phase_share() {
+        // 100 steps of 10..=109 µs, each with 1 µs of broad phase, 3 pairs queried and 250 skipped.
+        let steps: Vec<StepTiming> = (0..100u32)
+            .map(|i| StepTiming { work_us: 10 + i, broad_ns: 1000, queried: 3, culled: 250, ..Default::default() })
+            .collect();
+        let c = step_costs(&steps);
+        assert_eq!((c.work_p50_us, c.work_p99_us, c.broad_p99_us), (60, 108, 1.0));
+        assert!((c.broad_share - 100_000.0 / 5_950_000.0).abs() < 1e-6, "{c:?}");
+        assert_eq!((c.queried_mean, c.culled_mean), (3.0, 250.0));
+        assert_eq!(step_costs(&[]), StepCosts::default());
     }
 
     #[test]

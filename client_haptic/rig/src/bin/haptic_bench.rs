@@ -66,6 +66,13 @@ struct Args {
     /// the real intersection for a tool this much smaller than the object (docs/collette.md).
     #[arg(long)]
     surface: bool,
+    /// Scatter this many small objects (1.2 cm balls and boxes of 300 spheres) around the bunny, in the
+    /// tool's way: a whole scene for the collision thread's broad phase (at most 255 beside the bunny).
+    #[arg(long, default_value_t = 0)]
+    objects: usize,
+    /// Query every object every collision step (no broad phase), to compare.
+    #[arg(long)]
+    no_broad_phase: bool,
     /// Print the summary as one JSON object, last.
     #[arg(long)]
     json: bool,
@@ -169,6 +176,7 @@ fn run() -> anyhow::Result<()> {
             timing_capacity: ticks,
             realtime_priority: args.realtime.map(|p| (p - 1).max(1)),
             spin_margin_us: args.spin_us,
+            broad_phase: !args.no_broad_phase,
             ..CollisionConfig::default()
         },
         force_sample_capacity: ticks,
@@ -186,12 +194,16 @@ fn run() -> anyhow::Result<()> {
     );
     let bunny_material = Material { stiffness_n_per_m3: 5e7, damping_ns_per_m: 4.0, friction: 0.3, texture: None };
     let bunny = ObjectSpec { id: 1, tree: Arc::new(bunny), pose: Pose::IDENTITY, material: bunny_material };
+    let scattered = scatter(args.objects, &bunny_mesh, &bunny_material)?;
     if args.lockstep {
-        return lockstep(&args, device, tool, (bunny, surface), &config, replay.as_ref(), recording);
+        return lockstep(&args, device, tool, (bunny, surface, scattered), &config, replay.as_ref(), recording);
     }
     let rig = HapticRig::start(device, tool, config, HapticEvents::default(), Delegator::new())?;
     let id = bunny.id;
     rig.add_object(bunny)?;
+    for object in scattered {
+        rig.add_object(object)?;
+    }
     if surface.is_some() {
         rig.set_surface(id, surface)?;
     }
@@ -228,6 +240,7 @@ fn run() -> anyhow::Result<()> {
     let mut windows = bench::windows(&haptic, &collision, &forces, 100_000, period_us);
     bench::add_steal(&mut windows, &haptic, &steal_samples, 100_000, period_us);
     let s = bench::summary(&windows, &haptic, &collision, &forces, period_us as u32);
+    let costs = bench::step_costs(&collision);
     let nominal = args.rate_hz as f64;
     let low_haptic = windows.iter().filter(|w| w.haptic_hz < nominal).count();
     let low_collision = windows.iter().filter(|w| w.collision_hz < nominal).count();
@@ -248,7 +261,7 @@ fn run() -> anyhow::Result<()> {
     }
 
     println!(
-        "haptic-bench: {} windows of 100 ms; min haptic {:.0} Hz, min collision {:.0} Hz; windows below {:.0} Hz: haptic {}, collision {} ({} of them without hypervisor steal near them); haptic stalls > 5 periods {}; CPU time stolen by the hypervisor {}; haptic period jitter p50 {} us, p99 {} us, max {} us; collision jitter p50 {} us, p99 {} us; budget hits {}; max |F| {:.2} N (peak {:.2}), max |tau| {:.3} N.m, max |dF| per tick {:.3} N; skipped ticks {}; real-time scheduling {}, memory locked {}; safety {:?}; CSV {}, PNG {}",
+        "haptic-bench: {} windows of 100 ms; min haptic {:.0} Hz, min collision {:.0} Hz; windows below {:.0} Hz: haptic {}, collision {} ({} of them without hypervisor steal near them); haptic stalls > 5 periods {}; CPU time stolen by the hypervisor {}; haptic period jitter p50 {} us, p99 {} us, max {} us; collision jitter p50 {} us, p99 {} us; budget hits {}; collision step p50 {} us, p99 {} us (broad phase p99 {:.1} us, {:.1} % of the work; {:.1} pairs queried and {:.1} skipped a step, {} objects{}); max |F| {:.2} N (peak {:.2}), max |tau| {:.3} N.m, max |dF| per tick {:.3} N; skipped ticks {}; real-time scheduling {}, memory locked {}; safety {:?}; CSV {}, PNG {}",
         s.windows,
         s.min_haptic_hz,
         s.min_collision_hz,
@@ -264,6 +277,14 @@ fn run() -> anyhow::Result<()> {
         s.collision.jitter_p50_us,
         s.collision.jitter_p99_us,
         s.budget_hits,
+        costs.work_p50_us,
+        costs.work_p99_us,
+        costs.broad_p99_us,
+        costs.broad_share * 100.0,
+        costs.queried_mean,
+        costs.culled_mean,
+        args.objects + 1,
+        if args.no_broad_phase { ", no broad phase" } else { "" },
         s.max_force_n,
         specs.peak_force_n,
         s.max_torque_nm,
@@ -285,6 +306,14 @@ fn run() -> anyhow::Result<()> {
             "collision_jitter_p50_us": s.collision.jitter_p50_us,
             "collision_jitter_p99_us": s.collision.jitter_p99_us,
             "budget_hits": s.budget_hits,
+            "collision_step_p50_us": costs.work_p50_us,
+            "collision_step_p99_us": costs.work_p99_us,
+            "broad_phase_p99_us": costs.broad_p99_us,
+            "broad_phase_share": costs.broad_share,
+            "pairs_queried_mean": costs.queried_mean,
+            "pairs_culled_mean": costs.culled_mean,
+            "objects": args.objects + 1,
+            "broad_phase": !args.no_broad_phase,
             "max_force_n": s.max_force_n,
             "max_torque_nm": s.max_torque_nm,
             "max_force_step_n": s.max_force_step_n,
@@ -313,7 +342,7 @@ fn lockstep(
     args: &Args,
     device: Box<dyn Device>,
     tool: ToolSpec,
-    (bunny, surface): (ObjectSpec, Option<Arc<collette::SignedDistanceGrid>>),
+    (bunny, surface, scattered): (ObjectSpec, Option<Arc<collette::SignedDistanceGrid>>, Vec<ObjectSpec>),
     config: &RigConfig,
     replay: Option<&Trace>,
     recording: Option<TraceWriter>,
@@ -330,6 +359,9 @@ fn lockstep(
     let mut rig = Lockstep::new(device, tool, config, 1, None)?;
     let id = bunny.id;
     rig.add_object(bunny)?;
+    for object in scattered {
+        rig.add_object(object)?;
+    }
     if surface.is_some() {
         rig.set_surface(id, surface)?;
     }
@@ -379,6 +411,39 @@ fn lockstep(
         println!("{json}");
     }
     Ok(())
+}
+
+/// `n` small objects (balls and boxes of 1.2 cm, 300 spheres each, two trees shared by all) scattered
+/// at random (a fixed seed) in the bunny's box grown by 2 cm: in the tool's way along the path.
+fn scatter(n: usize, bunny: &collette::TriMesh, material: &Material) -> anyhow::Result<Vec<ObjectSpec>> {
+    if n == 0 {
+        return Ok(Vec::new());
+    }
+    anyhow::ensure!(n < haptic_rig::MAX_OBJECTS, "--objects: at most {} beside the bunny", haptic_rig::MAX_OBJECTS - 1);
+    let shapes = [collette::shape::uv_sphere_buffers(0.006, 12, 16), collette::shape::box_buffers(Vec3::splat(0.006))];
+    let mut trees = Vec::new();
+    for (v, t) in shapes {
+        let mesh = collette::TriMesh::new(v, t).context("a scattered object's mesh")?;
+        let (tree, _) = collette::build(&mesh, &collette::BuildOptions::spheres(300), &mut |_| {})
+            .context("a scattered object's tree")?;
+        trees.push(Arc::new(tree));
+    }
+    let area = bunny.aabb();
+    let (low, size) = (area.min - Vec3::splat(0.02), area.extents() + Vec3::splat(0.04));
+    let mut seed = 0x2545_f491u32;
+    let mut roll = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 17;
+        seed ^= seed << 5;
+        seed as f32 / u32::MAX as f32
+    };
+    Ok((0..n)
+        .map(|i| {
+            let at = low + size * Vec3::new(roll(), roll(), roll());
+            let turn = glam::Quat::from_euler(glam::EulerRot::XYZ, roll() * 3.0, roll() * 3.0, roll() * 3.0);
+            ObjectSpec { id: 2 + i as u32, tree: trees[i % 2].clone(), pose: Pose::new(at, turn), material: *material }
+        })
+        .collect())
 }
 
 /// Closes a recording and says what it wrote.
