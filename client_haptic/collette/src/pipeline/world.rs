@@ -241,8 +241,6 @@ pub struct StepReport {
     pub queried: u32,
     /// Watched pairs with both objects present that the broad phase found apart (not queried).
     pub culled: u32,
-    /// Object pairs whose boxes overlap (the broad phase's candidates, watched or not).
-    pub overlapping: u32,
     /// Time spent reading poses and in the broad phase, ns.
     pub broad_ns: u32,
     /// Contacts (or near spheres) published over all pairs.
@@ -257,14 +255,37 @@ struct ObjectSlot {
     surface: Option<Arc<SignedDistanceGrid>>,
     /// The pose this step uses (read from `pose` at the step's time).
     now: TimedPose,
+    /// A sphere holding the object in its own frame (see [`ObjectSlot::local_sphere`]), and where the
+    /// step's pose puts it.
+    local: (Vec3, f32),
+    world: (Vec3, f32),
 }
 
 impl ObjectSlot {
     fn new(tree: Arc<InnerSphereTree>, pose: triple_buffer::Output<ObjectPose>) -> Self {
-        Self { tree, pose, surface: None, now: TimedPose::default() }
+        let mut slot = Self {
+            tree,
+            pose,
+            surface: None,
+            now: TimedPose::default(),
+            local: (Vec3::ZERO, 0.0),
+            world: (Vec3::ZERO, 0.0),
+        };
+        slot.local = slot.local_sphere();
+        slot
     }
 
-    /// Reads the newest pose buffer at `at_us` into `now` (an empty track keeps the last pose).
+    /// A sphere holding the object in its frame: its tree's root bound, or with a surface grid the
+    /// grid's box (the mesh's surface lies a little outside the inner spheres).
+    fn local_sphere(&self) -> (Vec3, f32) {
+        match &self.surface {
+            Some(grid) => (grid.bounds().center(), grid.bounds().extents().length() * 0.5),
+            None => (self.tree.root().bound.center, self.tree.root().bound.radius),
+        }
+    }
+
+    /// Reads the newest pose buffer at `at_us` into `now`, and where it puts the object's sphere (an
+    /// empty track keeps the last pose).
     fn read_pose(&mut self, at_us: u64) {
         self.pose.update();
         match self.pose.output_buffer() {
@@ -275,16 +296,12 @@ impl ObjectSlot {
                 }
             }
         }
+        self.world = (self.now.pose.transform_point(self.local.0), self.local.1);
     }
 
-    /// A world sphere holding the object: its tree's root bound, or with a surface grid the grid's box
-    /// (the mesh's surface lies a little outside the inner spheres).
+    /// The world sphere holding the object on this step.
     fn sphere(&self) -> (Vec3, f32) {
-        let (center, radius) = match &self.surface {
-            Some(grid) => (grid.bounds().center(), grid.bounds().extents().length() * 0.5),
-            None => (self.tree.root().bound.center, self.tree.root().bound.radius),
-        };
-        (self.now.pose.transform_point(center), radius)
+        self.world
     }
 
     /// The world box holding [`sphere`](Self::sphere) and, for a near watcher's point, its reach.
@@ -314,6 +331,8 @@ pub struct CollisionWorld {
     workspace: QueryWorkspace,
     /// One pair's contacts or near spheres, before they join a scene watcher's set.
     scratch: ContactSet,
+    /// The objects a scene watcher queries on this step (a slot per object).
+    candidates: Vec<u32>,
     scratch_near: NearSpheres,
     on_collision: Delegator<OnCollision>,
     paused: bool,
@@ -337,6 +356,7 @@ impl CollisionWorld {
             region: None,
             workspace: QueryWorkspace::new(),
             scratch: ContactSet::new(),
+            candidates: Vec::with_capacity(config.max_objects),
             scratch_near: NearSpheres::default(),
             on_collision,
             paused: false,
@@ -367,7 +387,10 @@ impl CollisionWorld {
                 }
             }
             Command::SetTree(id, tree) => match self.objects.get_mut(id.0 as usize).and_then(Option::as_mut) {
-                Some(slot) => retire(Retired::Tree(std::mem::replace(&mut slot.tree, tree))),
+                Some(slot) => {
+                    retire(Retired::Tree(std::mem::replace(&mut slot.tree, tree)));
+                    slot.local = slot.local_sphere();
+                }
                 None => retire(Retired::Tree(tree)),
             },
             Command::SetSurface(id, surface) => match self.objects.get_mut(id.0 as usize).and_then(Option::as_mut) {
@@ -375,6 +398,7 @@ impl CollisionWorld {
                     if let Some(old) = std::mem::replace(&mut slot.surface, surface) {
                         retire(Retired::Surface(old));
                     }
+                    slot.local = slot.local_sphere();
                 }
                 None => {
                     if let Some(surface) = surface {
@@ -418,20 +442,23 @@ impl CollisionWorld {
         }
         self.sequence += 1;
         let broad_start = Instant::now();
+        let mut present = 0u32;
         for (slot, object) in self.objects.iter_mut().enumerate() {
             let bounds = object.as_mut().map(|o| {
                 o.read_pose(at_us);
                 o.bounds()
             });
+            present += bounds.is_some() as u32;
             self.broad.set(slot, bounds);
         }
         if self.broad_enabled {
             self.broad.update();
         }
-        report.overlapping = self.broad.overlapping();
         report.broad_ns = broad_start.elapsed().as_nanos().min(u32::MAX as u128) as u32;
         let sequence = self.sequence;
-        let Self { objects, watchers, broad, region, workspace, scratch, scratch_near, on_collision, .. } = self;
+        let Self {
+            objects, watchers, broad, region, workspace, scratch, scratch_near, on_collision, candidates, ..
+        } = self;
         let (objects, broad, region) = (&*objects, self.broad_enabled.then_some(&*broad), *region);
         let is_close = |ia: usize, ib: usize, near: bool| close(objects, broad, region, ia, ib, near);
         // Pairs to query this step, for the budget's shares.
@@ -439,9 +466,10 @@ impl CollisionWorld {
             .iter()
             .flatten()
             .map(|w| match w.out.is_scene() {
-                true => (0..objects.len())
-                    .filter(|&b| b != w.a.0 as usize && is_close(w.a.0 as usize, b, w.out.is_near()))
-                    .count() as u32,
+                true => {
+                    scene_candidates(objects, broad, region, w.a.0 as usize, w.out.is_near(), candidates);
+                    candidates.len() as u32
+                }
                 false => is_close(w.a.0 as usize, w.b.0 as usize, w.out.is_near()) as u32,
             })
             .sum();
@@ -460,27 +488,25 @@ impl CollisionWorld {
                     publish_empty_scene(&mut w.out, w.a.0, sequence, 0);
                     continue;
                 };
-                let (mut oldest, mut culled, near) = (a.now.timestamp_us, 0, w.out.is_near());
+                let mut oldest = a.now.timestamp_us;
+                scene_candidates(objects, broad, region, ia, w.out.is_near(), candidates);
+                report.culled += present.saturating_sub(1 + candidates.len() as u32);
                 match &mut w.out {
                     WatcherOutput::SceneContacts(out) => {
                         let set = out.input_buffer_mut();
                         set.clear();
-                        for (ib, b) in objects.iter().enumerate() {
-                            let Some(b) = b.as_ref().filter(|_| ib != ia) else { continue };
-                            if !is_close(ia, ib, near) {
-                                culled += 1;
-                                continue;
-                            }
+                        for &ib in candidates.iter() {
+                            let Some(Some(b)) = objects.get(ib as usize) else { continue };
                             let budget = share(&mut remaining).map_or(Budget::Unlimited, Budget::Deadline);
                             report.budget_hit |= !measure(a, b, budget, workspace, scratch);
                             report.queried += 1;
                             oldest = oldest.min(b.now.timestamp_us);
-                            (scratch.object_a, scratch.object_b, scratch.sequence) = (w.a.0, ib as u32, sequence);
+                            (scratch.object_a, scratch.object_b, scratch.sequence) = (w.a.0, ib, sequence);
                             scratch.timestamp_us = a.now.timestamp_us.min(b.now.timestamp_us);
                             if !scratch.is_empty() {
                                 on_collision.broadcast(scratch);
                             }
-                            set.add(ib as u32, scratch);
+                            set.add(ib, scratch);
                         }
                         (set.object, set.sequence, set.timestamp_us) = (w.a.0, sequence, oldest);
                         report.contacts += set.contacts().len() as u32;
@@ -489,13 +515,9 @@ impl CollisionWorld {
                     WatcherOutput::SceneNear(out) => {
                         let set = out.input_buffer_mut();
                         set.clear();
-                        for (ib, b) in objects.iter().enumerate() {
-                            let Some(b) = b.as_ref().filter(|_| ib != ia) else { continue };
-                            if !is_close(ia, ib, near) {
-                                culled += 1;
-                                continue;
-                            }
-                            gather_near(b, a.now.pose.translation, a.now.reach, ib as u32, workspace, scratch_near);
+                        for &ib in candidates.iter() {
+                            let Some(Some(b)) = objects.get(ib as usize) else { continue };
+                            gather_near(b, a.now.pose.translation, a.now.reach, ib, workspace, scratch_near);
                             report.queried += 1;
                             oldest = oldest.min(b.now.timestamp_us);
                             set.overflow += scratch_near.overflow;
@@ -508,7 +530,6 @@ impl CollisionWorld {
                     }
                     _ => {}
                 }
-                report.culled += culled;
                 continue;
             }
             let ib = w.b.0 as usize;
@@ -585,6 +606,30 @@ fn publish_empty_scene(out: &mut WatcherOutput, object: u32, sequence: u64, time
             out.publish();
         }
         _ => {}
+    }
+}
+
+/// Puts in `out` the objects to query against object `ia` for a scene watcher (`near`: a near one): with
+/// a broad phase, the objects whose boxes overlap its box and that pass [`close`]; without, every
+/// present object inside the region. Allocation-free (`out` holds a slot per object).
+fn scene_candidates(
+    objects: &[Option<ObjectSlot>],
+    broad: Option<&BroadPhase>,
+    region: Option<Aabb>,
+    ia: usize,
+    near: bool,
+    out: &mut Vec<u32>,
+) {
+    out.clear();
+    match broad {
+        Some(b) => b.near(ia, |ib| {
+            if close(objects, broad, region, ia, ib, near) {
+                out.push(ib as u32);
+            }
+        }),
+        None => out.extend(
+            (0..objects.len()).filter(|&ib| ib != ia && close(objects, None, region, ia, ib, near)).map(|ib| ib as u32),
+        ),
     }
 }
 
