@@ -561,12 +561,16 @@ pub(crate) fn report_pair_contacts(
     }
 }
 
-/// Moves colliders the game moved (`PostUpdate`, after transforms).
+/// Moves colliders the game moved (`PostUpdate`, after transforms): each new pose goes to the threads
+/// with the time it was sent on the haptic clock, so they move the collider smoothly between frames and
+/// feel its velocity (`haptic_rig`'s pose tracks, read 20 ms behind); one the game stops moving rests
+/// at its last pose.
 pub(crate) fn move_colliders(mut threads: Threads, moved: Query<(Entity, &GlobalTransform), ColliderMoved>) {
     let Some((runtime, watched)) = threads.get() else { return };
     for (entity, transform) in &moved {
         let Some(&id) = watched.ids.get(&entity) else { continue };
-        if let Some(Err(e)) = runtime.rig(|rig| rig.set_object_pose(id, pose_of(transform))) {
+        let sent = runtime.rig(|rig| rig.set_object_pose_at(id, pose_of(transform), rig.clock().now_us()));
+        if let Some(Err(e)) = sent {
             warn!("moving {entity} on the collision thread: {e}");
         }
     }

@@ -31,6 +31,8 @@ struct Entry {
     center_of_mass: glam::Vec3,
     /// Its last poses with their times, while the game moves it (empty: placed).
     track: PoseTrack,
+    /// Where the game last placed it (a track starts from there).
+    placed: Pose,
 }
 
 /// A watcher between two objects, read on the game thread.
@@ -115,7 +117,8 @@ impl Scene {
         });
         self.forces.push(ForceCommand::Add(object)).map_err(|_| RigError::QueueFull("haptic"))?;
         let track = PoseTrack::new(self.timing);
-        self.entries.push(Entry { id: spec.id, object: pose.id(), pose, center_of_mass: local_center, track });
+        let placed = spec.pose;
+        self.entries.push(Entry { id: spec.id, object: pose.id(), pose, center_of_mass: local_center, track, placed });
         for (a, b) in rewatch {
             self.watch_pair(a, b)?;
         }
@@ -193,6 +196,7 @@ impl Scene {
         // A placement, not a sample: it never ages (see `TimedPose`).
         entry.pose.set(pose, u64::MAX);
         entry.track.clear();
+        entry.placed = pose;
         Ok(())
     }
 
@@ -202,6 +206,10 @@ impl Scene {
         self.free_returned();
         let entry = self.entries.iter_mut().find(|e| e.id == id).ok_or(RigError::UnknownObject(id))?;
         let mut track = entry.track;
+        if track.samples().is_empty() {
+            // From rest where it was placed, not a jump to the first pose.
+            track.push(entry.placed, t_us.saturating_sub(self.timing.delay_us as u64));
+        }
         if !track.push(pose, t_us) {
             return Err(RigError::BadSample { id, t_us });
         }

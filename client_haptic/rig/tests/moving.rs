@@ -111,3 +111,32 @@ fn an_object_rising_into_the_tool_pushes_harder_than_one_resting_at_the_same_pla
         assert!((push - want).abs() <= 0.1 * want, "the damping of 50 mm/s: {push} N, not {want} N");
     }
 }
+
+#[test]
+fn an_object_moved_once_with_its_time_glides_there_from_where_it_was_placed() {
+    // The level slab 2 mm into the ball, then told once (at 50 ms) that it is 1 mm higher: placed, the
+    // overlap jumps on the next tick; sent with its time, it grows over the track's 20 ms.
+    let level = |y: f32| Pose::from_translation(Vec3::new(0.0, y, 0.0));
+    let run = |tracked: bool| {
+        let mut rig = rig();
+        rig.set_object_pose(1, level(-0.013)).expect("placed");
+        let mut volumes = Vec::new();
+        for t_us in (0..120_000u64).step_by(1000) {
+            if t_us == 50_000 {
+                match tracked {
+                    true => rig.set_object_pose_at(1, level(-0.012), t_us).expect("tracked"),
+                    false => rig.set_object_pose(1, level(-0.012)).expect("placed"),
+                }
+            }
+            rig.tick(t_us);
+            if t_us >= 40_000 {
+                volumes.push(rig.telemetry().objects().first().map_or(0.0, |c| c.volume));
+            }
+        }
+        let step = volumes.windows(2).map(|w| (w[1] - w[0]).abs()).fold(0.0f32, f32::max);
+        (step, *volumes.last().expect("ticks"))
+    };
+    let ((placed, placed_end), (glided, glided_end)) = (run(false), run(true));
+    assert!(placed_end > 0.0 && placed_end == glided_end, "both end in the same place: {placed_end} {glided_end}");
+    assert!(glided * 5.0 <= placed, "no jump: {glided:e} m³ a tick against {placed:e} m³");
+}
