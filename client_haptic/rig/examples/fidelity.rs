@@ -1,0 +1,481 @@
+//! fidelity: how close the rendered force and torque come to exact answers, on scenes whose answer is
+//! known (the approach of Weller et al.'s benchmarking suite for 6-DOF collision response, VRST 2010).
+//!
+//! `cargo run --release -p haptic_rig --example fidelity -- --json`
+//!
+//! Volumetric rendering (Eq. 1 and 2 with ε_c = 1, no damping or friction: the force is the overlap
+//! volume along the contact normals) is judged against the penalty the exact overlap gives: the exact
+//! volume along the exact normal, its torque about a handle point off the tool from the exact overlap's
+//! centroid. Two trees (the tool's against the object's) and the tree against the object's surface grid.
+//! The 3-DOF proxy is judged by where it holds the tip: its contact point against the exact closest
+//! point of the surface. Scenes: a sphere, a box's edge, a box's corner and a cylinder on its side
+//! pressed into a slab, a sphere into a sphere; the proxy's tip into the slab, the sphere and the box
+//! (faces, edges and corners), at depths from 0.1 to 5 mm (one pose in ten 5–10 mm), random places and
+//! turns about the normal. Meshes with a Monte Carlo reference are the next step (docs/haptics.md).
+
+use std::f32::consts::PI;
+use std::sync::Arc;
+
+use clap::Parser;
+use collette::shape::{box_buffers, uv_sphere_buffers};
+use collette::{BuildOptions, ContactSet, InnerSphereTree, QueryWorkspace, SignedDistanceGrid, TriMesh};
+use forcecomp::{Ball, BodyMotion, GodObject, Material, ProxyConfig};
+use glam::{Quat, Vec3};
+use haptic_common::Pose;
+
+#[derive(Parser, Debug)]
+#[command(about = "Judges rendered forces and torques against exact answers on scenes whose answer is known.")]
+struct Args {
+    /// Poses per scene.
+    #[arg(long, default_value_t = 2000)]
+    poses: usize,
+    /// Spheres in every tree.
+    #[arg(long, default_value_t = 5000)]
+    spheres: usize,
+    /// Voxels along the longest side of the objects' surface grids.
+    #[arg(long, default_value_t = 128)]
+    grid: usize,
+    /// Seed of the poses.
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+    /// End with one JSON line per rendering.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Errors end the program on one line.
+fn main() -> std::process::ExitCode {
+    match run(Args::parse()) {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+/// A shape's mesh, tree and surface grid.
+struct Shape {
+    tree: Arc<InnerSphereTree>,
+    grid: SignedDistanceGrid,
+}
+
+fn shape(buffers: (Vec<Vec3>, Vec<[u32; 3]>), args: &Args) -> anyhow::Result<Shape> {
+    let mesh = TriMesh::new(buffers.0, buffers.1)?;
+    let (tree, _) = collette::build(&mesh, &BuildOptions::spheres(args.spheres), &mut |_| {})?;
+    let grid = SignedDistanceGrid::new(&mesh, args.grid)?;
+    Ok(Shape { tree: Arc::new(tree), grid })
+}
+
+/// A closed cylinder along z: radius `r`, half length `h`, `n` sides.
+fn cylinder_buffers(r: f32, h: f32, n: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let mut v = vec![Vec3::new(0.0, 0.0, -h), Vec3::new(0.0, 0.0, h)];
+    for i in 0..n {
+        let a = i as f32 / n as f32 * 2.0 * PI;
+        v.push(Vec3::new(r * a.cos(), r * a.sin(), -h));
+        v.push(Vec3::new(r * a.cos(), r * a.sin(), h));
+    }
+    let mut t = Vec::new();
+    for i in 0..n {
+        let (b0, t0) = (2 + 2 * i, 3 + 2 * i);
+        let (b1, t1) = (2 + 2 * ((i + 1) % n), 3 + 2 * ((i + 1) % n));
+        t.push([0, b1, b0]);
+        t.push([1, t0, t1]);
+        t.push([b0, b1, t1]);
+        t.push([b0, t1, t0]);
+    }
+    (v, t)
+}
+
+/// Sizes of the scenes, m.
+const SPHERE_R: f32 = 0.02;
+const BALL_R: f32 = 0.03;
+const CUBE_HALF: f32 = 0.015;
+const CYL_R: f32 = 0.015;
+const CYL_HALF: f32 = 0.03;
+const SLAB_HALF: Vec3 = Vec3::new(0.1, 0.02, 0.1);
+/// The point torques are taken about: a handle off the tool's centre.
+const HANDLE: Vec3 = Vec3::new(0.04, 0.05, 0.03);
+
+/// The penalty the exact overlap gives: its volume along the normal, and the overlap's centroid.
+#[derive(Clone, Copy, Debug)]
+struct Exact {
+    volume: f32,
+    normal: Vec3,
+    centroid: Vec3,
+}
+
+/// Volume of a spherical cap of height `h` on a sphere of radius `r`.
+fn cap_volume(r: f32, h: f32) -> f32 {
+    PI * h * h * (3.0 * r - h) / 3.0
+}
+
+/// Distance from a sphere's centre to the centroid of its cap of height `h`.
+fn cap_centroid(r: f32, h: f32) -> f32 {
+    3.0 * (2.0 * r - h).powi(2) / (4.0 * (3.0 * r - h))
+}
+
+/// A sphere of radius `r` centred at `c` pressed `d` into the plane y = 0 from above.
+fn sphere_on_plane(r: f32, c: Vec3, d: f32) -> Exact {
+    Exact { volume: cap_volume(r, d), normal: Vec3::Y, centroid: c - Vec3::Y * cap_centroid(r, d) }
+}
+
+/// Sphere `r1` at `c1` overlapping sphere `r2` at `c2` (the tool is sphere 1).
+fn sphere_on_sphere(r1: f32, c1: Vec3, r2: f32, c2: Vec3) -> Exact {
+    let dist = c1.distance(c2);
+    let u = (c1 - c2) / dist;
+    // The radical plane lies `a2` from c2 along u; the lens is a cap of each sphere on either side.
+    let a2 = (dist * dist + r2 * r2 - r1 * r1) / (2.0 * dist);
+    let (h2, h1) = (r2 - a2, r1 - (dist - a2));
+    let (v1, v2) = (cap_volume(r1, h1), cap_volume(r2, h2));
+    let (g1, g2) = (c1 - u * cap_centroid(r1, h1), c2 + u * cap_centroid(r2, h2));
+    Exact { volume: v1 + v2, normal: u, centroid: (g1 * v1 + g2 * v2) / (v1 + v2) }
+}
+
+/// A box edge of length `len` lying level along the plane, its faces at 45°, `d` deep: a prism of
+/// cross-section d² whose centroid is d/3 below the plane, under the edge's middle `m`.
+fn edge_on_plane(len: f32, m: Vec3, d: f32) -> Exact {
+    Exact { volume: len * d * d, normal: Vec3::Y, centroid: Vec3::new(m.x, -d / 3.0, m.z) }
+}
+
+/// A cube corner at `corner`, its body diagonal vertical, `d` deep: a tetrahedron of legs √3·d,
+/// volume (√3/2)·d³, centroid a quarter of the way up.
+fn corner_on_plane(corner: Vec3, d: f32) -> Exact {
+    Exact { volume: 3f32.sqrt() / 2.0 * d.powi(3), normal: Vec3::Y, centroid: corner + Vec3::Y * (0.75 * d) }
+}
+
+/// A cylinder of radius `r`, length `len`, lying on its side with its axis at `c`, `d` deep: a
+/// circular segment times the length.
+fn cylinder_on_plane(r: f32, len: f32, c: Vec3, d: f32) -> Exact {
+    let theta = 2.0 * ((r - d) / r).acos();
+    let area = 0.5 * r * r * (theta - theta.sin());
+    let below = 4.0 * r * (theta / 2.0).sin().powi(3) / (3.0 * (theta - theta.sin()));
+    Exact { volume: area * len, normal: Vec3::Y, centroid: c - Vec3::Y * below }
+}
+
+/// A small deterministic generator (xorshift), 0..1.
+struct Dice(u32);
+
+impl Dice {
+    fn roll(&mut self) -> f32 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 17;
+        self.0 ^= self.0 << 5;
+        self.0 as f32 / u32::MAX as f32
+    }
+
+    /// A depth: log-uniform over 0.1–5 mm, one in ten 5–10 mm.
+    fn depth(&mut self) -> f32 {
+        if self.roll() < 0.1 { 0.005 + 0.005 * self.roll() } else { 1e-4 * 50f32.powf(self.roll()) }
+    }
+
+    fn unit(&mut self) -> Vec3 {
+        loop {
+            let v = Vec3::new(self.roll(), self.roll(), self.roll()) * 2.0 - Vec3::ONE;
+            if (0.01..=1.0).contains(&v.length_squared()) {
+                return v.normalize();
+            }
+        }
+    }
+}
+
+/// Angle between two vectors, degrees.
+fn angle_deg(a: Vec3, b: Vec3) -> f32 {
+    a.normalize_or_zero().dot(b.normalize_or_zero()).clamp(-1.0, 1.0).acos().to_degrees()
+}
+
+/// Errors of one rendering over many poses.
+#[derive(Default)]
+struct Errors {
+    direction_deg: Vec<f32>,
+    magnitude_pct: Vec<f32>,
+    torque_deg: Vec<f32>,
+    contact_mm: Vec<f32>,
+}
+
+impl Errors {
+    fn add(&mut self, other: Errors) {
+        self.direction_deg.extend(other.direction_deg);
+        self.magnitude_pct.extend(other.magnitude_pct);
+        self.torque_deg.extend(other.torque_deg);
+        self.contact_mm.extend(other.contact_mm);
+    }
+}
+
+/// The `q` quantile (0–1) of `values` (NaN when empty).
+fn quantile(values: &[f32], q: f32) -> f32 {
+    if values.is_empty() {
+        return f32::NAN;
+    }
+    let mut v = values.to_vec();
+    v.sort_by(f32::total_cmp);
+    v[((v.len() - 1) as f32 * q).round() as usize]
+}
+
+/// The tool's force and torque about the handle through `overlap` (ε_c = 1), against `exact`.
+fn judge(set: &ContactSet, tool: &Pose, exact: &Exact, errors: &mut Errors) {
+    let handle = tool.translation + HANDLE;
+    let unit = Material { stiffness_n_per_m3: 1.0, damping_ns_per_m: 0.0, friction: 0.0, texture: None };
+    let rendered =
+        forcecomp::volumetric_penalty(set, &BodyMotion::at_rest(handle), &BodyMotion::at_rest(Vec3::ZERO), &unit);
+    let force = exact.normal * exact.volume;
+    let torque = (exact.centroid - handle).cross(force);
+    errors.direction_deg.push(angle_deg(rendered.force, force));
+    errors.magnitude_pct.push((rendered.force.length() / force.length() - 1.0).abs() * 100.0);
+    errors.torque_deg.push(angle_deg(rendered.torque, torque));
+}
+
+/// The volumetric renderings of one scene: `place` gives, for a depth and the dice, the tool's pose and
+/// the exact answer.
+fn volumetric(
+    tool: &Shape,
+    object: &Shape,
+    object_pose: &Pose,
+    poses: usize,
+    dice: &mut Dice,
+    place: impl Fn(f32, &mut Dice) -> (Pose, Exact),
+) -> (Errors, Errors) {
+    let (mut trees, mut grid) = (Errors::default(), Errors::default());
+    let (mut ws, mut set) = (QueryWorkspace::new(), ContactSet::new());
+    for _ in 0..poses {
+        let (pose, exact) = place(dice.depth(), dice);
+        collette::overlap(&tool.tree, &pose, &object.tree, object_pose, &mut ws, &mut set);
+        judge(&set, &pose, &exact, &mut trees);
+        collette::overlap_field(&tool.tree, &pose, &object.tree, &object.grid, object_pose, &mut ws, &mut set);
+        judge(&set, &pose, &exact, &mut grid);
+    }
+    (trees, grid)
+}
+
+/// The 3-DOF proxy's tip (radius 4 mm, as the rig's default) pressed from `outside` to `inside`; its
+/// contact point (the proxy less its hold-off along the normal) against `surface`, the exact closest
+/// point of the object's surface to `inside`.
+fn proxy(object: &Shape, object_pose: &Pose, outside: Vec3, inside: Vec3, surface: Vec3, errors: &mut Errors) {
+    let config = ProxyConfig { friction: 0.0, tip_radius: 0.004, ..ProxyConfig::default() };
+    let mut ws = QueryWorkspace::new();
+    let mut balls = Vec::new();
+    collette::query::spheres_near(&object.tree, object_pose, inside, 0.03, &mut ws, |center, radius| {
+        balls.push(Ball { center, radius })
+    });
+    let mut god = GodObject::new();
+    god.update(&config, outside, Vec3::ZERO, &balls, 1.0);
+    for _ in 0..20 {
+        god.update(&config, inside, Vec3::ZERO, &balls, 1.0);
+    }
+    if !god.in_contact() {
+        errors.contact_mm.push(f32::INFINITY);
+        return;
+    }
+    // The proxy rests where the tip overlaps the surface by a cap of SURFACE_CAP of its radius; its
+    // normal points out of the object.
+    let hold_off = config.tip_radius * (1.0 - forcecomp::proxy::SURFACE_CAP);
+    let contact = god.proxy() - god.normal() * hold_off;
+    errors.contact_mm.push(contact.distance(surface) * 1000.0);
+}
+
+fn run(args: Args) -> anyhow::Result<()> {
+    anyhow::ensure!(args.poses > 0, "--poses must be at least 1");
+    let started = std::time::Instant::now();
+    let sphere = shape(uv_sphere_buffers(SPHERE_R, 48, 96), &args)?;
+    let ball = shape(uv_sphere_buffers(BALL_R, 48, 96), &args)?;
+    let cube = shape(box_buffers(Vec3::splat(CUBE_HALF)), &args)?;
+    let cylinder = shape(cylinder_buffers(CYL_R, CYL_HALF, 96), &args)?;
+    let slab = shape(box_buffers(SLAB_HALF), &args)?;
+    eprintln!("fidelity: trees and grids built in {:.1} s", started.elapsed().as_secs_f32());
+    let slab_pose = Pose::from_translation(Vec3::new(0.0, -SLAB_HALF.y, 0.0));
+    let mut dice = Dice(args.seed.max(1) * 0x9e37_79b9);
+    let spin = |dice: &mut Dice| Quat::from_rotation_y(dice.roll() * 2.0 * PI);
+    let spot = |dice: &mut Dice| Vec3::new(dice.roll() - 0.5, 0.0, dice.roll() - 0.5) * 0.06;
+
+    let mut table = Vec::new();
+    let scenes: [(&str, &Shape, &Shape, Pose); 5] = [
+        ("sphere on plane", &sphere, &slab, slab_pose),
+        ("sphere on sphere", &sphere, &ball, Pose::IDENTITY),
+        ("box edge on plane", &cube, &slab, slab_pose),
+        ("box corner on plane", &cube, &slab, slab_pose),
+        ("cylinder on its side", &cylinder, &slab, slab_pose),
+    ];
+    let (mut all_trees, mut all_grid) = (Errors::default(), Errors::default());
+    for (i, (name, tool, object, object_pose)) in scenes.into_iter().enumerate() {
+        let (trees, grid) = volumetric(tool, object, &object_pose, args.poses, &mut dice, |d, dice| match i {
+            0 => {
+                let c = spot(dice) + Vec3::Y * (SPHERE_R - d);
+                (Pose::new(c, spin(dice)), sphere_on_plane(SPHERE_R, c, d))
+            }
+            1 => {
+                let u = dice.unit();
+                let c = u * (SPHERE_R + BALL_R - d);
+                (Pose::new(c, spin(dice)), sphere_on_sphere(SPHERE_R, c, BALL_R, Vec3::ZERO))
+            }
+            2 => {
+                // Turned 45° about x, so that an edge along its local z lies lowest, then about y.
+                let turn = spin(dice) * Quat::from_rotation_x(PI / 4.0);
+                let m = spot(dice);
+                let c = m + Vec3::Y * (CUBE_HALF * 2f32.sqrt() - d);
+                (Pose::new(c, turn), edge_on_plane(2.0 * CUBE_HALF, m, d))
+            }
+            3 => {
+                // The corner (-h, -h, -h) turned to point straight down.
+                let down = Quat::from_rotation_arc(Vec3::splat(-1.0).normalize(), -Vec3::Y);
+                let turn = spin(dice) * down;
+                let corner = spot(dice) - Vec3::Y * d;
+                let c = corner + Vec3::Y * (CUBE_HALF * 3f32.sqrt());
+                (Pose::new(c, turn), corner_on_plane(corner, d))
+            }
+            _ => {
+                let c = spot(dice) + Vec3::Y * (CYL_R - d);
+                (Pose::new(c, spin(dice)), cylinder_on_plane(CYL_R, 2.0 * CYL_HALF, c, d))
+            }
+        });
+        table.push((name.to_string(), "volumetric, two trees", quantiles(&trees)));
+        table.push((name.to_string(), "volumetric, tree against grid", quantiles(&grid)));
+        all_trees.add(trees);
+        all_grid.add(grid);
+    }
+
+    // The proxy: the tip pressed into the slab, the ball and the cube.
+    let mut proxy_errors = Errors::default();
+    let mut slab_errors = Errors::default();
+    for _ in 0..args.poses {
+        let (d, at) = (dice.depth(), spot(&mut dice));
+        proxy(&slab, &slab_pose, at + Vec3::Y * 0.01, at - Vec3::Y * d, at, &mut slab_errors);
+    }
+    let mut ball_errors = Errors::default();
+    for _ in 0..args.poses {
+        let (d, u) = (dice.depth(), dice.unit());
+        proxy(&ball, &Pose::IDENTITY, u * (BALL_R + 0.01), u * (BALL_R - d), u * BALL_R, &mut ball_errors);
+    }
+    let mut cube_errors = Errors::default();
+    let cube_pose = Pose::IDENTITY;
+    for _ in 0..args.poses {
+        // Straight in through a face, anywhere on it up to its edges (there the face is the nearest).
+        let d = dice.depth().min(CUBE_HALF * 0.5);
+        let (k, sign) = ((dice.roll() * 3.0) as usize % 3, if dice.roll() < 0.5 { -1.0 } else { 1.0 });
+        let mut surface = (Vec3::new(dice.roll(), dice.roll(), dice.roll()) * 2.0 - Vec3::ONE) * (CUBE_HALF - d);
+        surface[k] = sign * CUBE_HALF;
+        let mut out = Vec3::ZERO;
+        out[k] = sign;
+        proxy(&cube, &cube_pose, surface + out * 0.01, surface - out * d, surface, &mut cube_errors);
+    }
+    table.push(("tip into a plane".to_string(), "3-DOF proxy", quantiles(&slab_errors)));
+    table.push(("tip into a sphere".to_string(), "3-DOF proxy", quantiles(&ball_errors)));
+    table.push(("tip into a box".to_string(), "3-DOF proxy", quantiles(&cube_errors)));
+    proxy_errors.add(slab_errors);
+    proxy_errors.add(ball_errors);
+    proxy_errors.add(cube_errors);
+
+    println!(
+        "| scene | rendering | direction p50 / p99 | magnitude p50 / p99 | torque direction p50 / p99 | contact p50 / p99 |"
+    );
+    println!("| --- | --- | --- | --- | --- | --- |");
+    for (scene, rendering, q) in &table {
+        println!("| {scene} | {rendering} | {} | {} | {} | {} |", q[0], q[1], q[2], q[3]);
+    }
+    println!(
+        "fidelity: {} poses a scene, trees of {} spheres, grids of {} voxels, in {:.1} s",
+        args.poses,
+        args.spheres,
+        args.grid,
+        started.elapsed().as_secs_f32()
+    );
+    if args.json {
+        for (rendering, e) in
+            [("volumetric_trees", &all_trees), ("volumetric_grid", &all_grid), ("proxy", &proxy_errors)]
+        {
+            let volumetric = rendering != "proxy";
+            let line = serde_json::json!({
+                "rendering": rendering,
+                "poses": e.direction_deg.len().max(e.contact_mm.len()),
+                "direction_p99_deg": volumetric.then(|| quantile(&e.direction_deg, 0.99)),
+                "magnitude_p99_pct": volumetric.then(|| quantile(&e.magnitude_pct, 0.99)),
+                "torque_direction_p99_deg": volumetric.then(|| quantile(&e.torque_deg, 0.99)),
+                "contact_p99_mm": (!volumetric).then(|| quantile(&e.contact_mm, 0.99)),
+            });
+            println!("{line}");
+        }
+    }
+    Ok(())
+}
+
+/// The table's cells for one rendering of one scene: p50 / p99 of each error ("–" where it does not
+/// apply).
+fn quantiles(e: &Errors) -> [String; 4] {
+    let cell = |v: &[f32], unit: &str, digits: usize| {
+        if v.is_empty() {
+            "–".to_string()
+        } else {
+            format!("{:.digits$} / {:.digits$} {unit}", quantile(v, 0.5), quantile(v, 0.99))
+        }
+    };
+    [
+        cell(&e.direction_deg, "°", 2),
+        cell(&e.magnitude_pct, "%", 1),
+        cell(&e.torque_deg, "°", 2),
+        cell(&e.contact_mm, "mm", 3),
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Volume and centroid of the part of a shape below y = 0 (or inside `inside`), by sampling a grid.
+    fn sampled(low: Vec3, high: Vec3, n: usize, inside: impl Fn(Vec3) -> bool) -> (f32, Vec3) {
+        let step = (high - low) / n as f32;
+        let (mut count, mut sum) = (0usize, Vec3::ZERO);
+        for i in 0..n {
+            for j in 0..n {
+                for k in 0..n {
+                    let p = low + step * Vec3::new(i as f32 + 0.5, j as f32 + 0.5, k as f32 + 0.5);
+                    if inside(p) {
+                        count += 1;
+                        sum += p;
+                    }
+                }
+            }
+        }
+        (count as f32 * step.x * step.y * step.z, sum / count.max(1) as f32)
+    }
+
+    fn close(exact: Exact, (volume, centroid): (f32, Vec3), scale: f32) {
+        assert!((exact.volume / volume - 1.0).abs() < 0.02, "volume {} sampled {volume}", exact.volume);
+        assert!(exact.centroid.distance(centroid) < 0.01 * scale, "centroid {} sampled {centroid}", exact.centroid);
+    }
+
+    #[test]
+    fn the_exact_answers_match_a_sampled_integration() {
+        let d = 0.004;
+        // Sphere on plane.
+        let c = Vec3::new(0.01, SPHERE_R - d, 0.0);
+        let s = sampled(c - Vec3::splat(SPHERE_R), c + Vec3::splat(SPHERE_R), 160, |p| {
+            p.y < 0.0 && p.distance(c) < SPHERE_R
+        });
+        close(sphere_on_plane(SPHERE_R, c, d), s, SPHERE_R);
+        // Sphere on sphere.
+        let c1 = Vec3::new(0.3, 0.5, 0.2).normalize() * (SPHERE_R + BALL_R - d);
+        let s =
+            sampled(-Vec3::splat(0.06), Vec3::splat(0.06), 240, |p| p.distance(c1) < SPHERE_R && p.length() < BALL_R);
+        close(sphere_on_sphere(SPHERE_R, c1, BALL_R, Vec3::ZERO), s, SPHERE_R);
+        // Box edge (45°, along z) and corner.
+        let turn = Quat::from_rotation_x(PI / 4.0);
+        let m = Vec3::new(0.0, 0.0, 0.0);
+        let c = m + Vec3::Y * (CUBE_HALF * 2f32.sqrt() - d);
+        let in_cube = |pose: Pose| move |p: Vec3| pose.inverse().transform_point(p).abs().max_element() < CUBE_HALF;
+        let edge_cube = in_cube(Pose::new(c, turn));
+        let s =
+            sampled(Vec3::new(-0.02, -0.005, -0.02), Vec3::new(0.02, 0.0, 0.02), 200, |p| p.y < 0.0 && edge_cube(p));
+        close(edge_on_plane(2.0 * CUBE_HALF, m, d), s, CUBE_HALF);
+        let down = Quat::from_rotation_arc(Vec3::splat(-1.0).normalize(), -Vec3::Y);
+        let corner = -Vec3::Y * d;
+        let corner_cube = in_cube(Pose::new(corner + Vec3::Y * (CUBE_HALF * 3f32.sqrt()), down));
+        let s =
+            sampled(Vec3::new(-0.01, -0.005, -0.01), Vec3::new(0.01, 0.0, 0.01), 200, |p| p.y < 0.0 && corner_cube(p));
+        close(corner_on_plane(corner, d), s, 0.1 * CUBE_HALF);
+        // Cylinder on its side (axis along z).
+        let c = Vec3::Y * (CYL_R - d);
+        let s = sampled(Vec3::new(-0.02, -0.005, -0.035), Vec3::new(0.02, 0.0, 0.035), 200, |p| {
+            p.y < 0.0 && Vec3::new(p.x - c.x, p.y - c.y, 0.0).length() < CYL_R && p.z.abs() < CYL_HALF
+        });
+        close(cylinder_on_plane(CYL_R, 2.0 * CYL_HALF, c, d), s, CYL_R);
+    }
+}
