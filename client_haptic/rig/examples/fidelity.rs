@@ -187,6 +187,8 @@ fn angle_deg(a: Vec3, b: Vec3) -> f32 {
 /// Errors of one rendering over many poses.
 #[derive(Default)]
 struct Errors {
+    /// The depth of each volumetric pose, m.
+    depth: Vec<f32>,
     direction_deg: Vec<f32>,
     magnitude_pct: Vec<f32>,
     torque_deg: Vec<f32>,
@@ -194,7 +196,22 @@ struct Errors {
 }
 
 impl Errors {
+    /// The volumetric errors of the poses whose depth lies in `low..high` (m).
+    fn band(&self, low: f32, high: f32) -> Errors {
+        let pick = |v: &[f32]| -> Vec<f32> {
+            v.iter().zip(&self.depth).filter(|(_, d)| (low..high).contains(*d)).map(|(x, _)| *x).collect()
+        };
+        Errors {
+            depth: pick(&self.depth),
+            direction_deg: pick(&self.direction_deg),
+            magnitude_pct: pick(&self.magnitude_pct),
+            torque_deg: pick(&self.torque_deg),
+            contact_mm: Vec::new(),
+        }
+    }
+
     fn add(&mut self, other: Errors) {
+        self.depth.extend(other.depth);
         self.direction_deg.extend(other.direction_deg);
         self.magnitude_pct.extend(other.magnitude_pct);
         self.torque_deg.extend(other.torque_deg);
@@ -213,13 +230,14 @@ fn quantile(values: &[f32], q: f32) -> f32 {
 }
 
 /// The tool's force and torque about the handle through `overlap` (ε_c = 1), against `exact`.
-fn judge(set: &ContactSet, tool: &Pose, exact: &Exact, errors: &mut Errors) {
+fn judge(set: &ContactSet, tool: &Pose, exact: &Exact, depth: f32, errors: &mut Errors) {
     let handle = tool.translation + HANDLE;
     let unit = Material { stiffness_n_per_m3: 1.0, damping_ns_per_m: 0.0, friction: 0.0, texture: None };
     let rendered =
         forcecomp::volumetric_penalty(set, &BodyMotion::at_rest(handle), &BodyMotion::at_rest(Vec3::ZERO), &unit);
     let force = exact.normal * exact.volume;
     let torque = (exact.centroid - handle).cross(force);
+    errors.depth.push(depth);
     errors.direction_deg.push(angle_deg(rendered.force, force));
     errors.magnitude_pct.push((rendered.force.length() / force.length() - 1.0).abs() * 100.0);
     errors.torque_deg.push(angle_deg(rendered.torque, torque));
@@ -238,11 +256,12 @@ fn volumetric(
     let (mut trees, mut grid) = (Errors::default(), Errors::default());
     let (mut ws, mut set) = (QueryWorkspace::new(), ContactSet::new());
     for _ in 0..poses {
-        let (pose, exact) = place(dice.depth(), dice);
+        let depth = dice.depth();
+        let (pose, exact) = place(depth, dice);
         collette::overlap(&tool.tree, &pose, &object.tree, object_pose, &mut ws, &mut set);
-        judge(&set, &pose, &exact, &mut trees);
+        judge(&set, &pose, &exact, depth, &mut trees);
         collette::overlap_field(&tool.tree, &pose, &object.tree, &object.grid, object_pose, &mut ws, &mut set);
-        judge(&set, &pose, &exact, &mut grid);
+        judge(&set, &pose, &exact, depth, &mut grid);
     }
     (trees, grid)
 }
@@ -370,6 +389,17 @@ fn run(args: Args) -> anyhow::Result<()> {
     println!("| --- | --- | --- | --- | --- | --- |");
     for (scene, rendering, q) in &table {
         println!("| {scene} | {rendering} | {} | {} | {} | {} |", q[0], q[1], q[2], q[3]);
+    }
+    println!();
+    println!(
+        "| rendering, all volumetric scenes | depth | direction p50 / p99 | magnitude p50 / p99 | torque direction p50 / p99 |"
+    );
+    println!("| --- | --- | --- | --- | --- |");
+    for (rendering, e) in [("two trees", &all_trees), ("tree against grid", &all_grid)] {
+        for (band, low, high) in [("0.1–1 mm", 0.0, 0.001), ("1–5 mm", 0.001, 0.005), ("5–10 mm", 0.005, 1.0)] {
+            let q = quantiles(&e.band(low, high));
+            println!("| {rendering} | {band} | {} | {} | {} |", q[0], q[1], q[2]);
+        }
     }
     println!(
         "fidelity: {} poses a scene, trees of {} spheres, grids of {} voxels, in {:.1} s",
