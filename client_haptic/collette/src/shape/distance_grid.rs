@@ -151,15 +151,19 @@ impl SignedDistanceGrid {
         self.voxel * 3f32.sqrt() * 0.5
     }
 
-    /// Interpolated signed distance at `p` (mesh frame; positive inside). Outside the grid: the value
-    /// at the nearest point of the grid minus the distance to it.
+    /// Interpolated signed distance at `p` (mesh frame; positive inside). Outside the grid: the tangent
+    /// plane at the nearest point of the grid, extrapolated (the value there plus the gradient's share of
+    /// the way: exact for a flat face, and for a curved one seen at an angle far closer than the value
+    /// less the whole way, which made a big sphere beside a ball miss it; it falls with the way out and
+    /// never reaches the inside, since the mesh lies inside the grid).
     #[inline]
     pub fn distance(&self, p: Vec3) -> f32 {
         self.distance_and_gradient(p).0
     }
 
     /// Gradient of the distance at `p`, interpolated from the grid points' central differences: it
-    /// points into the mesh (length about 1 near the surface; outside the grid, towards it) and, unlike
+    /// points into the mesh (length about 1 near the surface; outside the grid, the nearest grid
+    /// point's) and, unlike
     /// the interpolant's own gradient, changes continuously across the cells' faces, so normals built on
     /// it do not jump.
     #[inline]
@@ -187,13 +191,10 @@ impl SignedDistanceGrid {
         if q == p {
             return (v.x, v.yzw());
         }
-        // Outside: the distance falls by the way to the grid; along each axis `p` was clamped on, the
-        // gradient is that way's, along the others the grid's.
-        let out = q - p;
-        let away = out.length();
-        let towards = out / away;
-        let clamped = out.cmpne(Vec3::ZERO);
-        (v.x - away, Vec3::select(clamped, towards, v.yzw()))
+        // Outside: the tangent plane at the nearest grid point. The gradient there points at the mesh,
+        // which lies inside the grid, so it has no share along the way out: the distance only falls.
+        let gradient = v.yzw();
+        (v.x + gradient.dot(p - q).min(0.0), gradient)
     }
 
     #[inline]
