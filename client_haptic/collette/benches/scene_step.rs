@@ -14,6 +14,8 @@ use collette::shape::{box_buffers, uv_sphere_buffers};
 use collette::{BuildOptions, InnerSphereTree, Pose, TriMesh, build};
 use criterion::Criterion;
 use glam::{Quat, Vec3};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 
 fn tree(buffers: (Vec<Vec3>, Vec<[u32; 3]>), spheres: usize) -> Arc<InnerSphereTree> {
     let mesh = TriMesh::new(buffers.0, buffers.1).expect("valid mesh");
@@ -42,13 +44,8 @@ fn scene(objects: usize, broad_phase: bool) -> Scene {
     let (mut handle, stepper) = pipeline(&config, haptic_common::Delegator::new());
     let mut tool =
         handle.add_object(tree(box_buffers(Vec3::new(0.01, 0.003, 0.003)), 500), Pose::IDENTITY).expect("slot");
-    let mut seed = 0x2545_f491u32;
-    let mut roll = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 17;
-        seed ^= seed << 5;
-        seed as f32 / u32::MAX as f32
-    };
+    let mut rng = ChaCha8Rng::seed_from_u64(0x2545_f491);
+    let mut roll = || rng.random::<f32>();
     let writers: Vec<PoseWriter> = (0..objects)
         .map(|i| {
             let scattered = Vec3::new(roll(), roll(), roll()) * 0.2 - Vec3::splat(0.1);

@@ -13,24 +13,14 @@ use collette::{
     overlap_budgeted,
 };
 use glam::{Quat, Vec3};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 
 const OBJECTS: usize = 256;
 
 fn tree(buffers: (Vec<Vec3>, Vec<[u32; 3]>)) -> Arc<InnerSphereTree> {
     let mesh = TriMesh::new(buffers.0, buffers.1).expect("valid mesh");
     Arc::new(build(&mesh, &BuildOptions::spheres(120), &mut |_| {}).expect("builds").0)
-}
-
-/// A small deterministic generator (xorshift), 0..1.
-struct Dice(u32);
-
-impl Dice {
-    fn roll(&mut self) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 17;
-        self.0 ^= self.0 << 5;
-        self.0 as f32 / u32::MAX as f32
-    }
 }
 
 /// The query a step runs for a pair (exact: no time budget), run directly.
@@ -87,16 +77,17 @@ fn sweep(broad_phase: bool) {
     let (mut handle, mut stepper) = pipeline(&config, haptic_common::Delegator::new());
     let mut tool = handle.add_object(tool_tree.clone(), Pose::IDENTITY).expect("slot");
     // 256 objects on a 16 × 16 grid about 0.1 apart (jittered, turned), every eighth moved by the game.
-    let mut dice = Dice(0x5eed);
+    let mut rng = ChaCha8Rng::seed_from_u64(0x5eed);
+    let mut roll = || rng.random::<f32>();
     let mut placed: Vec<Placed> = Vec::new();
     for i in 0..OBJECTS {
-        let jitter = Vec3::new(dice.roll() - 0.5, dice.roll() - 0.5, dice.roll() - 0.5) * 0.04;
+        let jitter = Vec3::new(roll() - 0.5, roll() - 0.5, roll() - 0.5) * 0.04;
         let at = match placed.last() {
             // Every fourth object's right-hand neighbour leans on it (their pair is watched).
             Some(left) if i % 4 == 1 => left.rest.translation + Vec3::X * 0.05 + jitter * 0.2,
             _ => Vec3::new((i % 16) as f32 * 0.1, (i / 16) as f32 * 0.1, 0.0) + jitter,
         };
-        let rest = Pose::new(at, Quat::from_euler(glam::EulerRot::XYZ, dice.roll() * 3.0, dice.roll() * 3.0, 0.0));
+        let rest = Pose::new(at, Quat::from_euler(glam::EulerRot::XYZ, roll() * 3.0, roll() * 3.0, 0.0));
         let tree = shapes[i % 3].clone();
         let still = TimedPose { pose: rest, timestamp_us: u64::MAX, reach: 0.0 };
         let writer = handle.add_object_at(tree.clone(), still).expect("an object slot");

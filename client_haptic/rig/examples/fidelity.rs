@@ -22,6 +22,8 @@ use collette::{BuildOptions, ContactSet, InnerSphereTree, QueryWorkspace, Signed
 use forcecomp::{Ball, BodyMotion, GodObject, Material, ProxyConfig};
 use glam::{Quat, Vec3};
 use haptic_common::Pose;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 
 #[derive(Parser, Debug)]
 #[command(about = "Judges rendered forces and torques against exact answers on scenes whose answer is known.")]
@@ -153,15 +155,13 @@ fn cylinder_on_plane(r: f32, len: f32, c: Vec3, d: f32) -> Exact {
     Exact { volume: area * len, normal: Vec3::Y, centroid: c - Vec3::Y * below }
 }
 
-/// A small deterministic generator (xorshift), 0..1.
-struct Dice(u32);
+/// The poses' random numbers (seeded).
+struct Dice(ChaCha8Rng);
 
 impl Dice {
+    /// Uniform in 0..1.
     fn roll(&mut self) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 17;
-        self.0 ^= self.0 << 5;
-        self.0 as f32 / u32::MAX as f32
+        self.0.random()
     }
 
     /// A depth: log-uniform over 0.1–5 mm, one in ten 5–10 mm.
@@ -302,7 +302,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     let slab = shape(box_buffers(SLAB_HALF), &args)?;
     eprintln!("fidelity: trees and grids built in {:.1} s", started.elapsed().as_secs_f32());
     let slab_pose = Pose::from_translation(Vec3::new(0.0, -SLAB_HALF.y, 0.0));
-    let mut dice = Dice(args.seed.max(1) * 0x9e37_79b9);
+    let mut dice = Dice(ChaCha8Rng::seed_from_u64(args.seed as u64));
     let spin = |dice: &mut Dice| Quat::from_rotation_y(dice.roll() * 2.0 * PI);
     let spot = |dice: &mut Dice| Vec3::new(dice.roll() - 0.5, 0.0, dice.roll() - 0.5) * 0.06;
 

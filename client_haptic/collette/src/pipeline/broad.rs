@@ -106,6 +106,8 @@ fn touch(a: &Aabb, b: &Aabb) -> bool {
 mod tests {
     use super::*;
     use glam::Vec3;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
 
     fn cube(at: Vec3, half: f32) -> Option<Aabb> {
         Some(Aabb::new(at - Vec3::splat(half), at + Vec3::splat(half)))
@@ -117,21 +119,16 @@ mod tests {
         // directly, over steps where they move, some leave and others come.
         let slots = 48;
         let mut broad = BroadPhase::new(slots);
-        let mut seed = 7u32;
-        let mut rand = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 17;
-            seed ^= seed << 5;
-            seed as f32 / u32::MAX as f32
-        };
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let mut roll = || rng.random::<f32>();
         let mut boxes: Vec<Option<Aabb>> = vec![None; slots];
         let mut found = 0;
         for step in 0..30 {
             for (slot, b) in boxes.iter_mut().enumerate() {
                 let present = (slot + step) % 7 != 0 && slot < 40 + step % 8;
                 *b = if present {
-                    let at = Vec3::new(slot as f32 * 0.3 + rand() * 0.5, rand(), rand() * 0.4);
-                    cube(at, 0.1 + rand() * rand() * 1.5)
+                    let at = Vec3::new(slot as f32 * 0.3 + roll() * 0.5, roll(), roll() * 0.4);
+                    cube(at, 0.1 + roll() * roll() * 1.5)
                 } else {
                     None
                 };

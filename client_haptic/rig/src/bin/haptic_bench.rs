@@ -430,13 +430,8 @@ fn scatter(n: usize, bunny: &collette::TriMesh, material: &Material) -> anyhow::
     }
     let area = bunny.aabb();
     let (low, size) = (area.min - Vec3::splat(0.02), area.extents() + Vec3::splat(0.04));
-    let mut seed = 0x2545_f491u32;
-    let mut roll = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 17;
-        seed ^= seed << 5;
-        seed as f32 / u32::MAX as f32
-    };
+    let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(0x2545_f491);
+    let mut roll = || rand::Rng::random::<f32>(&mut rng);
     Ok((0..n)
         .map(|i| {
             let at = low + size * Vec3::new(roll(), roll(), roll());
