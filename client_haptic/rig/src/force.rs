@@ -162,11 +162,27 @@ pub(crate) struct WatchedObject {
     /// Its object slot in the collision pipeline (how the tool's scene watcher names it).
     pub(crate) slot: u32,
     pub(crate) material: Material,
+    /// Where the game placed it, at rest (while it has no track).
     pub(crate) motion: BodyMotion,
     /// Its centre of mass in its own frame.
     pub(crate) center_of_mass: Vec3,
-    /// Its last poses while the game moves it: `motion` is read from it every tick.
+    /// Its last poses while the game moves it (see [`WatchedObject::motion_at`]).
     pub(crate) track: Option<PoseTrack>,
+}
+
+impl WatchedObject {
+    /// Its centre of mass, orientation and velocities at `now_us`: read from its track while the game
+    /// moves it (so the damping and friction see the contact point's velocity), else where it was placed.
+    fn motion_at(&self, now_us: u64) -> BodyMotion {
+        let Some(motion) = self.track.and_then(|t| t.at(now_us)) else { return self.motion };
+        let center_of_mass = motion.pose.transform_point(self.center_of_mass);
+        BodyMotion {
+            center_of_mass,
+            orientation: motion.pose.rotation,
+            linear_velocity: motion.velocity_at(center_of_mass),
+            angular_velocity: motion.angular_velocity,
+        }
+    }
 }
 
 /// The reader of the tool's scene watcher: overlaps with every object (volumetric) or every object's
@@ -238,7 +254,6 @@ impl ForceStage {
     /// tick's total with the safety layer's output. Allocation-free.
     pub fn on_tick(&mut self, tick: &ForceOnHapticTick) {
         self.apply_commands(tick.device.timestamp_us);
-        self.follow_tracks(tick.device.timestamp_us);
         if self.rendering == Rendering::Proxy {
             return self.on_proxy_tick(tick);
         }
@@ -275,7 +290,8 @@ impl ForceStage {
                 ForceTorque::ZERO
             } else {
                 let material = self.tool_material.combine(&object.material);
-                volumetric_penalty_of(contacts, touched.total_volume, &tool_motion, &object.motion, &material)
+                let motion = object.motion_at(device.timestamp_us);
+                volumetric_penalty_of(contacts, touched.total_volume, &tool_motion, &motion, &material)
             };
             contact.force += ft.force;
             contact.torque += ft.torque;
@@ -355,21 +371,6 @@ impl ForceStage {
         }
     }
 
-    /// Reads every moving object's track at `now_us`: its centre of mass, orientation and velocities
-    /// (the damping and friction see the contact point's velocity).
-    fn follow_tracks(&mut self, now_us: u64) {
-        for o in self.objects.iter_mut().flatten() {
-            let Some(motion) = o.track.and_then(|t| t.at(now_us)) else { continue };
-            let center_of_mass = motion.pose.transform_point(o.center_of_mass);
-            o.motion = BodyMotion {
-                center_of_mass,
-                orientation: motion.pose.rotation,
-                linear_velocity: motion.velocity_at(center_of_mass),
-                angular_velocity: motion.angular_velocity,
-            };
-        }
-    }
-
     fn discard(&mut self, object: Box<WatchedObject>) {
         if let Err(rtrb::PushError::Full(object)) = self.garbage.push(object) {
             std::mem::forget(object); // leak rather than free on this thread (the ring is sized not to fill)
@@ -427,15 +428,15 @@ impl ForceStage {
         };
         let scale = self.map.scale.max(f32::MIN_POSITIVE);
         // The tip's speed against the surface it is near (a moving object's surface moves too).
-        let surface = nearest.map_or(Vec3::ZERO, |o| o.motion.velocity_at(near));
+        let body = nearest.map(|o| o.motion_at(device.timestamp_us));
+        let surface = body.map_or(Vec3::ZERO, |b| b.velocity_at(near));
         let velocity = (self.map.velocity_to_scene(device.linear_velocity) - surface) / scale;
         let mut force_scene = self.god.update(&config, tip.translation, velocity, balls, scale);
         // Ridges: the spring's push along the surface normal becomes that of the ridged surface.
         let texture = material.and_then(|m| m.texture);
-        if let (Some(t), Some(object)) = (texture, nearest.filter(|_| self.god.in_contact())) {
+        if let (Some(t), Some(body)) = (texture, body.filter(|_| self.god.in_contact())) {
             let n = self.god.normal();
             let push = n * force_scene.dot(n).max(0.0);
-            let body = &object.motion;
             let ridged = t.apply(
                 push,
                 self.god.proxy(),

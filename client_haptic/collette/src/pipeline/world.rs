@@ -143,7 +143,7 @@ impl NearSpheres {
 /// Sizes and timing of a collision world.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CollisionConfig {
-    /// Object slots (default 64; the broad phase keeps a bit per pair of slots).
+    /// Object slots (default 64).
     pub max_objects: usize,
     /// Watcher slots (default 16).
     pub max_watchers: usize,
@@ -485,7 +485,7 @@ impl CollisionWorld {
             let ia = w.a.0 as usize;
             if w.out.is_scene() {
                 let Some(Some(a)) = objects.get(ia) else {
-                    publish_empty_scene(&mut w.out, w.a.0, sequence, 0);
+                    publish_empty_scene(&mut w.out, w.a.0, sequence);
                     continue;
                 };
                 let mut oldest = a.now.timestamp_us;
@@ -590,19 +590,19 @@ impl CollisionWorld {
     }
 }
 
-/// Publishes an empty result for a scene watcher whose object is missing.
-fn publish_empty_scene(out: &mut WatcherOutput, object: u32, sequence: u64, timestamp_us: u64) {
+/// Publishes an empty result (no pose, so time 0) for a scene watcher whose object is missing.
+fn publish_empty_scene(out: &mut WatcherOutput, object: u32, sequence: u64) {
     match out {
         WatcherOutput::SceneContacts(out) => {
             let set = out.input_buffer_mut();
             set.clear();
-            (set.object, set.sequence, set.timestamp_us) = (object, sequence, timestamp_us);
+            (set.object, set.sequence, set.timestamp_us) = (object, sequence, 0);
             out.publish();
         }
         WatcherOutput::SceneNear(out) => {
             let set = out.input_buffer_mut();
             set.clear();
-            (set.sequence, set.timestamp_us) = (sequence, timestamp_us);
+            (set.sequence, set.timestamp_us) = (sequence, 0);
             out.publish();
         }
         _ => {}
