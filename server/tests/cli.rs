@@ -698,7 +698,10 @@ fn the_fleets_arguments_run_a_server_on_the_passthrough_port_and_a_second_sigter
     let log = lines_of(serve.stderr.take().unwrap());
     let hosting = line_after(&out, "hosting on ", Duration::from_secs(40));
     assert_eq!(hosting, format!("127.0.0.1:{port} (UDP game, TCP tokens)"), "the Passthrough port, Agones' address");
-    assert!(fake.wait_for(Duration::from_secs(10), |r| r.ready == 1));
+    // The server says Ready, then sets its annotation: wait for both (on a busy machine the second
+    // can land after a check made right after the first).
+    let announced = |r: &agones_fake::Recorded| r.ready == 1 && r.annotations.contains_key("phantom-heist.address");
+    assert!(fake.wait_for(Duration::from_secs(10), announced));
     assert_eq!(fake.recorded().annotations.get("phantom-heist.address"), Some(&format!("127.0.0.1:{port}")));
 
     // A heist under way; SIGTERM starts a drain, a second SIGTERM exits at once with 128 + 15.
