@@ -29,6 +29,14 @@ pub enum RigError {
         /// The sample's time, µs on the rig's clock.
         t_us: u64,
     },
+    /// A pushed object's mass that is not a positive number.
+    #[error("object {id}'s mass must be a positive number of kilograms, not {mass_kg}")]
+    BadMass {
+        /// The object.
+        id: u32,
+        /// The mass given, kg.
+        mass_kg: f32,
+    },
     /// No watched object has this id.
     #[error("no watched object has id {0}")]
     UnknownObject(u32),

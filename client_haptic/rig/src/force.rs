@@ -15,6 +15,7 @@ use glam::Vec3;
 use haptic_common::{DeviceState, ForceOnHapticTick, ForceTorque, Pose};
 
 use crate::WorkspaceMap;
+use crate::push::{ObjectPush, PushCoupling, PushedBody};
 
 /// One tick's forces, recorded for plots (preallocated ring; lost when full).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -168,6 +169,8 @@ pub(crate) struct WatchedObject {
     pub(crate) center_of_mass: Vec3,
     /// Its last poses while the game moves it (see [`WatchedObject::motion_at`]).
     pub(crate) track: Option<PoseTrack>,
+    /// The haptic body of an object the tool pushes (see [`crate::push`]).
+    pub(crate) pushed: Option<PushedBody>,
 }
 
 impl WatchedObject {
@@ -181,6 +184,14 @@ impl WatchedObject {
             orientation: motion.pose.rotation,
             linear_velocity: motion.velocity_at(center_of_mass),
             angular_velocity: motion.angular_velocity,
+        }
+    }
+
+    /// What the tool touches at `now_us`: the haptic body of a pushed object, else the game's.
+    fn touched_motion(&self, now_us: u64) -> BodyMotion {
+        match &self.pushed {
+            Some(body) => body.motion(),
+            None => self.motion_at(now_us),
         }
     }
 }
@@ -247,6 +258,9 @@ pub struct ForceStage {
     /// This tick's contact with each object touched, the first `touched` in use.
     pub(crate) object_contacts: [ObjectContact; MAX_TOUCHED],
     pub(crate) touched: usize,
+    /// How pushed objects follow the game's bodies, and where their pushes go.
+    pub(crate) push_coupling: PushCoupling,
+    pub(crate) pushes: rtrb::Producer<ObjectPush>,
 }
 
 impl ForceStage {
@@ -284,14 +298,20 @@ impl ForceStage {
         let used = Published { sequence: set.sequence, timestamp_us: set.timestamp_us, contacts, watched, since_us }
             .at(device.timestamp_us);
         for touched in set.touched() {
-            let Some(object) = self.objects.get(touched.object as usize).and_then(Option::as_ref) else { continue };
+            let Some(object) = self.objects.get_mut(touched.object as usize).and_then(Option::as_mut) else { continue };
             let contacts = set.contacts_of(touched);
             let ft = if self.rendering == Rendering::Off {
                 ForceTorque::ZERO
             } else {
                 let material = self.tool_material.combine(&object.material);
-                let motion = object.motion_at(device.timestamp_us);
-                volumetric_penalty_of(contacts, touched.total_volume, &tool_motion, &motion, &material)
+                let motion = object.touched_motion(device.timestamp_us);
+                let ft = volumetric_penalty_of(contacts, touched.total_volume, &tool_motion, &motion, &material);
+                if let Some(body) = &mut object.pushed {
+                    // Equal and opposite; the torque moved from the tool's centre of mass to the object's.
+                    let lever = com - motion.center_of_mass;
+                    body.add_reaction(-ft.force, -ft.torque - lever.cross(ft.force));
+                }
+                ft
             };
             contact.force += ft.force;
             contact.torque += ft.torque;
@@ -326,7 +346,19 @@ impl ForceStage {
             Rendering::Direct | Rendering::Proxy | Rendering::Off => self.map.to_scene(&device.pose),
         };
         self.tool.set(tool_now, device.timestamp_us);
+        self.step_pushed(device.timestamp_us, dt);
         self.report(device, out, contact_device.force, tool_now.translation, tool_now, used);
+    }
+
+    /// Moves every pushed object's haptic body one tick and hands its impulses to the game.
+    fn step_pushed(&mut self, now_us: u64, dt_s: f32) {
+        let coupling = self.push_coupling;
+        for object in self.objects.iter_mut().flatten() {
+            let game = object.motion_at(now_us);
+            let Some(body) = &mut object.pushed else { continue };
+            body.step(game, &coupling, dt_s, now_us);
+            body.hand_over(|push| self.pushes.push(push).is_ok());
+        }
     }
 
     /// Applies the game thread's changes at device time `now_us`; what they replace goes back to be
@@ -360,6 +392,9 @@ impl ForceStage {
                     if let Some(o) = self.objects.get_mut(slot as usize).and_then(Option::as_mut) {
                         o.motion = BodyMotion { orientation, ..BodyMotion::at_rest(center_of_mass) };
                         o.track = None;
+                        if let Some(body) = &mut o.pushed {
+                            body.place(o.motion);
+                        }
                     }
                 }
                 ForceCommand::Track { slot, track } => {
@@ -428,7 +463,7 @@ impl ForceStage {
         };
         let scale = self.map.scale.max(f32::MIN_POSITIVE);
         // The tip's speed against the surface it is near (a moving object's surface moves too).
-        let body = nearest.map(|o| o.motion_at(device.timestamp_us));
+        let body = nearest.map(|o| o.touched_motion(device.timestamp_us));
         let surface = body.map_or(Vec3::ZERO, |b| b.velocity_at(near));
         let velocity = (self.map.velocity_to_scene(device.linear_velocity) - surface) / scale;
         let mut force_scene = self.god.update(&config, tip.translation, velocity, balls, scale);
@@ -451,6 +486,13 @@ impl ForceStage {
             c.touching = true;
             c.force = force_scene;
         }
+        // A pushed object takes the opposite of the spring's force where the proxy rests on it.
+        if let (Some(slot), Some(body)) = (nearest_slot.filter(|_| self.god.in_contact()), body)
+            && let Some(pushed) = self.objects.get_mut(slot).and_then(Option::as_mut).and_then(|o| o.pushed.as_mut())
+        {
+            let lever = self.god.proxy() - body.center_of_mass;
+            pushed.add_reaction(-force_scene, lever.cross(-force_scene));
+        }
         let contact_device = self.map.wrench_to_device(ForceTorque { force: force_scene, torque: Vec3::ZERO });
         let before = tick.total();
         let requested = ForceTorque { force: before.force + contact_device.force, torque: before.torque };
@@ -459,6 +501,7 @@ impl ForceStage {
         let proxy_pose = Pose::new(self.god.proxy(), tip.rotation);
         let reach = self.god.proxy().distance(tip.translation) + self.proxy.margin + self.proxy.tip_radius;
         self.tool.set_with_reach(tip, device.timestamp_us, reach);
+        self.step_pushed(device.timestamp_us, tick.dt_s);
         self.report(device, out, contact_device.force, tip.translation, proxy_pose, used);
     }
 

@@ -56,7 +56,18 @@ impl<D: Device> Lockstep<D> {
 
     /// Watches an object.
     pub fn add_object(&mut self, object: ObjectSpec) -> Result<()> {
-        self.scene.add_object(object)
+        self.scene.add_object(object, None)
+    }
+
+    /// Watches an object the tool can push (see [`HapticRig::add_pushable`](crate::HapticRig::add_pushable)).
+    pub fn add_pushable(&mut self, object: ObjectSpec, mass_kg: f32) -> Result<()> {
+        self.scene.add_object(object, Some(mass_kg))
+    }
+
+    /// Moves what the tool did to pushed objects into `out` (see
+    /// [`HapticRig::take_pushes`](crate::HapticRig::take_pushes)).
+    pub fn take_pushes(&mut self, out: &mut Vec<crate::ObjectPush>) {
+        self.outputs.take_pushes(out);
     }
 
     /// Moves watched object `id` to `pose` (see [`HapticRig::set_object_pose`](crate::HapticRig::set_object_pose)).

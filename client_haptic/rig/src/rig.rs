@@ -12,6 +12,7 @@ use haptico::{Device, HapticClock, HapticConfig, HapticEvents, HapticHandle, Hap
 
 use crate::collision::{CollisionConfig, RigPacer, StepTiming};
 use crate::force::{ForceSample, ForceStage, ProxyRendering, Rendering, RigTelemetry, SceneInput};
+use crate::push::{ObjectPush, PushCoupling};
 use crate::scene::{FORCE_COMMANDS, Scene};
 use crate::spec::{MAX_OBJECTS, ObjectSpec, PairContact, ToolSpec};
 use crate::{Result, RigError, WorkspaceMap};
@@ -43,6 +44,8 @@ pub struct RigConfig {
     /// [`set_object_pose_at`](HapticRig::set_object_pose_at)): by default 20 ms behind, which suits a
     /// game sending poses at 60 Hz or faster.
     pub tracks: TrackTiming,
+    /// How objects the tool pushes follow the game's bodies ([`HapticRig::add_pushable`]).
+    pub pushes: PushCoupling,
 }
 
 impl Default for RigConfig {
@@ -58,6 +61,7 @@ impl Default for RigConfig {
             proxy: ProxyRendering::default(),
             force_sample_capacity: 1 << 16,
             tracks: TrackTiming::default(),
+            pushes: PushCoupling::default(),
         }
     }
 }
@@ -72,6 +76,20 @@ pub fn safety_for(specs: &haptico::DeviceSpecs) -> SafetyConfig {
 pub(crate) struct Outputs {
     pub(crate) samples: rtrb::Consumer<ForceSample>,
     pub(crate) telemetry: triple_buffer::Output<RigTelemetry>,
+    pub(crate) pushes: rtrb::Consumer<ObjectPush>,
+}
+
+impl Outputs {
+    /// Moves what the tool did to pushed objects into `out`, one entry per object (merged with any
+    /// entry for it already there).
+    pub(crate) fn take_pushes(&mut self, out: &mut Vec<ObjectPush>) {
+        while let Ok(p) = self.pushes.pop() {
+            match out.iter_mut().find(|o| o.id == p.id) {
+                Some(o) => o.merge(&p),
+                None => out.push(p),
+            }
+        }
+    }
 }
 
 /// The rig's pieces before they are given to threads: the force stage (for the haptic thread), the
@@ -112,6 +130,7 @@ impl Parts {
         // each command it sends (see collette's pipeline for the same argument).
         let (garbage_tx, garbage_rx) = rtrb::RingBuffer::new(FORCE_COMMANDS + MAX_OBJECTS);
         let (samples_tx, samples_rx) = rtrb::RingBuffer::new(config.force_sample_capacity.max(1));
+        let (pushes_tx, pushes_rx) = rtrb::RingBuffer::new(crate::push::PUSH_RING);
         let balls = if proxy { collette::pipeline::MAX_NEAR_SPHERES } else { 0 };
         let scene = Scene::new(collision, tool_pose.id(), forces_tx, garbage_rx, config.tracks);
         let stage = ForceStage {
@@ -138,8 +157,11 @@ impl Parts {
             samples: samples_tx,
             object_contacts: [crate::force::ObjectContact::default(); collette::pipeline::MAX_TOUCHED],
             touched: 0,
+            push_coupling: config.pushes,
+            pushes: pushes_tx,
         };
-        Ok(Self { stage, scene, outputs: Outputs { samples: samples_rx, telemetry: telemetry_out } })
+        let outputs = Outputs { samples: samples_rx, telemetry: telemetry_out, pushes: pushes_rx };
+        Ok(Self { stage, scene, outputs })
     }
 }
 
@@ -235,7 +257,23 @@ impl<D: Device + 'static> HapticRig<D> {
 
     /// Watches an object (replaces the one with the same id).
     pub fn add_object(&self, object: ObjectSpec) -> Result<()> {
-        self.with_scene(|s| s.add_object(object))
+        self.with_scene(|s| s.add_object(object, None))
+    }
+
+    /// Watches an object the tool can push, a rigid body of `mass_kg` the game simulates (replaces the
+    /// one with the same id): the haptic thread moves it as the tool pushes, and
+    /// [`take_pushes`](Self::take_pushes) hands back the impulses to apply to the game's body, whose
+    /// poses the game sends as it moves ([`set_object_pose_at`](Self::set_object_pose_at)). See
+    /// [`crate::push`] for how the two stay together and passive.
+    pub fn add_pushable(&self, object: ObjectSpec, mass_kg: f32) -> Result<()> {
+        self.with_scene(|s| s.add_object(object, Some(mass_kg)))
+    }
+
+    /// Moves into `out` what the tool did to pushed objects since the last call: one [`ObjectPush`]
+    /// per object (merged with an entry for it already in `out`), to apply to the game's bodies once
+    /// a frame.
+    pub fn take_pushes(&self, out: &mut Vec<ObjectPush>) {
+        self.outputs().take_pushes(out);
     }
 
     /// Moves watched object `id` to `pose` (scene frame): the collision thread measures it there from its

@@ -14,6 +14,7 @@ use forcecomp::BodyMotion;
 use haptic_common::Pose;
 
 use crate::force::{ForceCommand, WatchedObject};
+use crate::push::PushedBody;
 use crate::spec::{MAX_OBJECTS, MAX_PAIR_WATCHERS, ObjectSpec, PairContact, ToolSpec, center_of_mass};
 use crate::{Result, RigError};
 
@@ -25,8 +26,8 @@ pub(crate) const FORCE_COMMANDS: usize = 1024;
 struct Entry {
     id: u32,
     object: ObjectId,
-    /// Moves the object on the collision thread.
-    pose: PoseWriter,
+    /// Moves the object on the collision thread (None: a pushed object, which the haptic thread moves).
+    pose: Option<PoseWriter>,
     /// Its centre of mass in its own frame.
     center_of_mass: glam::Vec3,
     /// Its last poses with their times, while the game moves it (empty: placed).
@@ -76,9 +77,13 @@ impl Scene {
         Self { collision, tool, entries, pairs, forces, garbage, timing, freed: 0 }
     }
 
-    /// Watches an object (replaces the one with the same id).
-    pub(crate) fn add_object(&mut self, spec: ObjectSpec) -> Result<()> {
+    /// Watches an object (replaces the one with the same id); with a mass, the tool pushes it (see
+    /// [`crate::push`]).
+    pub(crate) fn add_object(&mut self, spec: ObjectSpec, pushed_kg: Option<f32>) -> Result<()> {
         self.free_returned();
+        if let Some(mass_kg) = pushed_kg.filter(|m| !(m.is_finite() && *m > 0.0)) {
+            return Err(RigError::BadMass { id: spec.id, mass_kg });
+        }
         if self.forces.slots() == 0 {
             return Err(RigError::QueueFull("haptic"));
         }
@@ -107,18 +112,25 @@ impl Scene {
             orientation: spec.pose.rotation,
             ..BodyMotion::at_rest(spec.pose.transform_point(local_center))
         };
+        let object_id = pose.id();
+        // A pushed object's pose is written by the haptic thread, which moves it.
+        let (pose, pushed) = match pushed_kg {
+            Some(mass_kg) => (None, Some(PushedBody::new(&spec.tree, mass_kg, spec.pose, pose, spec.id))),
+            None => (Some(pose), None),
+        };
         let object = Box::new(WatchedObject {
             id: spec.id,
-            slot: pose.id().0,
+            slot: object_id.0,
             material: spec.material,
             motion,
             center_of_mass: local_center,
             track: None,
+            pushed,
         });
         self.forces.push(ForceCommand::Add(object)).map_err(|_| RigError::QueueFull("haptic"))?;
         let track = PoseTrack::new(self.timing);
         let placed = spec.pose;
-        self.entries.push(Entry { id: spec.id, object: pose.id(), pose, center_of_mass: local_center, track, placed });
+        self.entries.push(Entry { id: spec.id, object: object_id, pose, center_of_mass: local_center, track, placed });
         for (a, b) in rewatch {
             self.watch_pair(a, b)?;
         }
@@ -194,7 +206,9 @@ impl Scene {
         };
         self.forces.push(command).map_err(|_| RigError::QueueFull("haptic"))?;
         // A placement, not a sample: it never ages (see `TimedPose`).
-        entry.pose.set(pose, u64::MAX);
+        if let Some(writer) = &mut entry.pose {
+            writer.set(pose, u64::MAX);
+        }
         entry.track.clear();
         entry.placed = pose;
         Ok(())
@@ -216,7 +230,9 @@ impl Scene {
         let command = ForceCommand::Track { slot: entry.object.0, track };
         self.forces.push(command).map_err(|_| RigError::QueueFull("haptic"))?;
         entry.track = track;
-        entry.pose.set_track(&track);
+        if let Some(writer) = &mut entry.pose {
+            writer.set_track(&track);
+        }
         Ok(())
     }
 

@@ -18,15 +18,23 @@ static ALLOCATOR: AllocDisabler = AllocDisabler;
 
 #[test]
 fn a_steady_state_rig_tick_neither_allocates_nor_frees() {
-    steady_state_ticks_do_not_allocate(presets::phantom_premium_6dof(), Rendering::Coupled);
+    steady_state_ticks_do_not_allocate(presets::phantom_premium_6dof(), Rendering::Coupled, false);
 }
 
 #[test]
 fn a_steady_state_proxy_tick_neither_allocates_nor_frees() {
-    steady_state_ticks_do_not_allocate(presets::touch(), Rendering::Proxy);
+    steady_state_ticks_do_not_allocate(presets::touch(), Rendering::Proxy, false);
 }
 
-fn steady_state_ticks_do_not_allocate(specs: haptico::DeviceSpecs, rendering: Rendering) {
+#[test]
+fn a_steady_state_tick_pushing_an_object_neither_allocates_nor_frees() {
+    // The slab is a 1 kg body the tool pushes: its haptic body moves, its pose goes to the collision
+    // stage and its impulses to the game's ring every tick.
+    steady_state_ticks_do_not_allocate(presets::touch(), Rendering::Coupled, true);
+    steady_state_ticks_do_not_allocate(presets::touch(), Rendering::Proxy, true);
+}
+
+fn steady_state_ticks_do_not_allocate(specs: haptico::DeviceSpecs, rendering: Rendering, pushed: bool) {
     let device = SimDevice::new(
         SimConfig::new(specs),
         TargetPath::line(Vec3::new(0.0, 0.01, 0.0), Vec3::new(0.003, -0.003, 0.002), 2.0),
@@ -43,7 +51,10 @@ fn steady_state_ticks_do_not_allocate(specs: haptico::DeviceSpecs, rendering: Re
             ..Material::default()
         },
     };
-    rig.add_object(slab).expect("object");
+    match pushed {
+        true => rig.add_pushable(slab, 1.0).expect("pushable"),
+        false => rig.add_object(slab).expect("object"),
+    }
     let mut t = 0;
     for _ in 0..500 {
         rig.tick(t);
@@ -58,4 +69,9 @@ fn steady_state_ticks_do_not_allocate(specs: haptico::DeviceSpecs, rendering: Re
         }
     });
     assert!(contacts > 0, "the tool touched the slab during the checked ticks");
+    if pushed {
+        let mut pushes = Vec::new();
+        rig.take_pushes(&mut pushes);
+        assert!(pushes.first().is_some_and(|p| p.impulse_ns.y < 0.0), "the tool pushed the slab down: {pushes:?}");
+    }
 }
