@@ -61,9 +61,11 @@ pub fn add_haptics(app: &mut App, settings: &HapticsSettings) -> Result<(), Clie
         ..HapticDevice::opened(opened)
     });
     app.add_plugins(
-        HapticsPlugins
-            .set(CollettePlugin { collision: setup.config.collision.clone() })
-            .set(ForceCompPlugin { mode, proxy: setup.config.proxy }),
+        HapticsPlugins.set(CollettePlugin { collision: setup.config.collision.clone() }).set(ForceCompPlugin {
+            mode,
+            proxy: setup.config.proxy,
+            pushes: setup.config.pushes,
+        }),
     );
     let gem = SphereTree { tree: setup.tool.tree.clone(), surface: None };
     let gem = app.world_mut().resource_mut::<Assets<SphereTree>>().add(gem);

@@ -66,6 +66,36 @@ impl HapticCollider {
     }
 }
 
+/// Makes a [`HapticCollider`] an object the tool can push: a rigid body of `mass_kg` that your game
+/// simulates. The haptic thread moves it at once as the tool pushes (so the hand feels its mass, not a
+/// wall), and every frame hands back what the tool did to it as a [`ToolPushed`](crate::ToolPushed)
+/// (impulses to apply to your body; with the `avian3d` feature, applied to its avian3d `RigidBody` for
+/// you). Move the entity as your physics moves it: its poses reach the threads with their times, and
+/// the haptic thread's copy follows them through a spring tuned to your game's latency
+/// ([`ForceCompPlugin::pushes`](crate::ForceCompPlugin::pushes); `haptic_rig::push` explains why).
+/// Give it the mass your rigid body has; its inertia is that of the tree at uniform density.
+#[derive(Component, Reflect, Clone, Copy, Debug, PartialEq)]
+#[reflect(Component, Default)]
+#[type_path = "bevy_haptics"]
+#[require(HapticCollider)]
+pub struct HapticPushable {
+    /// The body's mass, kg (default 0.2).
+    pub mass_kg: f32,
+}
+
+impl Default for HapticPushable {
+    fn default() -> Self {
+        Self { mass_kg: 0.2 }
+    }
+}
+
+impl HapticPushable {
+    /// A pushable body of `mass_kg`.
+    pub fn new(mass_kg: f32) -> Self {
+        Self { mass_kg }
+    }
+}
+
 /// Ridges across a surface, felt as the tool slides over them.
 #[derive(Reflect, Clone, Copy, Debug, PartialEq)]
 #[reflect(Default)]

@@ -104,3 +104,20 @@ pub struct PairContactEnded {
     /// The other.
     pub b: Entity,
 }
+
+/// What the tool did to a [`HapticPushable`](crate::HapticPushable) since the last frame (written in
+/// `PreUpdate`, for each object the tool pushed or whose haptic copy is still settling): apply the
+/// impulses to its rigid body once (the `avian3d` feature does it for an avian3d body). Triggered on the
+/// object.
+#[derive(Message, EntityEvent, Clone, Copy, Debug, PartialEq)]
+pub struct ToolPushed {
+    /// The pushed object.
+    #[event_target]
+    pub object: Entity,
+    /// Linear impulse at its centre of mass, world frame, N·s.
+    pub impulse_ns: Vec3,
+    /// Angular impulse about its centre of mass, world frame, N·m·s.
+    pub angular_impulse_nms: Vec3,
+    /// The time the impulses were gathered over, s (their mean force is `impulse_ns / duration_s`).
+    pub duration_s: f32,
+}

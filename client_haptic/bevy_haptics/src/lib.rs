@@ -1,6 +1,8 @@
 #![doc = include_str!("../README.md")]
 #![warn(missing_docs)]
 
+#[cfg(feature = "avian3d")]
+mod avian;
 mod components;
 #[cfg(feature = "debug")]
 pub mod debug;
@@ -16,13 +18,16 @@ mod source;
 mod stats;
 mod tree;
 
-pub use components::{CollisionVolume, CollisionWatcher, ForceComponent, HapticCollider, HapticTool, Ridges};
+pub use components::{
+    CollisionVolume, CollisionWatcher, ForceComponent, HapticCollider, HapticPushable, HapticTool, Ridges,
+};
 #[cfg(feature = "debug")]
 pub use debug::{HapticsDebugConfig, HapticsDebugPlugin};
 pub use device::{DeviceError, DeviceKind, HapticDevice, HapticDeviceLink, SimulatedHand};
 pub use effects::{EffectKind, HapticEffect, MAX_EFFECTS};
 pub use events::{
     ContactData, ContactEnded, ContactOngoing, ContactStarted, PairContactEnded, PairContactStarted, ToolMoved,
+    ToolPushed,
 };
 pub use frame::HapticFrame;
 pub use mesh_build::SphereTreeFromMesh;
@@ -44,9 +49,9 @@ pub mod prelude {
     pub use crate::{
         CollettePlugin, CollisionVolume, CollisionWatcher, ContactEnded, ContactOngoing, ContactStarted, EffectKind,
         ForceCompPlugin, ForceComponent, HapticCollider, HapticDelegates, HapticDevice, HapticEffect, HapticFrame,
-        HapticStats, HapticStatus, HapticTool, HapticoPlugin, HapticsPlugins, HapticsSystems, PairContactEnded,
-        PairContactStarted, RenderingMode, SimulatedHand, SphereTree, SphereTreeFromMesh, SphereTreeSettings,
-        SphereTreeSource, ToolMoved,
+        HapticPushable, HapticStats, HapticStatus, HapticTool, HapticoPlugin, HapticsPlugins, HapticsSystems,
+        PairContactEnded, PairContactStarted, RenderingMode, SimulatedHand, SphereTree, SphereTreeFromMesh,
+        SphereTreeSettings, SphereTreeSource, ToolMoved, ToolPushed,
     };
     pub use haptic_common::{ForceOnHapticTick, ForceTorque};
     pub use haptico::steer::HandGoal;

@@ -12,13 +12,16 @@
 use bevy::app::PluginGroupBuilder;
 use bevy::asset::ReflectHandle;
 use bevy::prelude::*;
-use haptic_rig::ProxyRendering;
+use haptic_rig::{ProxyRendering, PushCoupling};
 
-use crate::components::{CollisionVolume, CollisionWatcher, ForceComponent, HapticCollider, HapticTool, Ridges};
+use crate::components::{
+    CollisionVolume, CollisionWatcher, ForceComponent, HapticCollider, HapticPushable, HapticTool, Ridges,
+};
 use crate::device::HapticDevice;
 use crate::effects::{self, EffectKind, HapticEffect};
 use crate::events::{
     ContactData, ContactEnded, ContactOngoing, ContactStarted, PairContactEnded, PairContactStarted, ToolMoved,
+    ToolPushed,
 };
 use crate::frame::HapticFrame;
 use crate::mesh_build::{self, SphereTreeFromMesh};
@@ -104,6 +107,7 @@ impl Plugin for CollettePlugin {
             .register_type::<HapticCollider>()
             .register_type::<CollisionVolume>()
             .register_type::<CollisionWatcher>()
+            .register_type::<HapticPushable>()
             .register_type::<SphereTreeFromMesh>()
             .register_type::<SphereTreeSource>()
             // A `Handle<SphereTree>` in a scene file (`tree: Path("trees/box.ist")`) loads that file.
@@ -114,27 +118,29 @@ impl Plugin for CollettePlugin {
             .add_message::<ContactEnded>()
             .add_message::<PairContactStarted>()
             .add_message::<PairContactEnded>()
+            .add_message::<ToolPushed>()
             .add_systems(
                 PreUpdate,
-                (runtime::report_contacts, runtime::report_pair_contacts).in_set(HapticsSystems::Read),
+                (runtime::report_contacts, runtime::report_pair_contacts, runtime::report_pushes)
+                    .in_set(HapticsSystems::Read),
             )
-            .add_systems(Update, (mesh_build::start_mesh_builds, mesh_build::finish_mesh_builds))
-            .add_systems(
-                PostUpdate,
-                (
-                    source::load_sources.before(runtime::sync_tool).before(runtime::send_colliders),
-                    runtime::sync_tool,
-                    (
-                        runtime::forget_colliders,
-                        runtime::send_colliders,
-                        runtime::move_colliders,
-                        runtime::sync_watchers,
-                    )
-                        .chain(),
-                    runtime::sync_volume,
-                )
-                    .in_set(HapticsSystems::Write),
-            );
+            .add_systems(Update, (mesh_build::start_mesh_builds, mesh_build::finish_mesh_builds));
+        #[cfg(feature = "avian3d")]
+        app.add_systems(
+            PreUpdate,
+            crate::avian::apply_pushes.after(runtime::report_pushes).in_set(HapticsSystems::Read),
+        );
+        app.add_systems(
+            PostUpdate,
+            (
+                source::load_sources.before(runtime::sync_tool).before(runtime::send_colliders),
+                runtime::sync_tool,
+                (runtime::forget_colliders, runtime::send_colliders, runtime::move_colliders, runtime::sync_watchers)
+                    .chain(),
+                runtime::sync_volume,
+            )
+                .in_set(HapticsSystems::Write),
+        );
     }
 }
 
@@ -146,10 +152,13 @@ pub struct ForceCompPlugin {
     pub mode: RenderingMode,
     /// How the 3-DOF proxy feels materials.
     pub proxy: ProxyRendering,
+    /// How [`HapticPushable`] objects follow your game's bodies: set its `latency_s` to how long your
+    /// game takes to show a push in the poses it sends (default 45 ms: a 60 Hz game; 70 ms at 30 Hz).
+    pub pushes: PushCoupling,
 }
 
 impl Plugin for ForceCompPlugin {
     fn build(&self, app: &mut App) {
-        app.insert_resource(ForceRendering { mode: self.mode, proxy: self.proxy });
+        app.insert_resource(ForceRendering { mode: self.mode, proxy: self.proxy, pushes: self.pushes });
     }
 }

@@ -17,10 +17,13 @@ use haptic_rig::{ForceSample, HapticRig, ObjectSpec, Rendering, RigConfig, ToolS
 use haptico::trace::TraceWriter;
 use haptico::{Device, DeviceSpecs, HapticClock, HapticEvents, HapticHandle};
 
-use crate::components::{CollisionVolume, CollisionWatcher, ForceComponent, HapticCollider, HapticTool};
+use crate::components::{
+    CollisionVolume, CollisionWatcher, ForceComponent, HapticCollider, HapticPushable, HapticTool,
+};
 use crate::device::{HapticDevice, HapticDeviceLink, SimulatedHand};
 use crate::events::{
     ContactData, ContactEnded, ContactOngoing, ContactStarted, PairContactEnded, PairContactStarted, ToolMoved,
+    ToolPushed,
 };
 use crate::frame::HapticFrame;
 use crate::settings::{CollisionSettings, ForceRendering};
@@ -186,6 +189,7 @@ fn try_start(world: &mut World) -> Result<HapticStatus, String> {
     let rate_hz = haptic.rate_hz;
     let collision = world.get_resource::<CollisionSettings>().cloned();
     let rendering = world.get_resource::<ForceRendering>().map(|r| r.resolve(&specs));
+    let pushes = world.get_resource::<ForceRendering>().map(|r| r.pushes).unwrap_or_default();
     let clock = HapticClock::new();
     let (engine, rendering, clock) = match collision {
         None => {
@@ -196,7 +200,8 @@ fn try_start(world: &mut World) -> Result<HapticStatus, String> {
         Some(CollisionSettings(mut collision)) => {
             collision.realtime_priority = device.realtime_priority.map(|p| (p - 1).max(1));
             let (rendering, proxy) = rendering.unwrap_or((Rendering::Off, Default::default()));
-            let config = RigConfig { haptic, collision, map, rendering, proxy, workspace, ..RigConfig::default() };
+            let config =
+                RigConfig { haptic, collision, map, rendering, proxy, workspace, pushes, ..RigConfig::default() };
             let tool = ToolSpec::new(SphereTree::ball(HapticTool::default().tip_radius_m).tree, rigid_tool());
             let rig = HapticRig::start(opened, tool, config, events, Default::default()).map_err(|e| e.to_string())?;
             let clock = rig.clock();
@@ -373,9 +378,11 @@ pub(crate) fn sync_tool(
     }
 }
 
-type ColliderChanged = Or<(Changed<HapticCollider>, Changed<ForceComponent>, Added<HapticCollider>)>;
+type ColliderChanged =
+    Or<(Changed<HapticCollider>, Changed<ForceComponent>, Added<HapticCollider>, Changed<HapticPushable>)>;
 type ColliderMoved = (With<HapticCollider>, Changed<GlobalTransform>);
-type Collider<'a> = (Entity, &'a HapticCollider, &'a GlobalTransform, Option<&'a ForceComponent>);
+type Collider<'a> =
+    (Entity, &'a HapticCollider, &'a GlobalTransform, Option<&'a ForceComponent>, Option<&'a HapticPushable>);
 
 /// The game thread's two ends: the threads (if running) and its record of what they watch.
 #[derive(SystemParam)]
@@ -471,7 +478,7 @@ pub(crate) fn send_colliders(
     // A collider whose tree is still loading is sent once it is there (checked every frame).
     let waiting = all.iter().map(|(e, ..)| e).filter(|e| !watched.ids.contains_key(e));
     let to_send: HashSet<Entity> = changed.iter().chain(waiting).collect();
-    for (entity, collider, transform, force) in to_send.into_iter().filter_map(|e| all.get(e).ok()) {
+    for (entity, collider, transform, force, pushable) in to_send.into_iter().filter_map(|e| all.get(e).ok()) {
         let Some(tree) = trees.get(&collider.tree) else { continue };
         let id = match watched.ids.get(&entity) {
             Some(&id) => id,
@@ -483,7 +490,19 @@ pub(crate) fn send_colliders(
         let material = force.copied().unwrap_or_default().material();
         let spec = ObjectSpec { id, tree: Arc::clone(&tree.tree), pose: pose_of(transform), material };
         let surface = tree.surface.clone();
-        match runtime.rig(|rig| rig.add_object(spec).and_then(|()| rig.set_surface(id, surface))) {
+        let added = runtime.rig(|rig| {
+            match pushable {
+                Some(p) => rig.add_pushable(spec, p.mass_kg),
+                None => rig.add_object(spec),
+            }
+            .and_then(|()| rig.set_surface(id, surface))
+        });
+        match added {
+            Some(Err(e @ haptic_rig::RigError::BadMass { .. })) => {
+                // Not a queue to wait for: said once, and the entity is not sent again until it changes.
+                warn!("{entity} is not pushable: {e}");
+                watched.ids.insert(entity, id);
+            }
             Some(Err(e)) => warn!("{entity} waits for the collision thread: {e}"),
             _ => {
                 watched.ids.insert(entity, id);
@@ -579,6 +598,29 @@ pub(crate) fn move_colliders(mut threads: Threads, moved: Query<(Entity, &Global
 fn pose_of(transform: &GlobalTransform) -> Pose {
     let (_, rotation, translation) = transform.to_scale_rotation_translation();
     Pose::new(translation, rotation)
+}
+
+/// Hands what the tool did to pushed objects to the game (`PreUpdate`): one [`ToolPushed`] per object,
+/// as a message and triggered on the object.
+pub(crate) fn report_pushes(
+    mut threads: Threads,
+    mut pushes: Local<Vec<haptic_rig::ObjectPush>>,
+    mut pushed: MessageWriter<ToolPushed>,
+    mut commands: Commands,
+) {
+    let Some((runtime, watched)) = threads.get() else { return };
+    pushes.clear();
+    runtime.rig(|rig| rig.take_pushes(&mut pushes));
+    for p in pushes.iter() {
+        let Some(&object) = watched.entities.get(&p.id) else { continue };
+        let duration_s = p.to_us.saturating_sub(p.from_us) as f32 * 1e-6;
+        let event =
+            ToolPushed { object, impulse_ns: p.impulse_ns, angular_impulse_nms: p.angular_impulse_nms, duration_s };
+        pushed.write(event);
+        if commands.get_entity(object).is_ok() {
+            commands.trigger(event);
+        }
+    }
 }
 
 /// Sends the collision volume's box when it changes or goes (`PostUpdate`).

@@ -5,7 +5,7 @@
 //! You need this module to change them before the app starts (they are resources).
 
 use bevy::prelude::*;
-use haptic_rig::{ProxyRendering, Rendering};
+use haptic_rig::{ProxyRendering, PushCoupling, Rendering};
 use haptico::DeviceSpecs;
 
 /// The collision thread's settings (present when [`CollettePlugin`](crate::CollettePlugin) is added).
@@ -32,6 +32,8 @@ pub struct ForceRendering {
     pub mode: RenderingMode,
     /// How the 3-DOF proxy feels materials.
     pub proxy: ProxyRendering,
+    /// How pushed objects follow the game's bodies.
+    pub pushes: PushCoupling,
 }
 
 impl ForceRendering {

@@ -97,3 +97,24 @@ fn six_dof_tool_presses_the_gem_into_the_bunny_and_feels_a_torque_headless() {
     check(&report, "six_dof_tool", 5.0, 8.5, true);
     assert!(number(&report, "max_torque_nm") > 0.0, "the gem's off-centre contact twists it: {report}");
 }
+
+#[test]
+fn moving_platform_carries_the_resting_tool_while_the_game_slides_it_headless() {
+    let report = run("moving_platform", 4.0);
+    check(&report, "moving_platform", 4.0, 3.3, true);
+    // The hand lands at about 0.8 s; the contact goes on, frame after frame, while the platform slides.
+    assert!(number(&report, "frames_on_platform") >= 100.0, "the tool rides the platform: {report}");
+}
+
+#[test]
+fn push_box_pushes_an_avian_box_along_the_table_headless() {
+    let report = run("push_box", 4.0);
+    check(&report, "push_box", 4.0, 3.3, true);
+    // The hand goes 6.5 cm past the box's face along +x: avian's box goes most of that way, straight,
+    // and stays on the table.
+    let x = number(&report, "box_moved_x_m");
+    assert!((0.03..0.08).contains(&x), "pushed along +x: {report}");
+    assert!(number(&report, "box_moved_z_m").abs() < 0.01, "straight: {report}");
+    assert!((number(&report, "box_height_m") - 0.02).abs() < 0.005, "on the table: {report}");
+    assert!(number(&report, "impulse_x_ns") > 0.0, "the pushes went to avian: {report}");
+}

@@ -254,3 +254,64 @@ fn a_watcher_between_two_colliders_hears_them_meet_and_part_where_the_game_moves
     assert!(matches!(seen[2], PairSeen::Started(x, y, _) if (x, y) == (a, b)), "{seen:?}");
     assert_eq!(seen[3], PairSeen::Ended(a, b), "a despawned collider ends its watcher's contact");
 }
+
+/// A game's own rigid body (no physics engine): a velocity, a table's friction, and the pushes.
+#[derive(Component, Default)]
+struct Body {
+    velocity: Vec3,
+    pushes: u32,
+}
+
+#[test]
+fn a_pushable_box_is_handed_the_pushes_that_move_it_the_way_the_hand_goes() {
+    const MASS_KG: f32 = 0.1;
+    let mut app = App::new();
+    app.add_plugins((MinimalPlugins, AssetPlugin::default(), HapticsPlugins))
+        .init_asset::<Mesh>()
+        .insert_resource(HapticDevice::simulated("touch", Vec3::new(-0.04, 0.0, 0.0)));
+    let world = app.world_mut();
+    world.spawn(HapticTool::ball(0.005));
+    let tree = world.resource_mut::<Assets<SphereTree>>().add(box_tree());
+    // The game applies each push to its body (an observer on the box) and moves it (a system).
+    let boxed = world
+        .spawn((HapticCollider::new(tree), HapticPushable::new(MASS_KG), Body::default(), Transform::default()))
+        .observe(|push: On<ToolPushed>, mut bodies: Query<&mut Body>| {
+            let mut body = bodies.get_mut(push.object).expect("the box");
+            body.velocity += push.impulse_ns / MASS_KG;
+            body.pushes += 1;
+        })
+        .id();
+    app.add_systems(Update, |time: Res<Time>, mut bodies: Query<(&mut Body, &mut Transform)>| {
+        let dt = time.delta_secs();
+        for (mut body, mut t) in &mut bodies {
+            let rub = 0.3 * 9.81 * dt;
+            let v = Vec3::new(body.velocity.x, 0.0, body.velocity.z);
+            body.velocity = if v.length() <= rub { Vec3::ZERO } else { v - v.normalize() * rub };
+            t.translation += body.velocity * dt;
+        }
+    });
+    app.finish();
+    app.cleanup();
+    // The hand (its ball 3 cm left of the box's 2 cm face) goes 7 cm along +x over 1.4 s.
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let mut moved = false;
+    while Instant::now() < deadline {
+        app.update();
+        std::thread::sleep(Duration::from_millis(5));
+        let world = app.world_mut();
+        if let Some(mut hand) = world.get_resource_mut::<SimulatedHand>()
+            && !moved
+        {
+            hand.move_to(Vec3::new(0.03, 0.0, 0.0), 1.4);
+            moved = true;
+        }
+        let x = world.get::<Transform>(boxed).expect("box").translation.x;
+        if x > 0.03 {
+            break;
+        }
+    }
+    let world = app.world();
+    let (t, body) = (world.get::<Transform>(boxed).expect("box"), world.get::<Body>(boxed).expect("body"));
+    assert!(t.translation.x > 0.03, "pushed along +x: {:?} after {} pushes", t.translation, body.pushes);
+    assert!(t.translation.z.abs() < 0.01, "straight: {:?}", t.translation);
+}

@@ -223,6 +223,7 @@ fn a_light_box_pushed_and_released_on_ice_leaves_no_faster_than_a_hit_could_send
     let run = on_ice(PushCoupling::default());
     assert_passive(&run, "50 g pushed and released on ice");
     let v = run.game.velocity;
+    eprintln!("on ice: leaves at {v:?} m/s");
     // Struck elastically by the 150 g hand at 0.1 m/s, a 50 g box leaves at 0.15 m/s; nothing faster.
     assert!(v.x > 0.05 && v.length() <= 0.15 * 1.1, "it slides on along +x, no faster than a hit sends it: {v:?}");
 }

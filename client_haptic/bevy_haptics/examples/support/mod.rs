@@ -77,10 +77,14 @@ impl Run {
                 .insert_resource(bevy_haptics::HapticsDebugConfig { tree_depth: None, ..default() })
                 .add_systems(Update, (screenshot, toggle_trees));
         }
-        app.insert_resource(self).add_systems(Startup, realtime).add_systems(Update, end);
+        app.insert_resource(self).init_resource::<Figures>().add_systems(Startup, realtime).add_systems(Update, end);
         app
     }
 }
+
+/// An example's own figures, added to its JSON line (e.g. how far a pushed box moved).
+#[derive(Resource, Default)]
+pub struct Figures(pub serde_json::Map<String, serde_json::Value>);
 
 /// Gives the threads the real-time priority asked for (`Startup`: before they start in `PostStartup`).
 fn realtime(run: Res<Run>, device: Option<ResMut<HapticDevice>>) {
@@ -105,6 +109,7 @@ fn end(
     time: Res<Time<Real>>,
     stats: Res<HapticStats>,
     status: Res<HapticStatus>,
+    figures: Res<Figures>,
     mut exit: MessageWriter<AppExit>,
 ) {
     let Some(seconds) = run.seconds else { return };
@@ -114,7 +119,7 @@ fn end(
     if let HapticStatus::Failed(why) = &*status {
         fail(&format!("haptics did not start: {why}"));
     }
-    let line = serde_json::json!({
+    let mut line = serde_json::json!({
         "example": run.name,
         "seconds": seconds,
         "haptic_hz_min": stats.haptic.min_hz(),
@@ -130,6 +135,9 @@ fn end(
         "ticks": stats.ticks,
         "non_finite": stats.non_finite,
     });
+    if let Some(line) = line.as_object_mut() {
+        line.extend(figures.0.clone());
+    }
     println!("{line}");
     exit.write(AppExit::Success);
 }
