@@ -13,6 +13,6 @@ pub use coupling::{CouplingConfig, VirtualCoupling};
 pub use error::{ForceCompError, Result};
 pub use material::{BodyMotion, Material};
 pub use penalty::{volumetric_penalty, volumetric_penalty_of};
-pub use proxy::{Ball, GodObject, ProxyConfig};
+pub use proxy::{Ball, GodObject, ProxyConfig, TipField, half_space_overlap};
 pub use safety::{SafetyConfig, SafetyLayer, SafetyPhase, SafetyStats, Workspace};
 pub use texture::Texture;

@@ -8,6 +8,11 @@
 //! slides over an inner-sphere packing without catching in the gaps between spheres, as a point on the
 //! union of the spheres would.
 //!
+//! An object can also be given as a field instead of balls ([`TipField`]): the overlap of the tip with
+//! it and its gradient, such as [`half_space_overlap`] at the signed distance a surface grid gives. The
+//! tip is then held on the object's true surface, whose normals change smoothly, not on its packing;
+//! both kinds add up, so a tip between a grid-backed object and a packed one is held off both.
+//!
 //! Each tick the proxy slides along that surface towards the device point (tangential steps, each
 //! followed by a Newton step back onto the surface); friction keeps it in place while the pull along the
 //! surface stays inside the friction cone. A spring from the device to the proxy is the force, so the
@@ -59,6 +64,34 @@ impl ProxyConfig {
     }
 }
 
+/// More of what the tip is held outside of, besides the balls: for each object given as a field, the
+/// tip's overlap volume with it at the tip's centre `p` and that volume's gradient (pointing into the
+/// object), in the balls' units. Called many times a tick, on the haptic thread: no allocation.
+pub trait TipField {
+    /// The tip's (radius `tip_radius`) overlap volume at `p` and its gradient.
+    fn overlap_and_gradient(&self, p: Vec3, tip_radius: f32) -> (f32, Vec3);
+}
+
+/// No field: the balls alone.
+impl TipField for () {
+    fn overlap_and_gradient(&self, _: Vec3, _: f32) -> (f32, Vec3) {
+        (0.0, Vec3::ZERO)
+    }
+}
+
+/// The tip's overlap with the object behind a surface, taken as flat at the tip: the cap the tangent
+/// plane cuts from the tip when its centre is `depth` inside the surface (negative: outside), and the
+/// gradient of that volume along `inward` (the unit normal into the object; the distance's gradient).
+/// Exact for a flat face, C¹ in the depth, and the same volume the balls give for the same place, so
+/// the tip rests `(1 − SURFACE_CAP) × tip_radius` outside the surface either way.
+pub fn half_space_overlap(tip_radius: f32, depth: f32, inward: Vec3) -> (f32, Vec3) {
+    let h = (tip_radius + depth).clamp(0.0, 2.0 * tip_radius);
+    if !(h.is_finite() && inward.is_finite()) {
+        return (0.0, Vec3::ZERO);
+    }
+    (cap_volume(tip_radius, h), inward * (PI * h * (2.0 * tip_radius - h)))
+}
+
 /// The surface is where the tip overlaps the object by a cap this high, as a fraction of its radius.
 pub const SURFACE_CAP: f32 = 0.2;
 /// Tangential steps per update, each at most half the tip's radius (so the proxy follows the device at
@@ -103,11 +136,25 @@ impl GodObject {
     /// `velocity` (m/s, along the same axes) into the surface. Allocation-free; non-finite or empty balls
     /// are ignored.
     pub fn update(&mut self, config: &ProxyConfig, device: Vec3, velocity: Vec3, balls: &[Ball], scale: f32) -> Vec3 {
+        self.update_with(config, device, velocity, balls, &(), scale)
+    }
+
+    /// [`update`](Self::update) against `balls` and the objects given as `field` together.
+    pub fn update_with<F: TipField + ?Sized>(
+        &mut self,
+        config: &ProxyConfig,
+        device: Vec3,
+        velocity: Vec3,
+        balls: &[Ball],
+        field: &F,
+        scale: f32,
+    ) -> Vec3 {
         if !device.is_finite() || config.tip_radius.is_nan() || config.tip_radius <= 0.0 {
             return Vec3::ZERO;
         }
         let surface = Surface {
             balls,
+            field,
             tip: config.tip_radius,
             level: cap_volume(config.tip_radius, SURFACE_CAP * config.tip_radius),
         };
@@ -152,26 +199,28 @@ impl GodObject {
     }
 }
 
-/// The surface the tip is held on: where its overlap volume with the balls is `level`.
-struct Surface<'a> {
+/// The surface the tip is held on: where its overlap volume with the balls and the field is `level`.
+struct Surface<'a, F: TipField + ?Sized> {
     balls: &'a [Ball],
+    field: &'a F,
     tip: f32,
     level: f32,
 }
 
-impl Surface<'_> {
+impl<F: TipField + ?Sized> Surface<'_, F> {
     fn valid(&self) -> impl Iterator<Item = &Ball> {
         self.balls.iter().filter(|b| b.center.is_finite() && b.radius.is_finite() && b.radius > 0.0)
     }
 
     /// The tip's overlap volume with the balls at `p`.
     fn volume(&self, p: Vec3) -> f32 {
-        self.valid().map(|b| lens_volume(self.tip, b.radius, p.distance(b.center))).sum()
+        let field = self.field.overlap_and_gradient(p, self.tip).0;
+        field + self.valid().map(|b| lens_volume(self.tip, b.radius, p.distance(b.center))).sum::<f32>()
     }
 
     /// The overlap volume at `p` and its gradient (pointing into the object).
     fn volume_and_gradient(&self, p: Vec3) -> (f32, Vec3) {
-        let (mut v, mut g) = (0.0, Vec3::ZERO);
+        let (mut v, mut g) = self.field.overlap_and_gradient(p, self.tip);
         for b in self.valid() {
             let delta = p - b.center;
             let d = delta.length();
@@ -421,10 +470,53 @@ mod tests {
         assert_eq!(g.update(&no_tip, Vec3::new(0.0, -0.01, 0.0), Vec3::ZERO, &floor(), 1.0), Vec3::ZERO);
     }
 
+    /// A flat floor at y = 0 given as a field (what a surface grid gives: depth and inward normal).
+    struct FieldFloor;
+
+    impl TipField for FieldFloor {
+        fn overlap_and_gradient(&self, p: Vec3, tip_radius: f32) -> (f32, Vec3) {
+            half_space_overlap(tip_radius, -p.y, Vec3::NEG_Y)
+        }
+    }
+
+    #[test]
+    fn a_floor_given_as_a_field_holds_the_tip_where_a_floor_of_balls_does() {
+        let mut g = GodObject::new();
+        g.update_with(&K, Vec3::new(0.0, 0.01, 0.0), Vec3::ZERO, &[], &FieldFloor, 1.0);
+        let f = g.update_with(&K, Vec3::new(0.0, REST - 0.002, 0.0), Vec3::ZERO, &[], &FieldFloor, 1.0);
+        assert!((f - Vec3::new(0.0, 1.0, 0.0)).length() < 0.02, "{f}");
+        assert!((g.proxy().y - REST).abs() < 2e-5 && (g.normal() - Vec3::Y).length() < 1e-3, "{}", g.proxy());
+        // Dragged along it, frictionless: the force stays straight up (no bumps to catch on).
+        for i in 1..=40 {
+            let f = g.update_with(&K, Vec3::new(i as f32 * 2e-4, REST - 0.002, 0.0), Vec3::ZERO, &[], &FieldFloor, 1.0);
+            assert!(f.x.abs() < 1e-4 && (f.y - 1.0).abs() < 0.02, "at step {i}: {f}");
+        }
+        // A wall of balls at x = 0.01 beside the field floor: an inside corner, held off both.
+        let wall = [Ball { center: Vec3::new(10.01, 0.0, 0.0), radius: 10.0 }];
+        let f = g.update_with(&K, Vec3::new(0.012, -0.001, 0.0), Vec3::ZERO, &wall, &FieldFloor, 1.0);
+        assert!(f.x < -0.3 && f.y > 0.3 && g.proxy().x < 0.01, "{f}, proxy {}", g.proxy());
+    }
+
+    #[test]
+    fn the_half_space_overlap_is_a_cap_and_its_gradient_its_derivative() {
+        let (v, _) = half_space_overlap(R, -R, Vec3::NEG_Y);
+        assert_eq!(v, 0.0, "touching from outside: nothing");
+        let (v, _) = half_space_overlap(R, R, Vec3::NEG_Y);
+        assert!((v - 4.0 / 3.0 * PI * R.powi(3)).abs() < 1e-12, "all in: the whole ball");
+        let h = 1e-6;
+        for depth in [-0.0015, -0.0008, 0.0, 0.0011] {
+            let (_, g) = half_space_overlap(R, depth, Vec3::NEG_Y);
+            let numeric = (half_space_overlap(R, depth + h, Vec3::NEG_Y).0
+                - half_space_overlap(R, depth - h, Vec3::NEG_Y).0)
+                / (2.0 * h);
+            assert!((numeric + g.y).abs() < 1e-3 * numeric.abs() + 1e-12, "at {depth}: {numeric} vs {}", -g.y);
+        }
+    }
+
     #[test]
     fn the_gradient_is_the_derivative_of_the_volume() {
         let balls = [Ball { center: Vec3::new(0.001, -0.002, 0.0005), radius: 0.003 }];
-        let surface = Surface { balls: &balls, tip: R, level: 0.0 };
+        let surface = Surface { balls: &balls, field: &(), tip: R, level: 0.0 };
         let p = Vec3::new(0.0, 0.002, 0.0);
         let (_, g) = surface.volume_and_gradient(p);
         let h = 1e-5;

@@ -8,7 +8,7 @@
 //! volume along the exact normal, its torque about a handle point off the tool from the exact overlap's
 //! centroid. Two trees (the tool's against the object's) and the tree against the object's surface grid.
 //! The 3-DOF proxy is judged by where it holds the tip: its contact point against the exact closest
-//! point of the surface. Scenes: a sphere, a box's edge, a box's corner and a cylinder on its side
+//! point of the surface, held on the object's packing or on its surface grid. Scenes: a sphere, a box's edge, a box's corner and a cylinder on its side
 //! pressed into a slab, a sphere into a sphere; the proxy's tip into the slab, the sphere and the box
 //! (faces, edges and corners), at depths from 0.1 to 5 mm (one pose in ten 5–10 mm), random places and
 //! turns about the normal. Meshes with a Monte Carlo reference are the next step (docs/haptics.md).
@@ -266,20 +266,52 @@ fn volumetric(
     (trees, grid)
 }
 
-/// The 3-DOF proxy's tip (radius 4 mm, as the rig's default) pressed from `outside` to `inside`; its
-/// contact point (the proxy less its hold-off along the normal) against `surface`, the exact closest
-/// point of the object's surface to `inside`.
-fn proxy(object: &Shape, object_pose: &Pose, outside: Vec3, inside: Vec3, surface: Vec3, errors: &mut Errors) {
+/// An object's surface grid at its pose, as the proxy feels it (what the rig does for a grid-backed
+/// object).
+struct GridField<'a> {
+    grid: &'a SignedDistanceGrid,
+    pose: Pose,
+}
+
+impl forcecomp::TipField for GridField<'_> {
+    fn overlap_and_gradient(&self, p: Vec3, tip_radius: f32) -> (f32, Vec3) {
+        let local = self.pose.rotation.inverse() * (p - self.pose.translation);
+        let (depth, inward) = self.grid.distance_and_gradient(local);
+        forcecomp::half_space_overlap(tip_radius, depth, self.pose.rotation * inward.normalize_or_zero())
+    }
+}
+
+/// The 3-DOF proxy's tip (radius 4 mm, as the rig's default) pressed from `outside` to `inside`, held
+/// on the object's packing or (`on_grid`) its surface grid; its contact point (the proxy less its
+/// hold-off along the normal) against `surface`, the exact closest point of the object's surface to
+/// `inside`.
+#[allow(clippy::too_many_arguments)]
+fn proxy(
+    object: &Shape,
+    object_pose: &Pose,
+    on_grid: bool,
+    outside: Vec3,
+    inside: Vec3,
+    surface: Vec3,
+    errors: &mut Errors,
+) {
     let config = ProxyConfig { friction: 0.0, tip_radius: 0.004, ..ProxyConfig::default() };
-    let mut ws = QueryWorkspace::new();
     let mut balls = Vec::new();
-    collette::query::spheres_near(&object.tree, object_pose, inside, 0.03, &mut ws, |center, radius| {
-        balls.push(Ball { center, radius })
-    });
+    if !on_grid {
+        let mut ws = QueryWorkspace::new();
+        collette::query::spheres_near(&object.tree, object_pose, inside, 0.03, &mut ws, |center, radius| {
+            balls.push(Ball { center, radius })
+        });
+    }
+    let field = GridField { grid: &object.grid, pose: *object_pose };
     let mut god = GodObject::new();
-    god.update(&config, outside, Vec3::ZERO, &balls, 1.0);
+    let mut press = |at: Vec3| match on_grid {
+        true => god.update_with(&config, at, Vec3::ZERO, &balls, &field, 1.0),
+        false => god.update(&config, at, Vec3::ZERO, &balls, 1.0),
+    };
+    press(outside);
     for _ in 0..20 {
-        god.update(&config, inside, Vec3::ZERO, &balls, 1.0);
+        press(inside);
     }
     if !god.in_contact() {
         errors.contact_mm.push(f32::INFINITY);
@@ -352,36 +384,43 @@ fn run(args: Args) -> anyhow::Result<()> {
         all_grid.add(grid);
     }
 
-    // The proxy: the tip pressed into the slab, the ball and the cube.
-    let mut proxy_errors = Errors::default();
-    let mut slab_errors = Errors::default();
-    for _ in 0..args.poses {
-        let (d, at) = (dice.depth(), spot(&mut dice));
-        proxy(&slab, &slab_pose, at + Vec3::Y * 0.01, at - Vec3::Y * d, at, &mut slab_errors);
+    // The proxy: the tip pressed into the slab, the ball and the cube, on their packings and on their
+    // grids (the same poses for both).
+    let (mut proxy_errors, mut proxy_grid_errors) = (Errors::default(), Errors::default());
+    for (on_grid, rendering) in [(false, "3-DOF proxy on the packing"), (true, "3-DOF proxy on the grid")] {
+        let mut dice = Dice(ChaCha8Rng::seed_from_u64(args.seed as u64 + 1));
+        let mut slab_errors = Errors::default();
+        for _ in 0..args.poses {
+            let (d, at) = (dice.depth(), spot(&mut dice));
+            proxy(&slab, &slab_pose, on_grid, at + Vec3::Y * 0.01, at - Vec3::Y * d, at, &mut slab_errors);
+        }
+        let mut ball_errors = Errors::default();
+        for _ in 0..args.poses {
+            let (d, u) = (dice.depth(), dice.unit());
+            let (outside, inside) = (u * (BALL_R + 0.01), u * (BALL_R - d));
+            proxy(&ball, &Pose::IDENTITY, on_grid, outside, inside, u * BALL_R, &mut ball_errors);
+        }
+        let mut cube_errors = Errors::default();
+        let cube_pose = Pose::IDENTITY;
+        for _ in 0..args.poses {
+            // Straight in through a face, anywhere on it up to its edges (there the face is the nearest).
+            let d = dice.depth().min(CUBE_HALF * 0.5);
+            let (k, sign) = ((dice.roll() * 3.0) as usize % 3, if dice.roll() < 0.5 { -1.0 } else { 1.0 });
+            let mut surface = (Vec3::new(dice.roll(), dice.roll(), dice.roll()) * 2.0 - Vec3::ONE) * (CUBE_HALF - d);
+            surface[k] = sign * CUBE_HALF;
+            let mut out = Vec3::ZERO;
+            out[k] = sign;
+            let (outside, inside) = (surface + out * 0.01, surface - out * d);
+            proxy(&cube, &cube_pose, on_grid, outside, inside, surface, &mut cube_errors);
+        }
+        table.push(("tip into a plane".to_string(), rendering, quantiles(&slab_errors)));
+        table.push(("tip into a sphere".to_string(), rendering, quantiles(&ball_errors)));
+        table.push(("tip into a box".to_string(), rendering, quantiles(&cube_errors)));
+        let all = if on_grid { &mut proxy_grid_errors } else { &mut proxy_errors };
+        all.add(slab_errors);
+        all.add(ball_errors);
+        all.add(cube_errors);
     }
-    let mut ball_errors = Errors::default();
-    for _ in 0..args.poses {
-        let (d, u) = (dice.depth(), dice.unit());
-        proxy(&ball, &Pose::IDENTITY, u * (BALL_R + 0.01), u * (BALL_R - d), u * BALL_R, &mut ball_errors);
-    }
-    let mut cube_errors = Errors::default();
-    let cube_pose = Pose::IDENTITY;
-    for _ in 0..args.poses {
-        // Straight in through a face, anywhere on it up to its edges (there the face is the nearest).
-        let d = dice.depth().min(CUBE_HALF * 0.5);
-        let (k, sign) = ((dice.roll() * 3.0) as usize % 3, if dice.roll() < 0.5 { -1.0 } else { 1.0 });
-        let mut surface = (Vec3::new(dice.roll(), dice.roll(), dice.roll()) * 2.0 - Vec3::ONE) * (CUBE_HALF - d);
-        surface[k] = sign * CUBE_HALF;
-        let mut out = Vec3::ZERO;
-        out[k] = sign;
-        proxy(&cube, &cube_pose, surface + out * 0.01, surface - out * d, surface, &mut cube_errors);
-    }
-    table.push(("tip into a plane".to_string(), "3-DOF proxy", quantiles(&slab_errors)));
-    table.push(("tip into a sphere".to_string(), "3-DOF proxy", quantiles(&ball_errors)));
-    table.push(("tip into a box".to_string(), "3-DOF proxy", quantiles(&cube_errors)));
-    proxy_errors.add(slab_errors);
-    proxy_errors.add(ball_errors);
-    proxy_errors.add(cube_errors);
 
     println!(
         "| scene | rendering | direction p50 / p99 | magnitude p50 / p99 | torque direction p50 / p99 | contact p50 / p99 |"
@@ -409,10 +448,13 @@ fn run(args: Args) -> anyhow::Result<()> {
         started.elapsed().as_secs_f32()
     );
     if args.json {
-        for (rendering, e) in
-            [("volumetric_trees", &all_trees), ("volumetric_grid", &all_grid), ("proxy", &proxy_errors)]
-        {
-            let volumetric = rendering != "proxy";
+        for (rendering, e) in [
+            ("volumetric_trees", &all_trees),
+            ("volumetric_grid", &all_grid),
+            ("proxy", &proxy_errors),
+            ("proxy_grid", &proxy_grid_errors),
+        ] {
+            let volumetric = rendering.starts_with("volumetric");
             let line = serde_json::json!({
                 "rendering": rendering,
                 "poses": e.direction_deg.len().max(e.contact_mm.len()),

@@ -11,6 +11,9 @@ use forcecomp::{
     Ball, BodyMotion, GodObject, Material, ProxyConfig, SafetyLayer, SafetyPhase, SafetyStats, VirtualCoupling,
     volumetric_penalty_of,
 };
+use std::sync::Arc;
+
+use collette::SignedDistanceGrid;
 use glam::Vec3;
 use haptic_common::{DeviceState, ForceOnHapticTick, ForceTorque, Pose};
 
@@ -171,6 +174,8 @@ pub(crate) struct WatchedObject {
     pub(crate) track: Option<PoseTrack>,
     /// The haptic body of an object the tool pushes (see [`crate::push`]).
     pub(crate) pushed: Option<PushedBody>,
+    /// Its surface grid: the 3-DOF proxy is held on it instead of on its spheres.
+    pub(crate) surface: Option<Arc<SignedDistanceGrid>>,
 }
 
 impl WatchedObject {
@@ -193,6 +198,46 @@ impl WatchedObject {
             Some(body) => body.motion(),
             None => self.motion_at(now_us),
         }
+    }
+
+    /// Its pose (scene frame) for a motion of its centre of mass.
+    fn pose_of(&self, motion: &BodyMotion) -> Pose {
+        Pose::new(motion.center_of_mass - motion.orientation * self.center_of_mass, motion.orientation)
+    }
+}
+
+/// What the threads hand back to the game thread to free (held only to be dropped there).
+#[expect(dead_code, reason = "the values are only dropped, on the game thread")]
+pub(crate) enum Returned {
+    Object(Box<WatchedObject>),
+    Surface(Arc<SignedDistanceGrid>),
+}
+
+/// The surface grids of the objects near the proxy's tip, each at its pose: the tip's overlap with
+/// them, as with a flat face at the signed distance the grid gives (`forcecomp::half_space_overlap`).
+struct GridSurfaces<'a> {
+    objects: &'a [Option<Box<WatchedObject>>],
+    near: &'a [(u32, Pose)],
+}
+
+impl GridSurfaces<'_> {
+    /// Each grid near the tip with the depth of `p` inside it and the inward normal (scene frame).
+    fn depths(&self, p: Vec3) -> impl Iterator<Item = (u32, f32, Vec3)> + '_ {
+        self.near.iter().filter_map(move |&(slot, pose)| {
+            let grid = self.objects.get(slot as usize)?.as_ref()?.surface.as_ref()?;
+            let local = pose.rotation.inverse() * (p - pose.translation);
+            let (depth, inward) = grid.distance_and_gradient(local);
+            Some((slot, depth, pose.rotation * inward.normalize_or_zero()))
+        })
+    }
+}
+
+impl forcecomp::TipField for GridSurfaces<'_> {
+    fn overlap_and_gradient(&self, p: Vec3, tip_radius: f32) -> (f32, Vec3) {
+        self.depths(p).fold((0.0, Vec3::ZERO), |(v, g), (_, depth, inward)| {
+            let (dv, dg) = forcecomp::half_space_overlap(tip_radius, depth, inward);
+            (v + dv, g + dg)
+        })
     }
 }
 
@@ -224,6 +269,11 @@ pub(crate) enum ForceCommand {
         slot: u32,
         track: PoseTrack,
     },
+    /// An object's surface grid (or none again).
+    Surface {
+        slot: u32,
+        grid: Option<Arc<SignedDistanceGrid>>,
+    },
 }
 
 /// The force stage's state (lives on the haptic thread).
@@ -249,10 +299,12 @@ pub struct ForceStage {
     pub(crate) watched: usize,
     pub(crate) watched_since_us: u64,
     pub(crate) commands: rtrb::Consumer<ForceCommand>,
-    pub(crate) garbage: rtrb::Producer<Box<WatchedObject>>,
+    pub(crate) garbage: rtrb::Producer<Returned>,
     /// Proxy rendering: every object's spheres near the tip this tick, with the object's slot.
     pub(crate) balls: Vec<Ball>,
     pub(crate) ball_objects: Vec<u32>,
+    /// Proxy rendering: the objects near the tip that have a surface grid (slot, pose).
+    pub(crate) grids_near: Vec<(u32, Pose)>,
     pub(crate) telemetry: triple_buffer::Input<RigTelemetry>,
     pub(crate) samples: rtrb::Producer<ForceSample>,
     /// This tick's contact with each object touched, the first `touched` in use.
@@ -402,13 +454,26 @@ impl ForceStage {
                         o.track = Some(track);
                     }
                 }
+                ForceCommand::Surface { slot, grid } => {
+                    let old = match self.objects.get_mut(slot as usize).and_then(Option::as_mut) {
+                        Some(o) => std::mem::replace(&mut o.surface, grid),
+                        None => grid,
+                    };
+                    if let Some(old) = old {
+                        self.give_back(Returned::Surface(old));
+                    }
+                }
             }
         }
     }
 
     fn discard(&mut self, object: Box<WatchedObject>) {
-        if let Err(rtrb::PushError::Full(object)) = self.garbage.push(object) {
-            std::mem::forget(object); // leak rather than free on this thread (the ring is sized not to fill)
+        self.give_back(Returned::Object(object));
+    }
+
+    fn give_back(&mut self, item: Returned) {
+        if let Err(rtrb::PushError::Full(item)) = self.garbage.push(item) {
+            std::mem::forget(item); // leak rather than free on this thread (the ring is sized not to fill)
         }
     }
 
@@ -418,6 +483,7 @@ impl ForceStage {
         let tip = self.map.to_scene(&device.pose);
         self.balls.clear();
         self.ball_objects.clear();
+        self.grids_near.clear();
         self.touched = 0;
         let SceneInput::Near(reader) = &mut self.scene else { return };
         let set = reader.latest();
@@ -426,8 +492,14 @@ impl ForceStage {
             .at(device.timestamp_us);
         for s in set.as_slice().iter().take(self.balls.capacity()) {
             let Some(object) = self.objects.get(s.object as usize).and_then(Option::as_ref) else { continue };
-            self.balls.push(Ball { center: s.center, radius: s.radius });
-            self.ball_objects.push(s.object);
+            if object.surface.is_none() {
+                self.balls.push(Ball { center: s.center, radius: s.radius });
+                self.ball_objects.push(s.object);
+            } else if !self.grids_near.iter().any(|g| g.0 == s.object) && self.grids_near.len() < MAX_TOUCHED {
+                // Held on its surface grid instead of its spheres.
+                let pose = object.pose_of(&object.touched_motion(device.timestamp_us));
+                self.grids_near.push((s.object, pose));
+            }
             // Each object near the tip once, with its count of spheres.
             let listed = &mut self.object_contacts[..self.touched];
             match listed.iter_mut().find(|c| c.id == object.id) {
@@ -441,15 +513,21 @@ impl ForceStage {
             }
         }
         let balls = self.balls.as_slice();
-        // The spring of the material the proxy rests on: the object of the sphere nearest to it.
+        let grids = GridSurfaces { objects: &self.objects, near: &self.grids_near };
+        // The spring of the material the proxy rests on: the object of the sphere (or the surface grid)
+        // nearest to it.
         let near = if self.god.in_contact() { self.god.proxy() } else { tip.translation };
-        let nearest_slot = balls
+        let nearest_ball = balls
             .iter()
             .enumerate()
-            .min_by(|a, b| {
-                (a.1.center.distance(near) - a.1.radius).total_cmp(&(b.1.center.distance(near) - b.1.radius))
-            })
-            .map(|(i, _)| self.ball_objects[i] as usize);
+            .map(|(i, b)| (b.center.distance(near) - b.radius, self.ball_objects[i]))
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        let nearest_grid = grids.depths(near).map(|(slot, depth, _)| (-depth, slot)).min_by(|a, b| a.0.total_cmp(&b.0));
+        let nearest_slot = match (nearest_ball, nearest_grid) {
+            (Some(b), Some(g)) => Some(if g.0 <= b.0 { g.1 } else { b.1 }),
+            (b, g) => b.or(g).map(|n| n.1),
+        }
+        .map(|slot| slot as usize);
         let nearest = nearest_slot.and_then(|slot| self.objects.get(slot)).and_then(Option::as_deref);
         let material = nearest.map(|o| self.tool_material.combine(&o.material));
         let config = ProxyConfig {
@@ -466,7 +544,7 @@ impl ForceStage {
         let body = nearest.map(|o| o.touched_motion(device.timestamp_us));
         let surface = body.map_or(Vec3::ZERO, |b| b.velocity_at(near));
         let velocity = (self.map.velocity_to_scene(device.linear_velocity) - surface) / scale;
-        let mut force_scene = self.god.update(&config, tip.translation, velocity, balls, scale);
+        let mut force_scene = self.god.update_with(&config, tip.translation, velocity, balls, &grids, scale);
         // Ridges: the spring's push along the surface normal becomes that of the ridged surface.
         let texture = material.and_then(|m| m.texture);
         if let (Some(t), Some(body)) = (texture, body.filter(|_| self.god.in_contact())) {

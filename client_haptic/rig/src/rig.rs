@@ -153,6 +153,7 @@ impl Parts {
             garbage: garbage_tx,
             balls: Vec::with_capacity(balls),
             ball_objects: Vec::with_capacity(balls),
+            grids_near: Vec::with_capacity(if proxy { collette::pipeline::MAX_TOUCHED } else { 0 }),
             telemetry: telemetry_in,
             samples: samples_tx,
             object_contacts: [crate::force::ObjectContact::default(); collette::pipeline::MAX_TOUCHED],

@@ -13,7 +13,7 @@ use collette::pipeline::{
 use forcecomp::BodyMotion;
 use haptic_common::Pose;
 
-use crate::force::{ForceCommand, WatchedObject};
+use crate::force::{ForceCommand, Returned, WatchedObject};
 use crate::push::PushedBody;
 use crate::spec::{MAX_OBJECTS, MAX_PAIR_WATCHERS, ObjectSpec, PairContact, ToolSpec, center_of_mass};
 use crate::{Result, RigError};
@@ -57,7 +57,7 @@ pub(crate) struct Scene {
     entries: Vec<Entry>,
     pairs: Vec<PairEntry>,
     forces: rtrb::Producer<ForceCommand>,
-    garbage: rtrb::Consumer<Box<WatchedObject>>,
+    garbage: rtrb::Consumer<Returned>,
     /// How moving objects' tracks are read.
     timing: TrackTiming,
     /// Objects freed since the last `collect_garbage` (the other methods free too, before sending).
@@ -70,7 +70,7 @@ impl Scene {
         collision: CollisionHandle,
         tool: ObjectId,
         forces: rtrb::Producer<ForceCommand>,
-        garbage: rtrb::Consumer<Box<WatchedObject>>,
+        garbage: rtrb::Consumer<Returned>,
         timing: TrackTiming,
     ) -> Self {
         let (entries, pairs) = (Vec::with_capacity(MAX_OBJECTS), Vec::with_capacity(MAX_PAIR_WATCHERS));
@@ -126,6 +126,7 @@ impl Scene {
             center_of_mass: local_center,
             track: None,
             pushed,
+            surface: None,
         });
         self.forces.push(ForceCommand::Add(object)).map_err(|_| RigError::QueueFull("haptic"))?;
         let track = PoseTrack::new(self.timing);
@@ -280,7 +281,15 @@ impl Scene {
     ) -> Result<()> {
         self.free_returned();
         let entry = self.entries.iter().find(|e| e.id == id).ok_or(RigError::UnknownObject(id))?;
-        if self.collision.set_surface(entry.object, surface) { Ok(()) } else { Err(RigError::QueueFull("collision")) }
+        if self.forces.slots() == 0 {
+            return Err(RigError::QueueFull("haptic"));
+        }
+        if !self.collision.set_surface(entry.object, surface.clone()) {
+            return Err(RigError::QueueFull("collision"));
+        }
+        // The 3-DOF proxy holds the tip on the grid (on the haptic thread).
+        let command = ForceCommand::Surface { slot: entry.object.0, grid: surface };
+        self.forces.push(command).map_err(|_| RigError::QueueFull("haptic"))
     }
 
     /// Only checks objects whose bounds touch `region` (`None`: everywhere).
@@ -293,8 +302,8 @@ impl Scene {
         if self.collision.pause(paused) { Ok(()) } else { Err(RigError::QueueFull("collision")) }
     }
 
-    /// Frees what both threads handed back; returns how many objects the force stage has returned since
-    /// the last call.
+    /// Frees what both threads handed back; returns how many objects (and surface grids) the force
+    /// stage has returned since the last call.
     pub(crate) fn collect_garbage(&mut self) -> usize {
         self.free_returned();
         std::mem::take(&mut self.freed)

@@ -55,6 +55,12 @@ fn steady_state_ticks_do_not_allocate(specs: haptico::DeviceSpecs, rendering: Re
         true => rig.add_pushable(slab, 1.0).expect("pushable"),
         false => rig.add_object(slab).expect("object"),
     }
+    if pushed {
+        // With its surface grid: the proxy is held on it (read on the haptic thread every tick).
+        let (v, t) = collette::shape::box_buffers(Vec3::new(0.05, 0.01, 0.05));
+        let grid = collette::SignedDistanceGrid::new(&collette::TriMesh::new(v, t).expect("box"), 32).expect("grid");
+        rig.set_surface(1, Some(std::sync::Arc::new(grid))).expect("grid");
+    }
     let mut t = 0;
     for _ in 0..500 {
         rig.tick(t);

@@ -102,3 +102,79 @@ fn dragged_along_the_slab_the_point_slides_with_coulomb_friction() {
     let moved = proxy_x.last().copied().unwrap_or(0.0) - proxy_x[0];
     assert!(moved > 0.005, "the proxy slid along the surface ({moved} m), not stuck");
 }
+
+/// Strongest push along a stroke that repeats with the hand's travel, over the mean push into the
+/// surface: the largest Fourier amplitude of the along-stroke force (less its mean, the friction) at a
+/// period from 1.5 to 10 mm, over the mean normal force. Samples are (x of the hand, force).
+fn strongest_repeat(samples: &[(f32, Vec3)]) -> f32 {
+    let mean_along = samples.iter().map(|s| s.1.x).sum::<f32>() / samples.len() as f32;
+    let normal = samples.iter().map(|s| s.1.y).sum::<f32>() / samples.len() as f32;
+    let amplitude = |period: f32| {
+        let (mut c, mut s, mut travel) = (0.0f32, 0.0f32, 0.0f32);
+        for w in samples.windows(2) {
+            let dx = (w[1].0 - w[0].0).abs();
+            let phase = std::f32::consts::TAU * w[1].0 / period;
+            c += (w[1].1.x - mean_along) * phase.cos() * dx;
+            s += (w[1].1.x - mean_along) * phase.sin() * dx;
+            travel += dx;
+        }
+        2.0 * c.hypot(s) / travel.max(f32::MIN_POSITIVE)
+    };
+    (0..=34).map(|i| amplitude(0.0015 + i as f32 * 0.00025)).fold(0.0, f32::max) / normal.max(f32::MIN_POSITIVE)
+}
+
+/// A 4 cm stroke at 15 mm/s pressed ~1 N into the slab, with its surface grid or on its packing:
+/// the strongest repeat, and the hand's x and force while it slid.
+fn stroke_over_the_slab(grid: bool) -> (f32, Vec<(f32, Vec3)>) {
+    let press = -0.002;
+    let keys = vec![key(0.0, -0.02, 0.01), key(1.0, -0.02, press), key(1.5, -0.02, press), key(4.17, 0.02, press)];
+    let mut rig = rig(keys);
+    if grid {
+        let (v, t) = collette::shape::box_buffers(Vec3::new(0.05, 0.01, 0.05));
+        let mesh = collette::TriMesh::new(v, t).expect("box");
+        let grid = collette::SignedDistanceGrid::new(&mesh, 64).expect("grid");
+        rig.set_surface(1, Some(std::sync::Arc::new(grid))).expect("grid");
+    }
+    let mut samples = Vec::new();
+    for i in 0..4200u64 {
+        let out = rig.tick(i * 1000);
+        if (1700..4100).contains(&i) && out.force.y > 0.1 {
+            samples.push((rig.device().true_position().x, out.force));
+        }
+    }
+    assert!(samples.len() > 2000, "the stroke stayed on the slab ({} ticks)", samples.len());
+    (strongest_repeat(&samples), samples)
+}
+
+#[test]
+fn a_stroke_over_a_grid_backed_slab_slides_on_its_true_surface_without_the_packings_bumps() {
+    let (on_grid, samples) = stroke_over_the_slab(true);
+    let (on_packing, _) = stroke_over_the_slab(false);
+    eprintln!("strongest repeat along the stroke: {on_grid:.4} on the grid, {on_packing:.4} on the packing");
+    assert!(on_grid <= 0.02, "the grid's smooth face repeats nothing: {on_grid}");
+    assert!(on_packing > 2.0 * on_grid, "the packing's bumps repeat more: {on_packing} against {on_grid}");
+    // Friction kept: the drag over the push is the slab's coefficient while it slides.
+    let mut ratios: Vec<f32> = samples.iter().map(|s| -s.1.x / s.1.y).collect();
+    ratios.sort_by(f32::total_cmp);
+    let median = ratios[ratios.len() / 2];
+    assert!((median - MU).abs() < 0.1, "drag over push on the grid: median {median}");
+}
+
+#[test]
+fn a_tip_pressed_into_a_grid_backed_slab_rests_on_its_true_face() {
+    // On the grid the tip's centre rests (1 - SURFACE_CAP) x its radius above the true top face (y = 0),
+    // wherever the packing's spheres are.
+    let rest = (1.0 - SURFACE_CAP) * TIP;
+    let mut rig = rig(vec![key(0.0, 0.003, 0.01), key(1.0, 0.003, -0.003)]);
+    let (v, t) = collette::shape::box_buffers(Vec3::new(0.05, 0.01, 0.05));
+    let grid = collette::SignedDistanceGrid::new(&collette::TriMesh::new(v, t).expect("box"), 64).expect("grid");
+    rig.set_surface(1, Some(std::sync::Arc::new(grid))).expect("grid");
+    for i in 0..2500u64 {
+        rig.tick(i * 1000);
+    }
+    let t = rig.telemetry();
+    assert!((t.tool_pose.translation.y - rest).abs() < 5e-5, "the proxy on the true face: {:?}", t.tool_pose);
+    let depth = rest - t.device.pose.translation.y;
+    assert!((t.output.force.y - K * depth).abs() < 0.05, "F = k d: {} N at {depth} m", t.output.force.y);
+    assert!(t.objects().first().is_some_and(|c| c.touching && c.id == 1), "the slab is touched: {:?}", t.objects());
+}
