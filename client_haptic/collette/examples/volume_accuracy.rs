@@ -19,7 +19,6 @@
 //! signed distance grid (`overlap_field`, the grid as fine as B's packing grid).
 
 use clap::Parser;
-use collette::packing::to_parry_oriented;
 use collette::scene::{SphereCounts, brilliant_cut, default_bunny_path, load_bunny};
 use collette::shape::{box_buffers, torus_buffers, uv_sphere_buffers};
 use collette::{
@@ -27,7 +26,6 @@ use collette::{
     overlap_volume,
 };
 use glam::{Quat, Vec3};
-use parry3d::query::PointQuery;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -73,63 +71,22 @@ fn mesh(name: &str) -> Result<TriMesh, String> {
     }
 }
 
-/// A mesh that answers "is this point inside?" exactly, quickly away from its surface.
-struct Solid {
-    parry: parry3d::shape::TriMesh,
-    volume: f64,
-    origin: Vec3,
-    h: f32,
-    dims: [usize; 3],
-    /// Per voxel: 1 surely inside, -1 surely outside, 0 ask parry.
-    sure: Vec<i8>,
-}
+/// A mesh's inside (collette's exact reference), and stratified points in it.
+struct Solid(collette::shape::Solid);
 
 impl Solid {
     fn new(mesh: &TriMesh) -> Self {
-        let parry = to_parry_oriented(mesh);
-        let aabb = mesh.aabb();
-        let h = aabb.extents().max_element() / 96.0;
-        let origin = aabb.min - Vec3::splat(h);
-        let dims = [0, 1, 2].map(|a| ((aabb.extents()[a] + 2.0 * h) / h).ceil() as usize);
-        let half_diagonal = h * 3f32.sqrt() * 0.5;
-        let sure = (0..dims[0] * dims[1] * dims[2])
-            .into_par_iter()
-            .map(|i| {
-                let (x, y, z) = (i % dims[0], (i / dims[0]) % dims[1], i / (dims[0] * dims[1]));
-                let c = origin + (Vec3::new(x as f32, y as f32, z as f32) + 0.5) * h;
-                let q = parry3d::math::Vector::new(c.x, c.y, c.z);
-                let proj = parry.project_local_point(q, false);
-                let far = (proj.point - q).length() > half_diagonal * 1.01;
-                match (far, proj.is_inside) {
-                    (true, true) => 1,
-                    (true, false) => -1,
-                    _ => 0,
-                }
-            })
-            .collect();
-        Self { parry, volume: mesh.volume() as f64, origin, h, dims, sure }
+        Self(collette::shape::Solid::new(mesh, 96))
     }
 
     fn contains(&self, p: Vec3) -> bool {
-        let g = (p - self.origin) / self.h;
-        if g.min_element() < 0.0 {
-            return false;
-        }
-        let (x, y, z) = (g.x as usize, g.y as usize, g.z as usize);
-        if x >= self.dims[0] || y >= self.dims[1] || z >= self.dims[2] {
-            return false;
-        }
-        match self.sure[x + self.dims[0] * (y + self.dims[1] * z)] {
-            1 => true,
-            -1 => false,
-            _ => self.parry.contains_local_point(parry3d::math::Vector::new(p.x, p.y, p.z)),
-        }
+        self.0.contains(p)
     }
 
     /// About `n` stratified points inside the mesh: one jittered point per cell of a grid over its box.
     fn samples(&self, mesh: &TriMesh, n: usize, rng: &mut ChaCha8Rng) -> Vec<Vec3> {
         let aabb = mesh.aabb();
-        let cell = (self.volume / n as f64).cbrt() as f32;
+        let cell = (self.0.volume() / n as f64).cbrt() as f32;
         let cells = [0, 1, 2].map(|a| (aabb.extents()[a] / cell).ceil().max(1.0) as usize);
         let mut candidates = Vec::with_capacity(cells.iter().product());
         for z in 0..cells[2] {
@@ -176,7 +133,7 @@ fn run(args: &Args) -> Result<(), String> {
         let started = Instant::now();
         let (sa, sb) = (Solid::new(&ma), Solid::new(&mb));
         let pool = sa.samples(&ma, args.samples, &mut rng);
-        let smaller = sa.volume.min(sb.volume);
+        let smaller = sa.0.volume().min(sb.0.volume());
         let b_box = mb.aabb();
         let mut poses = Vec::with_capacity(args.poses);
         let mut attempts = 0;
@@ -185,7 +142,7 @@ fn run(args: &Args) -> Result<(), String> {
             let t = Vec3::new(rng.random(), rng.random(), rng.random());
             let pose = Pose { rotation: random_rotation(&mut rng), translation: b_box.min + t * b_box.extents() };
             let hits = pool.par_iter().filter(|&&p| sb.contains(pose.transform_point(p))).count();
-            let exact = sa.volume * hits as f64 / pool.len() as f64;
+            let exact = sa.0.volume() * hits as f64 / pool.len() as f64;
             if exact >= args.min_overlap * smaller {
                 poses.push((pose, exact));
             }

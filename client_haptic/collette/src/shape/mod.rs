@@ -6,10 +6,12 @@
 mod distance_grid;
 mod mesh;
 mod primitives;
+mod solid;
 mod sphere;
 
 pub use distance_grid::SignedDistanceGrid;
 pub use mesh::TriMesh;
 pub use primitives::{box_buffers, torus_buffers, uv_sphere_buffers};
+pub use solid::Solid;
 pub use sphere::{Lens, Sphere, lens, lens_volume, sphere_volume};
 pub(crate) use sphere::{Lens4, cap_moment, cap_volume, lens_x4};

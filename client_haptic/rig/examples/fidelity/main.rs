@@ -11,7 +11,10 @@
 //! point of the surface, held on the object's packing or on its surface grid. Scenes: a sphere, a box's edge, a box's corner and a cylinder on its side
 //! pressed into a slab, a sphere into a sphere; the proxy's tip into the slab, the sphere and the box
 //! (faces, edges and corners), at depths from 0.1 to 5 mm (one pose in ten 5–10 mm), random places and
-//! turns about the normal. Meshes with a Monte Carlo reference are the next step (docs/haptics.md).
+//! turns about the normal. Mesh pairs (a 1 cm gem on the bunny and on a torus, a ring on the bunny) at
+//! random surface points and turns, 1–10 mm deep, against a Monte Carlo reference ([`meshes`]).
+
+mod meshes;
 
 use std::f32::consts::PI;
 use std::sync::Arc;
@@ -37,6 +40,12 @@ struct Args {
     /// Voxels along the longest side of the objects' surface grids.
     #[arg(long, default_value_t = 128)]
     grid: usize,
+    /// Poses per mesh scene (each with a Monte Carlo reference of `--samples` points).
+    #[arg(long, default_value_t = 200)]
+    mesh_poses: usize,
+    /// Monte Carlo points per mesh pose, in the box the overlap can occupy.
+    #[arg(long, default_value_t = 1_000_000)]
+    samples: usize,
     /// Seed of the poses.
     #[arg(long, default_value_t = 1)]
     seed: u32,
@@ -63,9 +72,12 @@ struct Shape {
 }
 
 fn shape(buffers: (Vec<Vec3>, Vec<[u32; 3]>), args: &Args) -> anyhow::Result<Shape> {
-    let mesh = TriMesh::new(buffers.0, buffers.1)?;
-    let (tree, _) = collette::build(&mesh, &BuildOptions::spheres(args.spheres), &mut |_| {})?;
-    let grid = SignedDistanceGrid::new(&mesh, args.grid)?;
+    shape_of(&TriMesh::new(buffers.0, buffers.1)?, args)
+}
+
+fn shape_of(mesh: &TriMesh, args: &Args) -> anyhow::Result<Shape> {
+    let (tree, _) = collette::build(mesh, &BuildOptions::spheres(args.spheres), &mut |_| {})?;
+    let grid = SignedDistanceGrid::new(mesh, args.grid)?;
     Ok(Shape { tree: Arc::new(tree), grid })
 }
 
@@ -326,6 +338,7 @@ fn proxy(
 
 fn run(args: Args) -> anyhow::Result<()> {
     anyhow::ensure!(args.poses > 0, "--poses must be at least 1");
+    anyhow::ensure!(args.samples >= 1000, "--samples must be at least 1000");
     let started = std::time::Instant::now();
     let sphere = shape(uv_sphere_buffers(SPHERE_R, 48, 96), &args)?;
     let ball = shape(uv_sphere_buffers(BALL_R, 48, 96), &args)?;
@@ -384,6 +397,69 @@ fn run(args: Args) -> anyhow::Result<()> {
         all_grid.add(grid);
     }
 
+    // Mesh pairs against the Monte Carlo reference: depths 1–10 mm (shallower overlaps of a pointed
+    // tool are too few points for the reference; the primitives cover them).
+    let mesh_started = std::time::Instant::now();
+    let mut mesh_dice = Dice(ChaCha8Rng::seed_from_u64(args.seed as u64 + 2));
+    let surface_samples = 1_000_000;
+    let gem_mesh = collette::scene::brilliant_cut(0.01);
+    let bunny_mesh = collette::scene::load_bunny(collette::scene::default_bunny_path())?;
+    let closed = |(v, t): (Vec<Vec3>, Vec<[u32; 3]>)| TriMesh::new(v, t);
+    let torus_mesh = closed(collette::shape::torus_buffers(0.03, 0.01, 96, 48))?;
+    let ring_mesh = closed(collette::shape::torus_buffers(0.01, 0.004, 64, 32))?;
+    let mut mesh_shape = |mesh: TriMesh, voxels: usize| -> anyhow::Result<meshes::MeshShape> {
+        let shape = shape_of(&mesh, &args)?;
+        Ok(meshes::MeshShape::new(mesh, shape, voxels, surface_samples, &mut mesh_dice))
+    };
+    let gem = mesh_shape(gem_mesh, 128)?;
+    let ring = mesh_shape(ring_mesh, 128)?;
+    let bunny = mesh_shape(bunny_mesh, 256)?;
+    let torus = mesh_shape(torus_mesh, 256)?;
+    eprintln!("fidelity: mesh scenes built in {:.1} s", mesh_started.elapsed().as_secs_f32());
+    let mesh_scenes: [(&str, &meshes::MeshShape, &meshes::MeshShape); 3] =
+        [("gem on bunny", &gem, &bunny), ("gem on torus", &gem, &torus), ("ring on bunny", &ring, &bunny)];
+    let mut skipped = 0;
+    for (name, tool, object) in mesh_scenes {
+        let (mut trees, mut grid) = (Errors::default(), Errors::default());
+        let (mut ws, mut set) = (QueryWorkspace::new(), ContactSet::new());
+        let mut kept = 0;
+        while kept < args.mesh_poses && kept + skipped < 20 * args.mesh_poses {
+            let depth = if mesh_dice.roll() < 0.1 {
+                0.005 + 0.005 * mesh_dice.roll()
+            } else {
+                1e-3 * 5f32.powf(mesh_dice.roll())
+            };
+            let turn = Quat::from_scaled_axis(mesh_dice.unit() * (mesh_dice.roll() * PI));
+            let at = object.surface_point(&mut mesh_dice);
+            let Some((pose, exact)) = meshes::press(tool, object, turn, at, depth, args.samples, &mut mesh_dice) else {
+                skipped += 1;
+                continue;
+            };
+            let here = Pose::IDENTITY;
+            collette::overlap(&tool.shape.tree, &pose, &object.shape.tree, &here, &mut ws, &mut set);
+            judge(&set, &pose, &exact, depth, &mut trees);
+            collette::overlap_field(
+                &tool.shape.tree,
+                &pose,
+                &object.shape.tree,
+                &object.shape.grid,
+                &here,
+                &mut ws,
+                &mut set,
+            );
+            judge(&set, &pose, &exact, depth, &mut grid);
+            kept += 1;
+        }
+        table.push((name.to_string(), "volumetric, two trees", quantiles(&trees)));
+        table.push((name.to_string(), "volumetric, tree against grid", quantiles(&grid)));
+        all_trees.add(trees);
+        all_grid.add(grid);
+    }
+    eprintln!(
+        "fidelity: mesh scenes judged in {:.1} s ({skipped} poses with no overlap or one out of reach skipped)",
+        mesh_started.elapsed().as_secs_f32()
+    );
+
     // The proxy: the tip pressed into the slab, the ball and the cube, on their packings and on their
     // grids (the same poses for both).
     let (mut proxy_errors, mut proxy_grid_errors) = (Errors::default(), Errors::default());
@@ -441,8 +517,11 @@ fn run(args: Args) -> anyhow::Result<()> {
         }
     }
     println!(
-        "fidelity: {} poses a scene, trees of {} spheres, grids of {} voxels, in {:.1} s",
+        "fidelity: {} poses a primitive scene, {} a mesh scene ({} Monte Carlo points each), trees of {} spheres, \
+         grids of {} voxels, in {:.1} s",
         args.poses,
+        args.mesh_poses,
+        args.samples,
         args.spheres,
         args.grid,
         started.elapsed().as_secs_f32()
