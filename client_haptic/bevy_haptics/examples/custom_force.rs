@@ -31,10 +31,7 @@ fn main() {
     if run.headless {
         app.add_systems(Update, press);
     } else {
-        app.add_systems(Startup, |mut commands: Commands| {
-            support::camera(&mut commands, Vec3::new(0.1, 0.08, 0.15), Vec3::ZERO)
-        })
-        .add_systems(Update, (support::keyboard_hand, support::mouse_hand, support::show_tool));
+        support::windowed(&mut app, Vec3::new(0.1, 0.08, 0.15), Vec3::ZERO);
     }
     app.add_observer(|c: On<ContactStarted>| info!("the tool reached the floor ({} sphere pairs)", c.contact.pairs));
     app.run();

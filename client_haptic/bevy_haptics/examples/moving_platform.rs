@@ -8,7 +8,7 @@ mod support;
 
 use bevy::prelude::*;
 use bevy_haptics::prelude::*;
-use support::{Figures, Run};
+use support::{Figures, Paint, Run};
 
 /// Where the simulated hand rests, device frame, m.
 const START: Vec3 = Vec3::new(0.0, 0.03, 0.0);
@@ -30,35 +30,22 @@ fn main() {
     if run.headless {
         app.add_systems(Update, lower);
     } else {
-        app.add_systems(Startup, |mut commands: Commands| {
-            support::camera(&mut commands, Vec3::new(0.1, 0.08, 0.15), Vec3::ZERO)
-        })
-        .add_systems(Update, (support::keyboard_hand, support::mouse_hand, support::show_tool));
+        support::windowed(&mut app, Vec3::new(0.1, 0.08, 0.15), Vec3::ZERO);
     }
     app.run();
 }
 
-/// The scene (materials only with a window: a headless app has no renderer).
-fn setup(
-    mut commands: Commands,
-    mut meshes: ResMut<Assets<Mesh>>,
-    mut materials: Option<ResMut<Assets<StandardMaterial>>>,
-) {
-    let mut paint = |color: Color| {
-        materials.as_mut().map(|m| MeshMaterial3d(m.add(StandardMaterial { base_color: color, ..default() })))
-    };
+fn setup(mut commands: Commands, mut meshes: ResMut<Assets<Mesh>>) {
     commands.spawn(HapticTool::ball(0.004));
     // A 10 x 2 x 6 cm platform whose top is at y = 0; its tree built from the mesh.
-    let mut spawned = commands.spawn((
+    commands.spawn((
         Platform,
         Mesh3d(meshes.add(Cuboid::new(0.1, 0.02, 0.06))),
         SphereTreeFromMesh { spheres: 1500 },
         ForceComponent { stiffness_n_per_m3: 3e7, ..default() },
         Transform::from_xyz(0.0, -0.01, 0.0),
+        Paint(Color::srgb(0.3, 0.5, 0.7)),
     ));
-    if let Some(look) = paint(Color::srgb(0.3, 0.5, 0.7)) {
-        spawned.insert(look);
-    }
 }
 
 /// The game moves the platform: a sine along x, once a frame.

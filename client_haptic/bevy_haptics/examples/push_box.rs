@@ -12,7 +12,7 @@ mod support;
 use avian3d::prelude::*;
 use bevy::prelude::*;
 use bevy_haptics::prelude::*;
-use support::{Figures, Run};
+use support::{Figures, Paint, Run};
 
 /// Where the simulated hand starts, device frame = world, m: left of the box, at its half height.
 const START: Vec3 = Vec3::new(-0.06, 0.02, 0.0);
@@ -34,37 +34,24 @@ fn main() {
     if run.headless {
         app.add_systems(Update, push);
     } else {
-        app.add_systems(Startup, |mut commands: Commands| {
-            support::camera(&mut commands, Vec3::new(0.05, 0.12, 0.2), Vec3::ZERO)
-        })
-        .add_systems(Update, (support::keyboard_hand, support::mouse_hand, support::show_tool));
+        support::windowed(&mut app, Vec3::new(0.05, 0.12, 0.2), Vec3::ZERO);
     }
     app.run();
 }
 
-/// The scene (materials only with a window: a headless app has no renderer).
-fn setup(
-    mut commands: Commands,
-    mut meshes: ResMut<Assets<Mesh>>,
-    mut materials: Option<ResMut<Assets<StandardMaterial>>>,
-) {
-    let mut paint = |color: Color| {
-        materials.as_mut().map(|m| MeshMaterial3d(m.add(StandardMaterial { base_color: color, ..default() })))
-    };
+fn setup(mut commands: Commands, mut meshes: ResMut<Assets<Mesh>>) {
     commands.spawn(HapticTool::ball(0.005));
     // The table: avian's alone (the tool never reaches it).
-    let mut spawned = commands.spawn((
+    commands.spawn((
         RigidBody::Static,
         Collider::cuboid(0.4, 0.02, 0.4),
         Mesh3d(meshes.add(Cuboid::new(0.4, 0.02, 0.4))),
         Transform::from_xyz(0.0, -0.01, 0.0),
+        Paint(Color::srgb(0.5, 0.35, 0.2)),
     ));
-    if let Some(look) = paint(Color::srgb(0.5, 0.35, 0.2)) {
-        spawned.insert(look);
-    }
     // The box: avian's body and collider, and the haptic copy of the same mass with its tree built from
     // the same mesh.
-    let mut spawned = commands.spawn((
+    commands.spawn((
         PushedBox,
         RigidBody::Dynamic,
         Collider::cuboid(SIDE_M, SIDE_M, SIDE_M),
@@ -75,10 +62,8 @@ fn setup(
         HapticPushable::new(MASS_KG),
         ForceComponent { stiffness_n_per_m3: 3e8, ..default() },
         Transform::from_xyz(0.0, SIDE_M / 2.0, 0.0),
+        Paint(Color::srgb(0.8, 0.2, 0.2)),
     ));
-    if let Some(look) = paint(Color::srgb(0.8, 0.2, 0.2)) {
-        spawned.insert(look);
-    }
 }
 
 /// Along +x through where the box stands, then back (headless).

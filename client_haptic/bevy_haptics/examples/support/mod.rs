@@ -75,11 +75,34 @@ impl Run {
             let render = bevy::render::RenderPlugin { synchronous_pipeline_compilation: true, ..default() };
             app.add_plugins((DefaultPlugins.set(assets).set(render), bevy_haptics::HapticsDebugPlugin))
                 .insert_resource(bevy_haptics::HapticsDebugConfig { tree_depth: None, ..default() })
-                .add_systems(Update, (screenshot, toggle_trees));
+                .add_systems(Update, (screenshot, toggle_trees, paint));
         }
         app.insert_resource(self).init_resource::<Figures>().add_systems(Startup, realtime).add_systems(Update, end);
         app
     }
+}
+
+/// The colour an entity is drawn in (with a window; a headless app has no renderer to draw it).
+#[derive(Component, Clone, Copy)]
+pub struct Paint(pub Color);
+
+/// Gives each newly painted entity its material (windowed).
+fn paint(
+    mut commands: Commands,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+    painted: Query<(Entity, &Paint), Added<Paint>>,
+) {
+    for (entity, Paint(color)) in &painted {
+        let look = materials.add(StandardMaterial { base_color: *color, ..default() });
+        commands.entity(entity).insert(MeshMaterial3d(look));
+    }
+}
+
+/// With a window: a camera looking at `target` from `eye`, the hand moved by the keyboard and the
+/// mouse, the tool drawn as a ball.
+pub fn windowed(app: &mut App, eye: Vec3, target: Vec3) {
+    app.add_systems(Startup, move |mut commands: Commands| camera(&mut commands, eye, target))
+        .add_systems(Update, (keyboard_hand, mouse_hand, show_tool));
 }
 
 /// An example's own figures, added to its JSON line (e.g. how far a pushed box moved).
