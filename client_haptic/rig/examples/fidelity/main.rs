@@ -456,7 +456,8 @@ fn run(args: Args) -> anyhow::Result<()> {
         all_grid.add(grid);
     }
     eprintln!(
-        "fidelity: mesh scenes judged in {:.1} s ({skipped} poses with no overlap or one out of reach skipped)",
+        "fidelity: mesh scenes judged in {:.1} s ({skipped} poses skipped: no overlap, one out of reach, or the \
+         tool sunk whole)",
         mesh_started.elapsed().as_secs_f32()
     );
 

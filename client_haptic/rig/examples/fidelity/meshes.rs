@@ -69,7 +69,7 @@ impl MeshShape {
 
 /// The tool (`tool`) turned by `turn` and pressed `depth` into `object` at its surface point `p` with
 /// outward normal `n`: its deepest point along −n lies `depth` under the tangent plane at `p`. The
-/// pose, and the Monte Carlo reference (None when the overlap is empty).
+/// pose, and the Monte Carlo reference (None when the overlap is empty, or the tool is sunk whole).
 pub fn press(
     tool: &MeshShape,
     object: &MeshShape,
@@ -180,7 +180,9 @@ fn reference(
         .map(|(_, normal)| *normal * share)
         .reduce(|| Vec3::ZERO, |a, b| a + b);
     let normal = (-pull).normalize_or_zero();
-    if normal == Vec3::ZERO {
+    // A tool inside the object all but a sliver has no way out that shrinks the overlap: its outward
+    // normals sum to nothing, and no force direction is right or wrong.
+    if normal == Vec3::ZERO || volume as f64 >= 0.95 * tool.solid.volume() {
         return Reach::Empty;
     }
     Reach::Inside(Exact { volume, normal, centroid })
