@@ -1,14 +1,14 @@
 //! An object the game moves: a platform sliding back and forth under the tool at 60 frames a second.
 //! Its `Transform` is all the game changes; each frame's pose reaches the haptic threads with its time,
 //! and they move the platform smoothly between frames (1 kHz) and feel its speed, so resting on it feels
-//! like riding it, not a step each frame. `-- --headless --seconds 4` lowers the simulated hand onto
+//! like riding it, not a step each frame. `-- --headless --seconds 5` lowers the simulated hand onto
 //! the platform and holds it there while it slides.
 
 mod support;
 
 use bevy::prelude::*;
 use bevy_haptics::prelude::*;
-use support::{Figures, Paint, Run};
+use support::{Figures, Paint, Run, colliders_ready};
 
 /// Where the simulated hand rests, device frame, m.
 const START: Vec3 = Vec3::new(0.0, 0.03, 0.0);
@@ -62,10 +62,16 @@ fn ride(mut ongoing: MessageReader<ContactOngoing>, mut figures: ResMut<Figures>
     figures.0.insert("frames_on_platform".into(), (*frames).into());
 }
 
-/// Down onto the platform and held there (headless).
-fn lower(time: Res<Time<Real>>, hand: Option<ResMut<SimulatedHand>>, mut done: Local<bool>) {
+/// Down onto the platform and held there (headless), once its tree is built.
+fn lower(
+    hand: Option<ResMut<SimulatedHand>>,
+    trees: Res<Assets<SphereTree>>,
+    colliders: Query<&HapticCollider>,
+    building: Query<(), With<SphereTreeFromMesh>>,
+    mut done: Local<bool>,
+) {
     let Some(mut hand) = hand else { return };
-    if !*done && support::elapsed(&time) > 0.5 {
+    if !*done && colliders_ready(&trees, &colliders, &building) {
         hand.move_to(Vec3::new(0.0, -0.004, 0.0), 0.5);
         *done = true;
     }

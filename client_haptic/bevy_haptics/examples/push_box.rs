@@ -2,7 +2,7 @@
 //! `HapticPushable` of the same mass. The tool moves it on the haptic thread at once (the hand feels
 //! its 200 g and the table's friction, not a wall), and each frame the impulses go to avian's body
 //! (the `avian3d` feature), whose moves come back to the threads as any moved collider's.
-//! `-- --headless --seconds 4` pushes it 6 cm along +x with the simulated hand and prints how far it
+//! `-- --headless --seconds 5` pushes it 6 cm along +x with the simulated hand and prints how far it
 //! went.
 //!
 //! `cargo run -p bevy_haptics --features avian3d --example push_box`
@@ -12,7 +12,7 @@ mod support;
 use avian3d::prelude::*;
 use bevy::prelude::*;
 use bevy_haptics::prelude::*;
-use support::{Figures, Paint, Run};
+use support::{Figures, Paint, Run, colliders_ready};
 
 /// Where the simulated hand starts, device frame = world, m: left of the box, at its half height.
 const START: Vec3 = Vec3::new(-0.06, 0.02, 0.0);
@@ -66,13 +66,25 @@ fn setup(mut commands: Commands, mut meshes: ResMut<Assets<Mesh>>) {
     ));
 }
 
-/// Along +x through where the box stands, then back (headless).
-fn push(time: Res<Time<Real>>, hand: Option<ResMut<SimulatedHand>>, mut step: Local<u32>) {
+/// Along +x through where the box stands, then back (headless), once the box's tree is built.
+fn push(
+    time: Res<Time<Real>>,
+    hand: Option<ResMut<SimulatedHand>>,
+    trees: Res<Assets<SphereTree>>,
+    colliders: Query<&HapticCollider>,
+    building: Query<(), With<SphereTreeFromMesh>>,
+    mut start: Local<Option<f32>>,
+    mut step: Local<u32>,
+) {
     let Some(mut hand) = hand else { return };
-    let t = support::elapsed(&time);
+    let now = support::elapsed(&time);
+    if start.is_none() && colliders_ready(&trees, &colliders, &building) {
+        *start = Some(now);
+    }
+    let Some(t) = start.map(|s| now - s) else { return };
     match *step {
-        0 if t > 0.8 => hand.move_to(Vec3::new(0.04, START.y, 0.0), 1.5),
-        1 if t > 2.6 => hand.move_to(START, 0.8),
+        0 if t > 0.5 => hand.move_to(Vec3::new(0.04, START.y, 0.0), 1.5),
+        1 if t > 2.3 => hand.move_to(START, 0.8),
         _ => return,
     }
     *step += 1;

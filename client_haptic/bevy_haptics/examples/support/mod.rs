@@ -105,6 +105,17 @@ pub fn windowed(app: &mut App, eye: Vec3, target: Vec3) {
         .add_systems(Update, (keyboard_hand, mouse_hand, show_tool));
 }
 
+/// Whether every collider's sphere tree is built (a `SphereTreeFromMesh` builds it on the async pool,
+/// in a few tenths of a second): a scripted hand waits for it, so that it never reaches an object that
+/// is not there yet on a slow machine.
+pub fn colliders_ready(
+    trees: &Assets<SphereTree>,
+    colliders: &Query<&HapticCollider>,
+    building: &Query<(), With<SphereTreeFromMesh>>,
+) -> bool {
+    building.is_empty() && colliders.iter().all(|c| trees.contains(&c.tree))
+}
+
 /// An example's own figures, added to its JSON line (e.g. how far a pushed box moved).
 #[derive(Resource, Default)]
 pub struct Figures(pub serde_json::Map<String, serde_json::Value>);
