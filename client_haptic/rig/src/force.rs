@@ -202,7 +202,7 @@ impl WatchedObject {
 
     /// Its pose (scene frame) for a motion of its centre of mass.
     fn pose_of(&self, motion: &BodyMotion) -> Pose {
-        Pose::new(motion.center_of_mass - motion.orientation * self.center_of_mass, motion.orientation)
+        crate::push::pose_of(motion, self.center_of_mass)
     }
 }
 
@@ -213,29 +213,52 @@ pub(crate) enum Returned {
     Surface(Arc<SignedDistanceGrid>),
 }
 
-/// The surface grids of the objects near the proxy's tip, each at its pose: the tip's overlap with
-/// them, as with a flat face at the signed distance the grid gives (`forcecomp::half_space_overlap`).
+/// An object's surface grid at its pose (scene frame), as the 3-DOF proxy feels it: the tip's overlap
+/// with a flat face at the signed distance the grid gives (`forcecomp::half_space_overlap`).
+#[derive(Clone, Copy)]
+pub struct GridAt<'a> {
+    /// The grid, in the object's frame.
+    pub grid: &'a SignedDistanceGrid,
+    /// The object's pose.
+    pub pose: Pose,
+}
+
+impl GridAt<'_> {
+    /// How deep `p` (scene frame) is inside the object, and the unit normal into it (scene frame).
+    pub fn depth(&self, p: Vec3) -> (f32, Vec3) {
+        let local = self.pose.rotation.inverse() * (p - self.pose.translation);
+        let (depth, inward) = self.grid.distance_and_gradient(local);
+        (depth, self.pose.rotation * inward.normalize_or_zero())
+    }
+}
+
+impl forcecomp::TipField for GridAt<'_> {
+    fn overlap_and_gradient(&self, p: Vec3, tip_radius: f32) -> (f32, Vec3) {
+        let (depth, inward) = self.depth(p);
+        forcecomp::half_space_overlap(tip_radius, depth, inward)
+    }
+}
+
+/// The surface grids of the objects near the proxy's tip, each at its pose: their overlaps add up.
 struct GridSurfaces<'a> {
     objects: &'a [Option<Box<WatchedObject>>],
     near: &'a [(u32, Pose)],
 }
 
 impl GridSurfaces<'_> {
-    /// Each grid near the tip with the depth of `p` inside it and the inward normal (scene frame).
-    fn depths(&self, p: Vec3) -> impl Iterator<Item = (u32, f32, Vec3)> + '_ {
+    /// Each grid near the tip with its object's slot.
+    fn grids(&self) -> impl Iterator<Item = (u32, GridAt<'_>)> + '_ {
         self.near.iter().filter_map(move |&(slot, pose)| {
-            let grid = self.objects.get(slot as usize)?.as_ref()?.surface.as_ref()?;
-            let local = pose.rotation.inverse() * (p - pose.translation);
-            let (depth, inward) = grid.distance_and_gradient(local);
-            Some((slot, depth, pose.rotation * inward.normalize_or_zero()))
+            let grid = self.objects.get(slot as usize)?.as_ref()?.surface.as_deref()?;
+            Some((slot, GridAt { grid, pose }))
         })
     }
 }
 
 impl forcecomp::TipField for GridSurfaces<'_> {
     fn overlap_and_gradient(&self, p: Vec3, tip_radius: f32) -> (f32, Vec3) {
-        self.depths(p).fold((0.0, Vec3::ZERO), |(v, g), (_, depth, inward)| {
-            let (dv, dg) = forcecomp::half_space_overlap(tip_radius, depth, inward);
+        self.grids().fold((0.0, Vec3::ZERO), |(v, g), (_, grid)| {
+            let (dv, dg) = grid.overlap_and_gradient(p, tip_radius);
             (v + dv, g + dg)
         })
     }
@@ -405,7 +428,7 @@ impl ForceStage {
     /// Moves every pushed object's haptic body one tick and hands its impulses to the game.
     fn step_pushed(&mut self, now_us: u64, dt_s: f32) {
         let coupling = self.push_coupling;
-        for object in self.objects.iter_mut().flatten() {
+        for object in self.objects.iter_mut().flatten().filter(|o| o.pushed.is_some()) {
             let game = object.motion_at(now_us);
             let Some(body) = &mut object.pushed else { continue };
             body.step(game, &coupling, dt_s, now_us);
@@ -522,7 +545,8 @@ impl ForceStage {
             .enumerate()
             .map(|(i, b)| (b.center.distance(near) - b.radius, self.ball_objects[i]))
             .min_by(|a, b| a.0.total_cmp(&b.0));
-        let nearest_grid = grids.depths(near).map(|(slot, depth, _)| (-depth, slot)).min_by(|a, b| a.0.total_cmp(&b.0));
+        let nearest_grid =
+            grids.grids().map(|(slot, grid)| (-grid.depth(near).0, slot)).min_by(|a, b| a.0.total_cmp(&b.0));
         let nearest_slot = match (nearest_ball, nearest_grid) {
             (Some(b), Some(g)) => Some(if g.0 <= b.0 { g.1 } else { b.1 }),
             (b, g) => b.or(g).map(|n| n.1),

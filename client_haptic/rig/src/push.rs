@@ -113,15 +113,16 @@ pub(crate) struct PushedBody {
 }
 
 impl PushedBody {
-    /// A body of `mass_kg` at uniform density over `tree`'s inner spheres, at `pose`.
+    /// A body of `mass_kg` at uniform density over `tree`'s inner spheres (whose centre of mass, in the
+    /// tree's frame, is `center_of_mass`), at `pose`.
     pub(crate) fn new(
         tree: &collette::InnerSphereTree,
+        center_of_mass: Vec3,
         mass_kg: f32,
         pose: Pose,
         writer: collette::pipeline::PoseWriter,
         id: u32,
     ) -> Self {
-        let center_of_mass = crate::spec::center_of_mass(tree);
         let inertia = inertia_of(tree, center_of_mass, mass_kg);
         let inverse_inertia = if inertia.determinant() > 0.0 { inertia.inverse() } else { Mat3::ZERO };
         let state =
@@ -199,9 +200,7 @@ impl PushedBody {
                 && torque == Vec3::ZERO;
             self.active = !in_step;
         }
-        let pose =
-            Pose::new(self.state.center_of_mass - self.state.orientation * self.center_of_mass, self.state.orientation);
-        self.writer.set(pose, now_us);
+        self.writer.set(pose_of(&self.state, self.center_of_mass), now_us);
     }
 
     /// The impulses kept for the game, if any; cleared once `handed` says they went.
@@ -211,6 +210,12 @@ impl PushedBody {
             self.pending = ObjectPush { id: p.id, ..Default::default() };
         }
     }
+}
+
+/// The pose (scene frame) of a body whose centre of mass, at `center_of_mass` in its own frame, moves
+/// as `motion` says.
+pub(crate) fn pose_of(motion: &BodyMotion, center_of_mass: Vec3) -> Pose {
+    Pose::new(motion.center_of_mass - motion.orientation * center_of_mass, motion.orientation)
 }
 
 /// Inertia about `center` in the tree's frame of a body of `mass_kg` spread over its inner spheres in

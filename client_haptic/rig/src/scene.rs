@@ -115,7 +115,7 @@ impl Scene {
         let object_id = pose.id();
         // A pushed object's pose is written by the haptic thread, which moves it.
         let (pose, pushed) = match pushed_kg {
-            Some(mass_kg) => (None, Some(PushedBody::new(&spec.tree, mass_kg, spec.pose, pose, spec.id))),
+            Some(mass_kg) => (None, Some(PushedBody::new(&spec.tree, local_center, mass_kg, spec.pose, pose, spec.id))),
             None => (Some(pose), None),
         };
         let object = Box::new(WatchedObject {

@@ -278,21 +278,6 @@ fn volumetric(
     (trees, grid)
 }
 
-/// An object's surface grid at its pose, as the proxy feels it (what the rig does for a grid-backed
-/// object).
-struct GridField<'a> {
-    grid: &'a SignedDistanceGrid,
-    pose: Pose,
-}
-
-impl forcecomp::TipField for GridField<'_> {
-    fn overlap_and_gradient(&self, p: Vec3, tip_radius: f32) -> (f32, Vec3) {
-        let local = self.pose.rotation.inverse() * (p - self.pose.translation);
-        let (depth, inward) = self.grid.distance_and_gradient(local);
-        forcecomp::half_space_overlap(tip_radius, depth, self.pose.rotation * inward.normalize_or_zero())
-    }
-}
-
 /// The 3-DOF proxy's tip (radius 4 mm, as the rig's default) pressed from `outside` to `inside`, held
 /// on the object's packing or (`on_grid`) its surface grid; its contact point (the proxy less its
 /// hold-off along the normal) against `surface`, the exact closest point of the object's surface to
@@ -315,7 +300,7 @@ fn proxy(
             balls.push(Ball { center, radius })
         });
     }
-    let field = GridField { grid: &object.grid, pose: *object_pose };
+    let field = haptic_rig::force::GridAt { grid: &object.grid, pose: *object_pose };
     let mut god = GodObject::new();
     let mut press = |at: Vec3| match on_grid {
         true => god.update_with(&config, at, Vec3::ZERO, &balls, &field, 1.0),
