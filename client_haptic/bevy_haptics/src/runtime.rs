@@ -188,8 +188,9 @@ fn try_start(world: &mut World) -> Result<HapticStatus, String> {
     };
     let rate_hz = haptic.rate_hz;
     let collision = world.get_resource::<CollisionSettings>().cloned();
-    let rendering = world.get_resource::<ForceRendering>().map(|r| r.resolve(&specs));
-    let pushes = world.get_resource::<ForceRendering>().map(|r| r.pushes).unwrap_or_default();
+    let force = world.get_resource::<ForceRendering>().copied();
+    let rendering = force.map(|r| r.resolve(&specs));
+    let pushes = force.map(|r| r.pushes).unwrap_or_default();
     let clock = HapticClock::new();
     let (engine, rendering, clock) = match collision {
         None => {
@@ -587,7 +588,8 @@ pub(crate) fn report_pair_contacts(
 pub(crate) fn move_colliders(mut threads: Threads, moved: Query<(Entity, &GlobalTransform), ColliderMoved>) {
     let Some((runtime, watched)) = threads.get() else { return };
     for (entity, transform) in &moved {
-        let Some(&id) = watched.ids.get(&entity) else { continue };
+        // Only colliders on the threads (one refused for its mass has an id but is not there).
+        let Some(&id) = watched.ids.get(&entity).filter(|id| watched.entities.contains_key(id)) else { continue };
         let sent = runtime.rig(|rig| rig.set_object_pose_at(id, pose_of(transform), rig.clock().now_us()));
         if let Some(Err(e)) = sent {
             warn!("moving {entity} on the collision thread: {e}");
