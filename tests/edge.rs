@@ -34,7 +34,7 @@ fn crafted_datagrams_from_every_kind_of_address_leave_a_real_heist_running() {
     // A malicious Vive connects and is admitted: its address is a connected one.
     for _ in 0..10 * HZ {
         intruder.pump();
-        server.app.update();
+        server.update();
         if server.game().is_present(Role::Vive) && intruder.netcode.is_connected() {
             break;
         }
@@ -46,15 +46,15 @@ fn crafted_datagrams_from_every_kind_of_address_leave_a_real_heist_running() {
     intruder.send_sealed(&renet_slice(RELIABLE, 0, 5, 2));
     intruder.send_sealed(&renet_slice(RELIABLE, 1, 0, 2));
     intruder.send_sealed(&renet_slice(RELIABLE, 1, 7, 8));
-    server.app.update();
+    server.update();
 
     // Another token holder sends its connection request and never answers the challenge: its address is
     // a pending one.
     pending.pump();
-    server.app.update();
+    server.update();
     pending.send_raw(&crashing_prefix());
     pending.send_raw(&short_with_long_sequence());
-    server.app.update();
+    server.update();
 
     // Random datagrams from all three kinds of address, and random payloads sealed with a session key.
     for i in 0..900 {
@@ -66,13 +66,13 @@ fn crafted_datagrams_from_every_kind_of_address_leave_a_real_heist_running() {
             _ => intruder.send_sealed(&junk[..len.min(1200)]),
         }
         if i % 30 == 0 {
-            server.app.update();
+            server.update();
         }
     }
     for _ in 0..5 {
-        server.app.update();
+        server.update();
     }
-    let stats = server.app.world().resource::<GameTransport>().stats();
+    let stats = server.world().resource::<GameTransport>().stats();
     assert!(stats.refused_datagrams >= 300, "{stats:?}");
     assert!(stats.refused_payloads >= 2, "both crafted slices were refused: {stats:?}");
 
@@ -81,7 +81,7 @@ fn crafted_datagrams_from_every_kind_of_address_leave_a_real_heist_running() {
     intruder.leave();
     assert!(
         (0..5 * HZ).any(|_| {
-            server.app.update();
+            server.update();
             !server.game().is_present(Role::Vive)
         }),
         "the intruder's seat is free"

@@ -31,7 +31,7 @@ fn bots(seed: u64, vive: &SeatCache, phantom: &SeatCache) -> Heist {
 /// Steps the server and the one client left (`app`) for `ticks`.
 fn step_alone(server: &mut HostedServer, app: &mut App, ticks: u64) {
     for _ in 0..ticks {
-        server.app.update();
+        server.update();
         app.update();
     }
 }

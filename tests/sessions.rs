@@ -169,6 +169,7 @@ fn twenty_sessions_of_bot_pairs_play_whole_heists_at_once_and_no_client_sees_ano
         clients.extend(heist_server::load::create_bot_pair(&server, ViveStyle::Careful, 1, probe).expect("a pair"));
     }
     assert_eq!(server.registry.len(), SESSIONS);
+    assert!(server.shards.len() > 1, "the sessions are spread over shards, each a replication server of its own");
     let level = heist_shared::level::Level::museum();
     let most = [1, 1, 1, level.guards.len(), level.cases.len(), usize::MAX];
     let mut all_running_at_once = false;
@@ -179,7 +180,7 @@ fn twenty_sessions_of_bot_pairs_play_whole_heists_at_once_and_no_client_sees_ano
     };
     let mut ticks = 0;
     while !over(&mut server) && ticks < 90 * HZ {
-        server.app.update();
+        server.update();
         clients.iter_mut().for_each(bevy::prelude::App::update);
         ticks += 1;
         if ticks % 30 == 0 {
@@ -201,7 +202,7 @@ fn twenty_sessions_of_bot_pairs_play_whole_heists_at_once_and_no_client_sees_ano
     assert!(all_running_at_once, "the twenty heists ran at the same time");
     assert!(own_entities_seen.iter().all(|s| *s), "every client saw its own session whole");
     for _ in 0..10 {
-        server.app.update();
+        server.update();
         clients.iter_mut().for_each(bevy::prelude::App::update);
     }
 
@@ -242,13 +243,16 @@ fn twenty_sessions_of_bot_pairs_play_whole_heists_at_once_and_no_client_sees_ano
 
     // Over, the sessions end and free what they held: codes, seats, games, mirrors.
     let freed = |server: &mut heist_server::HostedServer| {
-        let world = server.app.world_mut();
-        let mirrors = world.query::<&bevy_replicon::prelude::Replicated>().iter(world).count();
+        let mut mirrors = 0;
+        for shard in &mut server.shards {
+            let world = shard.app.world_mut();
+            mirrors += world.query::<&bevy_replicon::prelude::Replicated>().iter(world).count();
+        }
         server.sessions().is_empty() && server.registry.is_empty() && mirrors == 0
     };
     let mut ticks = 0;
     while !freed(&mut server) && ticks < 30 * HZ {
-        server.app.update();
+        server.update();
         clients.iter_mut().for_each(bevy::prelude::App::update);
         ticks += 1;
         std::thread::sleep(std::time::Duration::from_millis(1));
@@ -258,4 +262,80 @@ fn twenty_sessions_of_bot_pairs_play_whole_heists_at_once_and_no_client_sees_ano
         let inbox = client.world().resource::<heist_client::Inbox>();
         assert_eq!(inbox.disconnect, Some(DisconnectReason::SessionEnded), "each player is told");
     }
+}
+
+/// Every replicated mirror on the server, over all its shards.
+fn mirrors(server: &mut heist_server::HostedServer) -> usize {
+    let mut n = 0;
+    for shard in &mut server.shards {
+        let world = shard.app.world_mut();
+        n += world.query::<&bevy_replicon::prelude::Replicated>().iter(world).count();
+    }
+    n
+}
+
+#[test]
+fn three_hundred_sessions_in_one_process_are_created_played_and_closed_and_no_client_sees_another_sessions_entities() {
+    const SESSIONS: usize = 300;
+    let mut options = heist_server::load::load_server_options(SESSIONS);
+    options.game.time_limit_s = Some(8.0);
+    options.game.idle_end_s = Some(1.0);
+    let mut server = build_server(options).expect("server starts");
+    let mut clients = Vec::with_capacity(2 * SESSIONS);
+    for _ in 0..SESSIONS {
+        clients.extend(heist_server::load::create_bot_pair(&server, ViveStyle::Careful, 1, |_| {}).expect("a pair"));
+    }
+    assert_eq!(server.registry.len(), SESSIONS);
+    assert_eq!(server.shards.len(), SESSIONS.div_ceil(server.registry.shard_size()), "spread over shards");
+    let level = heist_shared::level::Level::museum();
+    let most = [1, 1, 1, level.guards.len(), level.cases.len(), usize::MAX];
+    let mut own_seen = vec![false; clients.len()];
+    let mut most_running = 0;
+    let step = |server: &mut heist_server::HostedServer, clients: &mut Vec<bevy::prelude::App>| {
+        server.update();
+        clients.iter_mut().for_each(bevy::prelude::App::update);
+    };
+    let over = |server: &mut heist_server::HostedServer| {
+        let sessions = server.sessions();
+        sessions.len() == SESSIONS && sessions.iter().all(|s| !s.game.is_running() && s.game.phase != Phase::Lobby)
+    };
+    let mut ticks = 0;
+    while !over(&mut server) && ticks < 30 * HZ {
+        step(&mut server, &mut clients);
+        ticks += 1;
+        if ticks % 20 == 0 {
+            most_running = most_running.max(server.sessions().iter().filter(|s| s.game.is_running()).count());
+            for (i, client) in clients.iter_mut().enumerate() {
+                let counts = held(client);
+                assert!(
+                    counts.iter().zip(most).all(|(n, m)| *n <= m),
+                    "client {i} holds {counts:?}: another session's?"
+                );
+                let guards_whole = i % 2 == 0 || counts[3] == most[3];
+                own_seen[i] |= counts[..3] == [1, 1, 1] && guards_whole && counts[4] == most[4] && counts[5] > 0;
+            }
+        }
+    }
+    assert!(over(&mut server), "every session played its heist to a result within {ticks} ticks");
+    assert_eq!(most_running, SESSIONS, "the heists ran at the same time");
+    let unseen: Vec<usize> = (0..clients.len()).filter(|i| !own_seen[*i]).collect();
+    assert!(unseen.is_empty(), "clients {unseen:?} never held their own session whole");
+
+    // Over, every session closes and frees what it held.
+    let mut ticks = 0;
+    while !(server.sessions().is_empty() && server.registry.is_empty() && mirrors(&mut server) == 0) && ticks < 20 * HZ
+    {
+        step(&mut server, &mut clients);
+        ticks += 1;
+    }
+    assert!(server.registry.is_empty(), "{} sessions still open after {ticks} ticks", server.registry.len());
+    assert_eq!(mirrors(&mut server), 0, "every mirror despawned");
+    for _ in 0..5 {
+        step(&mut server, &mut clients);
+    }
+    let told = clients
+        .iter()
+        .filter(|c| c.world().resource::<heist_client::Inbox>().disconnect == Some(DisconnectReason::SessionEnded))
+        .count();
+    assert_eq!(told, clients.len(), "every player is told the session ended");
 }

@@ -42,7 +42,7 @@ impl Session {
 
     /// One tick for the server and every client.
     pub fn step(&mut self) {
-        self.server.app.update();
+        self.server.update();
         for c in &mut self.clients {
             c.update();
         }

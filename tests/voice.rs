@@ -44,7 +44,7 @@ fn a_voice_frame_reaches_the_partner_in_the_same_session_and_no_one_else() {
         clients.push(heist_server::demo::client_with_token(token, listening).expect("Phantom joins"));
     }
     let step = |server: &mut heist_server::HostedServer, clients: &mut Vec<App>| {
-        server.app.update();
+        server.update();
         clients.iter_mut().for_each(App::update);
     };
     for _ in 0..2 * HZ {

@@ -42,7 +42,7 @@ fn the_vive_client_in_bot_mode_and_a_phantom_bot_win_a_heist() {
     // sent to his client, so at the end of a heist there may be none in view.
     let mut samples: Vec<(Vec<usize>, usize)> = Vec::new();
     while ticks < max_ticks {
-        server.app.update();
+        server.update();
         vive.update();
         phantom.update();
         ticks += 1;
@@ -54,7 +54,7 @@ fn the_vive_client_in_bot_mode_and_a_phantom_bot_win_a_heist() {
         }
         if !server.game().is_running() && server.game().phase != Phase::Lobby {
             for _ in 0..10 {
-                server.app.update();
+                server.update();
                 vive.update();
                 phantom.update();
             }
@@ -137,7 +137,7 @@ fn the_vive_client_in_bot_mode_and_a_phantom_bot_win_a_heist_over_a_poor_link() 
     let limit = server.game().time_left_s;
     let max_ticks = ((f64::from(limit) + 40.0) * TICK_HZ) as u64;
     for _ in 0..max_ticks {
-        server.app.update();
+        server.update();
         vive.update();
         phantom.update();
         relay.advance(tick).expect("the relay runs");

@@ -107,7 +107,7 @@ fn run(link: Conditions) -> Measured {
     };
     let mut last = server.game().vive.position;
     while started.elapsed() < Duration::from_secs(40) && m.heist_ticks < 14 * 60 {
-        server.app.update();
+        server.update();
         vive.update();
         phantom.update();
         if server.game().phase == Phase::Heist {

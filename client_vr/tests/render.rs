@@ -45,7 +45,7 @@ fn desktop_mode_joins_a_server_and_shows_the_museum() {
     let period = Duration::from_secs_f64(1.0 / TICK_HZ);
     let started = Instant::now();
     let status = loop {
-        server.app.update();
+        server.update();
         if let Some(status) = child.try_wait().expect("child state") {
             break status;
         }
@@ -103,7 +103,7 @@ fn desktop_mode_joins_a_server_and_shows_the_museum() {
     let level = heist_shared::level::Level::museum();
     let walls = heist_shared::level::WallSet::new(&level);
     let guards: Vec<(String, glam::Vec2)> = {
-        let world = server.app.world_mut();
+        let world = server.world_mut();
         world.query::<&GuardView>().iter(world).map(|g| (g.name.clone(), g.position)).collect()
     };
     let eye = space::world(level.vive_spawn, space::EYE_HEIGHT_M);

@@ -32,7 +32,7 @@ fn session_tick(c: &mut Criterion) {
                         heist = fresh(); // only running sessions are measured
                     }
                     let t = Instant::now();
-                    heist.server.app.update();
+                    heist.server.update();
                     total += t.elapsed();
                     heist.vive.update();
                     heist.phantom.update();

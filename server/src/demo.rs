@@ -123,7 +123,7 @@ impl Heist {
 
     /// One tick for everyone.
     pub fn step(&mut self) {
-        self.server.app.update();
+        self.server.update();
         self.vive.update();
         self.phantom.update();
         self.ticks += 1;

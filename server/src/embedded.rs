@@ -100,13 +100,15 @@ pub fn start(host: HostOptions) -> anyhow::Result<Embedded> {
         intake_limits: Default::default(),
         drain_limit: crate::fleet::DEFAULT_DRAIN_LIMIT,
         stall_after: crate::fleet::STALL_AFTER,
+        shard_size: 1,
+        ports: Vec::new(),
     };
     let (tx, rx) = std::sync::mpsc::channel();
     std::thread::Builder::new().name("server".into()).spawn(move || match build_server(options) {
         Ok(mut server) => {
             let code = server.join_code().map(|c| c.code);
             let _ = tx.send(Ok((server.advertised, server.tokens.as_ref().map(|t| t.addr), code)));
-            server.app.run();
+            server.run();
         }
         Err(e) => {
             let _ = tx.send(Err(e));

@@ -16,7 +16,6 @@ use std::net::SocketAddr;
 use std::time::Duration;
 
 use anyhow::Context as _;
-use bevy::app::ScheduleRunnerPlugin;
 use bevy::prelude::*;
 use bevy::state::app::StatesPlugin;
 use bevy::time::TimeUpdateStrategy;
@@ -80,7 +79,19 @@ pub struct ServerOptions {
     pub drain_limit: Duration,
     /// How long without an update the game loop counts as stalled (health, Agones).
     pub stall_after: Duration,
+    /// Sessions one shard plays at most: a shard is a replication server (a Bevy app with its own
+    /// replicon, renet and game UDP port) for its sessions alone, so the cost of a session's tick does
+    /// not grow with the sessions other shards play (docs/decisions.md). A server of `max_sessions` runs
+    /// `max_sessions.div_ceil(shard_size)` shards, all ticked by one game loop.
+    pub shard_size: usize,
+    /// The shards' game ports, one each, when they are not consecutive (Agones gives each its own);
+    /// empty: shard `i` binds `bind`'s port + `i` (every one port 0 when `bind`'s is 0), and is
+    /// advertised at `advertise`'s port + `i`.
+    pub ports: Vec<u16>,
 }
+
+/// Sessions a shard plays unless told otherwise (the load figures in docs/performance.md).
+pub const DEFAULT_SHARD_SIZE: usize = 8;
 
 /// How long a join code works unless the host says otherwise.
 pub const DEFAULT_CODE_TTL: Duration = Duration::from_secs(30 * 60);
@@ -106,17 +117,53 @@ impl ServerOptions {
             intake_limits: IntakeLimits::default(),
             drain_limit: fleet::DEFAULT_DRAIN_LIMIT,
             stall_after: fleet::STALL_AFTER,
+            shard_size: DEFAULT_SHARD_SIZE,
+            ports: Vec::new(),
         }
+    }
+
+    /// Shard `i`'s bound address and the address its players are told.
+    fn shard_addrs(&self, i: usize) -> anyhow::Result<(SocketAddr, Option<SocketAddr>)> {
+        let port = |base: u16| -> anyhow::Result<u16> {
+            match self.ports.get(i) {
+                Some(p) => Ok(*p),
+                None if !self.ports.is_empty() => anyhow::bail!("{} game ports for {} shards", self.ports.len(), i + 1),
+                None if base == 0 => Ok(0),
+                None => u16::try_from(usize::from(base) + i).context("the shards' game ports run past 65535"),
+            }
+        };
+        let mut bind = self.bind;
+        bind.set_port(port(self.bind.port())?);
+        let advertise = match self.advertise {
+            Some(mut a) => {
+                a.set_port(port(a.port())?);
+                Some(a)
+            }
+            None => None,
+        };
+        Ok((bind, advertise))
     }
 }
 
-/// A built server, not yet running.
-pub struct HostedServer {
+/// One shard: a replication server for its sessions alone — a Bevy app with its own replicon, renet
+/// and game socket — ticked with the others by the server's game loop.
+pub struct Shard {
     /// The Bevy app.
     pub app: App,
     /// Its game address, as bound.
     pub addr: SocketAddr,
-    /// The game address players are given in their tokens (the bound one unless advertised otherwise).
+    /// The game address its players are given in their tokens.
+    pub advertised: SocketAddr,
+}
+
+/// A built server, not yet running.
+pub struct HostedServer {
+    /// Its shards (one unless `max_sessions` exceeds `shard_size`); the first plays the host's session.
+    pub shards: Vec<Shard>,
+    /// The first shard's game address, as bound.
+    pub addr: SocketAddr,
+    /// The game address the first shard's players are given in their tokens (the bound one unless
+    /// advertised otherwise).
     pub advertised: SocketAddr,
     /// The token endpoint (secure mode).
     pub tokens: Option<TokenService>,
@@ -129,16 +176,62 @@ pub struct HostedServer {
 }
 
 impl HostedServer {
+    /// One tick of the game loop: every shard's app updates once. (Never inlined: a profile finds the
+    /// server's work under it.)
+    #[inline(never)]
+    pub fn update(&mut self) {
+        for shard in &mut self.shards {
+            shard.app.update();
+        }
+    }
+
+    /// The first shard's world (the host's session, when there is one, lives there).
+    pub fn world(&self) -> &World {
+        self.shards[0].app.world()
+    }
+
+    /// The first shard's world, to change.
+    pub fn world_mut(&mut self) -> &mut World {
+        self.shards[0].app.world_mut()
+    }
+
+    /// How the game loop ended, once every shard has exited: the first error, else success.
+    pub fn should_exit(&self) -> Option<AppExit> {
+        let exits: Option<Vec<AppExit>> = self.shards.iter().map(|s| s.app.should_exit()).collect();
+        exits.map(|exits| exits.into_iter().find(AppExit::is_error).unwrap_or(AppExit::Success))
+    }
+
+    /// Runs the game loop in real time until every shard has exited (a drain, a failure), ticking each
+    /// shard in turn twice a game tick (as Bevy's schedule runner would one app); a shard that has exited
+    /// is no longer updated.
+    pub fn run(&mut self) -> AppExit {
+        let period = Duration::from_secs_f64(0.5 / TICK_HZ);
+        loop {
+            let start = std::time::Instant::now();
+            for shard in &mut self.shards {
+                if shard.app.should_exit().is_none() {
+                    shard.app.update();
+                }
+            }
+            if let Some(exit) = self.should_exit() {
+                return exit;
+            }
+            if let Some(rest) = period.checked_sub(start.elapsed()) {
+                std::thread::sleep(rest);
+            }
+        }
+    }
+
     /// The host's session (the one opened at start-up).
     ///
     /// # Panics
     /// When the server was built without one ([`ServerOptions::host_session`] false): a test's mistake.
     pub fn host_session(&self) -> &Session {
-        self.app
-            .world()
+        let world = self.world();
+        world
             .resource::<HostSession>()
             .0
-            .and_then(|e| self.app.world().get::<Session>(e))
+            .and_then(|e| world.get::<Session>(e))
             .expect("the server was built with a host session")
     }
 
@@ -159,27 +252,39 @@ impl HostedServer {
 
     /// Every session being played, in no particular order.
     pub fn sessions(&mut self) -> Vec<&Session> {
-        let world = self.app.world_mut();
-        let mut query = world.query::<&Session>();
-        query.iter(world).collect()
+        let mut all = Vec::new();
+        for shard in &mut self.shards {
+            let world = shard.app.world_mut();
+            let mut query = world.query::<&Session>();
+            // The query state only borrows the world; its items live as long as the world's borrow.
+            let world: &World = world;
+            all.extend(query.iter(world));
+        }
+        all
     }
 }
 
-/// Builds the server app, binds its sockets and starts the token endpoint.
+/// Builds the server's shards, binds their sockets and starts the token endpoint.
 pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
-    let socket = net::bind_game_socket(options.bind).with_context(|| format!("cannot bind UDP {}", options.bind))?;
-    let addr = socket.local_addr()?;
-    let advertise = match options.advertise {
-        None if addr.ip().is_unspecified() => Some(net::advertise_for(addr)?),
-        a => a,
-    };
-    let advertised = advertise.unwrap_or(addr);
     let max_sessions = options.max_sessions.clamp(1, net::MAX_SESSIONS);
-    let registry = Registry::new(max_sessions, options.code_ttl, options.token_limits.creates);
+    let shard_size = options.shard_size.clamp(1, max_sessions);
+    let shard_count = max_sessions.div_ceil(shard_size);
+    let mut sockets = Vec::with_capacity(shard_count);
+    for i in 0..shard_count {
+        let (bind, advertise) = options.shard_addrs(i)?;
+        let socket = net::bind_game_socket(bind).with_context(|| format!("cannot bind UDP {bind}"))?;
+        let addr = socket.local_addr()?;
+        let advertise = match advertise {
+            None if addr.ip().is_unspecified() => Some(net::advertise_for(addr)?),
+            a => a,
+        };
+        sockets.push((socket, addr, advertise));
+    }
+    let registry = Registry::sharded(max_sessions, shard_size, options.code_ttl, options.token_limits.creates);
     let fleet = Fleet::new(max_sessions, options.drain_limit, options.stall_after);
     let host_entry = if options.host_session {
         let entry = registry.open(None).map_err(|e| anyhow::anyhow!("cannot open the host's session: {e}"))?;
-        registry.take_opened(); // spawned below, with the host's options
+        registry.take_opened(entry.shard); // spawned below, with the host's options
         Some(entry)
     } else {
         None
@@ -193,7 +298,7 @@ pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
             TokenConfig {
                 registry: registry.clone(),
                 private_key,
-                server_addr: advertised,
+                server_addrs: sockets.iter().map(|(_, addr, advertise)| advertise.unwrap_or(*addr)).collect(),
                 limits: options.token_limits,
                 metrics: fleet.metrics.clone(),
             },
@@ -204,44 +309,53 @@ pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
     let codes = host_entry.as_ref().filter(|_| !options.insecure).map(|e| e.codes.clone());
     let new_sessions = NewSessions { level: options.level.clone(), game: options.game.clone(), echo: options.echo_log };
 
+    let mut shards = Vec::with_capacity(shard_count);
+    for (shard, (socket, addr, advertise)) in sockets.into_iter().enumerate() {
+        let settings = NetSettings {
+            auth: auth.clone(),
+            registry: registry.clone(),
+            shard,
+            abuse_limit: options.abuse_limit,
+            advertise,
+            new_sessions: new_sessions.clone(),
+            metrics: fleet.metrics.clone(),
+        };
+        let mut app = shard_app(options.clock, &fleet, socket, settings, options.intake_limits);
+        if let Some(entry) = host_entry.as_ref().filter(|e| e.shard == shard) {
+            let mut session = new_sessions.session(entry, Some(&options.game));
+            session.log.record(0.0, session::Record::SessionCreated, "session created; waiting for players".into());
+            let world = app.world_mut();
+            let entity = session::spawn_session(&mut world.commands(), session);
+            world.flush();
+            world.insert_resource(HostSession(Some(entity)));
+        }
+        app.finish();
+        app.cleanup();
+        shards.push(Shard { app, addr, advertised: advertise.unwrap_or(addr) });
+    }
+    let (addr, advertised) = (shards[0].addr, shards[0].advertised);
+    Ok(HostedServer { shards, addr, advertised, tokens, registry, codes, fleet })
+}
+
+/// One shard's app: replicon and renet on `socket`, the sessions `settings.shard` plays, the fleet side.
+fn shard_app(
+    clock: Clock,
+    fleet: &Fleet,
+    socket: std::net::UdpSocket,
+    settings: NetSettings,
+    intake: IntakeLimits,
+) -> App {
     let mut app = App::new();
-    let period = Duration::from_secs_f64(1.0 / TICK_HZ);
-    match options.clock {
-        Clock::RealTime => {
-            app.add_plugins(MinimalPlugins.set(ScheduleRunnerPlugin::run_loop(period / 2)));
-        }
-        Clock::Stepped => {
-            app.add_plugins(MinimalPlugins).insert_resource(TimeUpdateStrategy::ManualDuration(period));
-        }
+    app.add_plugins(MinimalPlugins);
+    if clock == Clock::Stepped {
+        let period = Duration::from_secs_f64(1.0 / TICK_HZ);
+        app.insert_resource(TimeUpdateStrategy::ManualDuration(period));
     }
     app.insert_resource(Time::<Fixed>::from_hz(TICK_HZ))
         .add_plugins((StatesPlugin, RepliconPlugins, RepliconRenetPlugins, ProtocolPlugin))
         .add_plugins(SessionPlugin)
         .insert_resource(fleet.clone())
         .add_plugins(FleetPlugin)
-        .add_plugins(ServerNetPlugin {
-            socket: std::sync::Mutex::new(Some(socket)),
-            settings: NetSettings {
-                auth,
-                registry: registry.clone(),
-                abuse_limit: options.abuse_limit,
-                advertise,
-                new_sessions: new_sessions.clone(),
-                metrics: fleet.metrics.clone(),
-            },
-            intake: options.intake_limits,
-        });
-    if let Some(entry) = &host_entry {
-        let mut session = new_sessions.session(entry, Some(&options.game));
-        session.log.record(0.0, session::Record::SessionCreated, "session created; waiting for players".into());
-        let world = app.world_mut();
-        let entity = session::spawn_session(&mut world.commands(), session);
-        world.flush();
-        world.insert_resource(HostSession(Some(entity)));
-    }
-    if options.clock == Clock::Stepped {
-        app.finish();
-        app.cleanup();
-    }
-    Ok(HostedServer { app, addr, advertised, tokens, registry, codes, fleet })
+        .add_plugins(ServerNetPlugin { socket: std::sync::Mutex::new(Some(socket)), settings, intake });
+    app
 }

@@ -1,8 +1,9 @@
 //! `heist-server load`: many bot pairs against one server process over loopback UDP, each pair in a
 //! session of its own that it created through the token endpoint, and what it costs the server.
 //!
-//! Everything is stepped in lockstep on one thread (the server, then every client, once a tick), so the
-//! server's cost per tick is its own thread's CPU time for that update, undisturbed by the bots; time
+//! Everything is stepped in lockstep on one thread (the server — every shard — then every client, once a
+//! tick), so the server's cost per tick is its own thread's CPU time for that update, undisturbed by the
+//! bots (a profile tells the server's work by [`HostedServer::update`] in its stacks); time
 //! is game time (a tick is 1/60 s), so bytes per second are per second of play whatever the machine's
 //! speed. Every bot pair asks for another round after each result, so the load is steady.
 
@@ -31,6 +32,21 @@ pub struct LoadOptions {
     pub style: ViveStyle,
     /// Serve `/healthz` and `/metrics` here while the load runs.
     pub metrics: Option<std::net::SocketAddr>,
+    /// Sessions a shard plays at most.
+    pub shard_size: usize,
+    /// What tells the server's own heap apart from the bots' (the binary's counting allocator).
+    pub heap: Option<HeapProbe>,
+}
+
+/// The net heap bytes allocated while a thread is flagged as doing the server's work: an allocator's
+/// view that separates the server's memory from the bots' in one process (`heist-server load` installs
+/// one; a library cannot).
+#[derive(Clone, Copy, Debug)]
+pub struct HeapProbe {
+    /// Flags the calling thread as doing the server's work (true) or not.
+    pub flag: fn(bool),
+    /// Net bytes allocated by flagged work so far.
+    pub bytes: fn() -> i64,
 }
 
 /// What a load run measured.
@@ -38,6 +54,8 @@ pub struct LoadOptions {
 pub struct LoadReport {
     /// Sessions played.
     pub sessions: usize,
+    /// Shards they were spread over.
+    pub shards: usize,
     /// Ticks measured.
     pub ticks: u64,
     /// Server CPU per tick divided by the sessions, µs: median.
@@ -48,30 +66,60 @@ pub struct LoadReport {
     pub tick_ms_median: f64,
     /// The same, 99th percentile.
     pub tick_ms_p99: f64,
+    /// Wall time of a whole server tick (every shard's update), ms, 99th percentile.
+    pub tick_wall_ms_p99: f64,
     /// Bytes a second each client sent the server (UDP payloads), averaged over the clients.
     pub client_bytes_per_s_up: f64,
     /// Bytes a second the server sent each client.
     pub client_bytes_per_s_down: f64,
+    /// Datagrams a second each client sent the server.
+    pub client_datagrams_per_s_up: f64,
+    /// Datagrams a second the server sent each client.
+    pub client_datagrams_per_s_down: f64,
     /// Players admitted when the measurement began (2 per session when all are in).
     pub players: usize,
     /// Rounds begun during the measurement (the bots ask for another after each result).
     pub rematches: u32,
+    /// The process's resident size, MB, by seconds of game time into the measurement (every
+    /// [`RESIDENT_SAMPLE_S`]; the bots' apps live in the same process).
+    pub resident_mb: Vec<(f64, f64)>,
+    /// The server's own heap (net bytes allocated during its updates since it started ticking), MB,
+    /// sampled as `resident_mb`; empty without a [`HeapProbe`].
+    pub server_heap_mb: Vec<(f64, f64)>,
 }
 
 impl std::fmt::Display for LoadReport {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         writeln!(
             f,
-            "{} sessions, {} players, {} ticks measured ({} rematches)",
-            self.sessions, self.players, self.ticks, self.rematches
+            "{} sessions over {} shards, {} players, {} ticks measured ({} rematches)",
+            self.sessions, self.shards, self.players, self.ticks, self.rematches
         )?;
         writeln!(
             f,
             "server CPU per session-tick: median {:.1} µs, p99 {:.1} µs",
             self.session_tick_us_median, self.session_tick_us_p99
         )?;
-        writeln!(f, "server tick: median {:.3} ms, p99 {:.3} ms", self.tick_ms_median, self.tick_ms_p99)?;
-        write!(f, "per client: up {:.0} B/s, down {:.0} B/s", self.client_bytes_per_s_up, self.client_bytes_per_s_down)
+        writeln!(
+            f,
+            "server tick: CPU median {:.3} ms, p99 {:.3} ms; wall p99 {:.3} ms",
+            self.tick_ms_median, self.tick_ms_p99, self.tick_wall_ms_p99
+        )?;
+        writeln!(
+            f,
+            "per client: up {:.0} B/s in {:.0} datagrams/s, down {:.0} B/s in {:.0} datagrams/s",
+            self.client_bytes_per_s_up,
+            self.client_datagrams_per_s_up,
+            self.client_bytes_per_s_down,
+            self.client_datagrams_per_s_down
+        )?;
+        let resident: Vec<String> = self.resident_mb.iter().map(|(s, mb)| format!("{s:.0} s {mb:.1}")).collect();
+        write!(f, "resident MB by game time: {}", resident.join(", "))?;
+        if !self.server_heap_mb.is_empty() {
+            let heap: Vec<String> = self.server_heap_mb.iter().map(|(s, mb)| format!("{s:.0} s {mb:.2}")).collect();
+            write!(f, "\nserver heap MB by game time: {}", heap.join(", "))?;
+        }
+        Ok(())
     }
 }
 
@@ -96,6 +144,16 @@ pub fn create_bot_pair(
     probe: impl Fn(&mut App),
 ) -> anyhow::Result<[App; 2]> {
     let endpoint = server.tokens.as_ref().context("the server runs without a token endpoint")?.addr;
+    create_bot_pair_at(endpoint, style, rounds, probe)
+}
+
+/// [`create_bot_pair`] through the token endpoint at `endpoint`.
+pub fn create_bot_pair_at(
+    endpoint: std::net::SocketAddr,
+    style: ViveStyle,
+    rounds: u32,
+    probe: impl Fn(&mut App),
+) -> anyhow::Result<[App; 2]> {
     let timeout = Duration::from_secs(5);
     let (code, token) = heist_client::create_session(endpoint, Role::Vive, timeout)?;
     let vive = crate::demo::client_with_token(token, |app| {
@@ -131,6 +189,49 @@ fn quantile(values: &mut [f64], q: f64) -> f64 {
     values[i.min(values.len() - 1)]
 }
 
+/// Resident size of this process, MB (0 where `/proc` cannot tell).
+pub fn resident_mb() -> f64 {
+    let pages = std::fs::read_to_string("/proc/self/statm")
+        .ok()
+        .and_then(|s| s.split_whitespace().nth(1).and_then(|p| p.parse::<f64>().ok()))
+        .unwrap_or(0.0);
+    // SAFETY: sysconf has no preconditions.
+    let page = unsafe { libc::sysconf(libc::_SC_PAGESIZE) };
+    pages * page.max(0) as f64 / 1e6
+}
+
+/// One tick of the server (every shard's update): the CPU time of this thread and the wall time it took.
+fn tick(server: &mut HostedServer, heap: Option<HeapProbe>) -> (Duration, Duration) {
+    let (cpu, wall) = (thread_cpu(), std::time::Instant::now());
+    if let Some(h) = heap {
+        (h.flag)(true);
+    }
+    server.update();
+    if let Some(h) = heap {
+        (h.flag)(false);
+    }
+    (thread_cpu() - cpu, wall.elapsed())
+}
+
+/// Players admitted by every shard.
+fn admitted(server: &mut HostedServer) -> usize {
+    server.shards.iter_mut().map(|s| admission_count(s.app.world_mut())).sum()
+}
+
+/// Bytes through every shard's game socket.
+fn traffic(server: &mut HostedServer) -> crate::net::transport::Traffic {
+    let mut all = crate::net::transport::Traffic::default();
+    for shard in &server.shards {
+        if let Some(t) = shard.app.world().get_resource::<GameTransport>().map(GameTransport::traffic) {
+            all.received += t.received;
+            all.sent += t.sent;
+            all.datagrams_received += t.datagrams_received;
+            all.datagrams_sent += t.datagrams_sent;
+        }
+    }
+    all
+}
+
 /// Runs the load: `progress` hears what is happening (joins, then the measurement).
 pub fn run_load(options: &LoadOptions, mut progress: impl FnMut(&str)) -> anyhow::Result<LoadReport> {
     anyhow::ensure!(
@@ -140,67 +241,85 @@ pub fn run_load(options: &LoadOptions, mut progress: impl FnMut(&str)) -> anyhow
         crate::net::MAX_SESSIONS
     );
     anyhow::ensure!(options.seconds.is_finite() && options.seconds > 0.0, "--seconds must be above zero");
-    let mut server = build_server(load_server_options(options.sessions))?;
+    let mut server =
+        build_server(ServerOptions { shard_size: options.shard_size, ..load_server_options(options.sessions) })?;
     let fleet = crate::fleet::FleetOptions { metrics: options.metrics, agones: None };
     let services = crate::fleet::FleetServices::start(&server, &fleet)?;
     if let Some(http) = &services.http {
         progress(&format!("health and metrics on http://{}/healthz and /metrics", http.addr));
     }
+    let endpoint = server.tokens.as_ref().context("the server runs without a token endpoint")?.addr;
+    let shards = server.shards.len();
+    progress(&format!("{} sessions over {shards} shards", options.sessions));
     let mut clients: Vec<App> = Vec::with_capacity(options.sessions * 2);
     for n in 0..options.sessions {
         clients.extend(
-            create_bot_pair(&server, options.style, u32::MAX, |_| {}).with_context(|| format!("bot pair {}", n + 1))?,
+            create_bot_pair_at(endpoint, options.style, u32::MAX, |_| {})
+                .with_context(|| format!("bot pair {}", n + 1))?,
         );
         // Let the server take each session and its players in before the next.
         for _ in 0..2 {
-            server.app.update();
+            tick(&mut server, options.heap);
             clients.iter_mut().for_each(App::update);
         }
     }
     progress(&format!("{} sessions created; waiting for {} players", options.sessions, clients.len()));
     let want = clients.len();
     for _ in 0..(20.0 * TICK_HZ) as u64 {
-        if admission_count(server.app.world_mut()) >= want {
+        if admitted(&mut server) >= want {
             break;
         }
-        server.app.update();
+        tick(&mut server, options.heap);
         clients.iter_mut().for_each(App::update);
     }
-    let players = admission_count(server.app.world_mut());
+    let players = admitted(&mut server);
     progress(&format!("{players} of {want} players in; measuring {} s of play", options.seconds));
-    let traffic = |s: &HostedServer| {
-        s.app.world().get_resource::<GameTransport>().map(GameTransport::traffic).unwrap_or_default()
-    };
     let rounds = |s: &mut HostedServer| s.sessions().iter().map(|s| s.game.round).sum::<u32>();
-    let (before, rounds_before) = (traffic(&server), rounds(&mut server));
+    let (before, rounds_before) = (traffic(&mut server), rounds(&mut server));
     let ticks = (f64::from(options.seconds) * TICK_HZ).ceil() as u64;
-    let mut tick_us = Vec::with_capacity(ticks as usize);
-    for _ in 0..ticks {
-        let start = thread_cpu();
-        server.app.update();
-        tick_us.push((thread_cpu() - start).as_secs_f64() * 1e6);
+    let sample_every = (RESIDENT_SAMPLE_S * TICK_HZ).round() as u64;
+    let heap_mb = || options.heap.map(|h| (h.bytes)() as f64 / 1e6);
+    let mut resident = vec![(0.0, resident_mb())];
+    let mut server_heap: Vec<(f64, f64)> = heap_mb().map(|mb| (0.0, mb)).into_iter().collect();
+    let (mut tick_us, mut wall_us) = (Vec::with_capacity(ticks as usize), Vec::with_capacity(ticks as usize));
+    for n in 1..=ticks {
+        let (cpu, wall) = tick(&mut server, options.heap);
+        tick_us.push(cpu.as_secs_f64() * 1e6);
+        wall_us.push(wall.as_secs_f64() * 1e6);
         clients.iter_mut().for_each(App::update);
+        if n % sample_every == 0 {
+            resident.push((n as f64 / TICK_HZ, resident_mb()));
+            server_heap.extend(heap_mb().map(|mb| (n as f64 / TICK_HZ, mb)));
+        }
     }
-    let after = traffic(&server);
+    let (after, rounds_after) = (traffic(&mut server), rounds(&mut server));
+    services.shut_down();
     let seconds = ticks as f64 / TICK_HZ;
     let per_client = (players.max(1) as f64) * seconds;
     let sessions = options.sessions as f64;
     let mut per_session: Vec<f64> = tick_us.iter().map(|us| us / sessions).collect();
-    let report = LoadReport {
+    Ok(LoadReport {
         sessions: options.sessions,
+        shards,
         ticks,
         session_tick_us_median: quantile(&mut per_session, 0.5),
         session_tick_us_p99: quantile(&mut per_session, 0.99),
         tick_ms_median: quantile(&mut tick_us, 0.5) / 1000.0,
         tick_ms_p99: quantile(&mut tick_us, 0.99) / 1000.0,
+        tick_wall_ms_p99: quantile(&mut wall_us, 0.99) / 1000.0,
         client_bytes_per_s_up: (after.received - before.received) as f64 / per_client,
         client_bytes_per_s_down: (after.sent - before.sent) as f64 / per_client,
+        client_datagrams_per_s_up: (after.datagrams_received - before.datagrams_received) as f64 / per_client,
+        client_datagrams_per_s_down: (after.datagrams_sent - before.datagrams_sent) as f64 / per_client,
         players,
-        rematches: rounds(&mut server).saturating_sub(rounds_before),
-    };
-    services.shut_down();
-    Ok(report)
+        rematches: rounds_after.saturating_sub(rounds_before),
+        resident_mb: resident,
+        server_heap_mb: server_heap,
+    })
 }
+
+/// Seconds of game time between two samples of the resident size.
+pub const RESIDENT_SAMPLE_S: f64 = 20.0;
 
 #[cfg(test)]
 mod tests {

@@ -1,5 +1,6 @@
 //! `heist-server`: host a Phantom Heist session, join one as a bot, or watch a whole demo heist.
 
+mod counting;
 mod logging;
 
 use std::io::BufRead as _;
@@ -105,6 +106,10 @@ enum Command {
         #[arg(long, default_value_t = heist_server::net::tokens::DEFAULT_MAX_SESSIONS,
               value_parser = max_sessions)]
         max_sessions: usize,
+        /// Sessions a shard plays at most: each shard serves its sessions on a UDP port of its own, the
+        /// next after --bind's (and --advertise's) for each shard after the first.
+        #[arg(long, default_value_t = heist_server::DEFAULT_SHARD_SIZE, value_parser = max_sessions)]
+        shard_size: usize,
         /// Minutes a session's join code works.
         #[arg(long, default_value_t = 30)]
         code_ttl: u64,
@@ -143,6 +148,9 @@ enum Command {
         /// Serve `/healthz` and `/metrics` on this TCP address while the load runs.
         #[arg(long)]
         metrics: Option<SocketAddr>,
+        /// Sessions a shard plays at most (as `serve --shard-size`).
+        #[arg(long, default_value_t = heist_server::DEFAULT_SHARD_SIZE, value_parser = max_sessions)]
+        shard_size: usize,
     },
     /// Host a session for players: prints the address and the join code.
     Host {
@@ -229,7 +237,7 @@ fn run_server(mut server: heist_server::HostedServer, fleet: &FleetArgs, agones:
     if let Some(http) = &services.http {
         println!("health and metrics on http://{}/healthz and /metrics", http.addr);
     }
-    server.app.run();
+    server.run();
     let failure = server.fleet.failure();
     services.shut_down();
     match failure {
@@ -304,6 +312,8 @@ struct Hosting {
     idle_end: f32,
     time_limit: Option<f32>,
     max_sessions: usize,
+    shard_size: usize,
+    ports: Vec<u16>,
     drain_limit: f32,
     difficulty: Difficulty,
 }
@@ -334,6 +344,8 @@ impl Hosting {
             intake_limits: Default::default(),
             drain_limit: Duration::from_secs_f32(self.drain_limit),
             stall_after: heist_server::fleet::STALL_AFTER,
+            shard_size: self.shard_size,
+            ports: self.ports,
         })
     }
 }
@@ -343,6 +355,10 @@ fn print_address(server: &heist_server::HostedServer) {
         println!("hosting on {} (UDP game, TCP tokens)", server.addr);
     } else {
         println!("hosting on {} (UDP game, TCP tokens); players connect to {}", server.addr, server.advertised);
+    }
+    if server.shards.len() > 1 {
+        let ports: Vec<String> = server.shards.iter().map(|s| s.advertised.port().to_string()).collect();
+        println!("{} shards, each serving its sessions on a UDP port of its own: {}", ports.len(), ports.join(", "));
     }
 }
 
@@ -428,6 +444,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 idle_end,
                 time_limit,
                 max_sessions,
+                shard_size: heist_server::DEFAULT_SHARD_SIZE,
+                ports: Vec::new(),
                 drain_limit,
                 difficulty,
             };
@@ -452,6 +470,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             mut bind,
             mut advertise,
             max_sessions,
+            shard_size,
             code_ttl,
             level,
             idle_end,
@@ -460,14 +479,26 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             fleet,
             agones,
         } => {
+            let mut ports = Vec::new();
             if agones && advertise.is_none() {
-                // Players reach the pod at its node's address and host port, which only Agones knows.
-                use heist_server::fleet::agones::{AgonesOptions, GAME_PORT, public_address};
-                let (ip, host_port) = public_address(&AgonesOptions::default(), GAME_PORT)?;
-                if bind.port() == 0 {
-                    bind.set_port(host_port.context("--bind has port 0 and the GameServer has no `game` port")?);
+                // Players reach the pod at its node's address and host ports, which only Agones knows:
+                // one port a shard, named `game`, `game-1`, `game-2`, ...
+                use heist_server::fleet::agones::{AgonesOptions, game_port_name, public_ports};
+                let names: Vec<String> = (0..max_sessions.div_ceil(shard_size)).map(game_port_name).collect();
+                let (ip, found) = public_ports(&AgonesOptions::default(), &names)?;
+                for (shard, (name, port)) in names.iter().zip(found).enumerate() {
+                    ports.push(match port {
+                        Some(p) => p,
+                        None if shard == 0 && bind.port() != 0 => bind.port(),
+                        None => anyhow::bail!(
+                            "the GameServer has no `{name}` port for shard {shard} (--max-sessions {max_sessions} \
+                             in shards of --shard-size {shard_size} need {} ports)",
+                            names.len()
+                        ),
+                    });
                 }
-                advertise = Some(SocketAddr::new(ip, host_port.unwrap_or(bind.port())));
+                bind.set_port(ports[0]);
+                advertise = Some(SocketAddr::new(ip, ports[0]));
             }
             let drain_limit = fleet.drain_limit;
             let hosting = Hosting {
@@ -478,6 +509,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 idle_end,
                 time_limit,
                 max_sessions,
+                shard_size,
+                ports,
                 drain_limit,
                 difficulty,
             };
@@ -488,8 +521,15 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             println!("drained: every session is over");
             Ok(())
         }
-        Command::Load { sessions, seconds, json, metrics } => {
-            let options = heist_server::load::LoadOptions { sessions, seconds, style: ViveStyle::Careful, metrics };
+        Command::Load { sessions, seconds, json, metrics, shard_size } => {
+            let options = heist_server::load::LoadOptions {
+                sessions,
+                seconds,
+                style: ViveStyle::Careful,
+                metrics,
+                shard_size,
+                heap: Some(counting::PROBE),
+            };
             let report = heist_server::load::run_load(&options, |line| println!("{line}"))?;
             println!("{report}");
             if json {

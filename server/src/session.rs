@@ -6,8 +6,8 @@
 use bevy::prelude::*;
 use bevy_replicon::prelude::*;
 use heist_shared::protocol::{
-    Audience, CaseId, CaseView, GameEvent, GuardAlert, GuardView, ItemId, ItemView, LossReason, PhantomTool, Phase,
-    Role, SessionView, VerdictOutcome, ViveAvatar,
+    Audience, CaseId, CaseView, Cases, GameEvent, GuardAlert, GuardView, Guards, ItemId, ItemView, Items, LossReason,
+    PhantomTool, Phase, Role, SessionView, VerdictOutcome, ViveAvatar,
 };
 
 use crate::game::Game;
@@ -79,7 +79,7 @@ pub enum LogEcho {
 /// `--log-format json` makes each a JSON object).
 #[derive(Resource, Default)]
 pub struct SessionLog {
-    /// Lines so far.
+    /// Lines so far (the last [`MAX_LOG_LINES`] at most).
     pub lines: Vec<String>,
     /// Where each line also goes.
     pub echo: LogEcho,
@@ -90,6 +90,11 @@ pub struct SessionLog {
     /// The round being played (set by the session as rounds start).
     pub round: u32,
 }
+
+/// The most lines a session's [`SessionLog::lines`] keeps, about four heists' worth (the oldest half goes
+/// when it is full), so a session that plays on does not grow; the
+/// echo (stdout, tracing) has them all.
+pub const MAX_LOG_LINES: usize = 512;
 
 /// What a log line records, for the structured log.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -172,6 +177,10 @@ impl SessionLog {
             LogEcho::Off => {}
             LogEcho::Stdout => println!("[{t:7.2}s] {text}"),
             LogEcho::Tracing => self.trace(t, record, &text),
+        }
+        if self.lines.len() >= MAX_LOG_LINES {
+            // A session that plays round after round must not grow without end: the oldest half goes.
+            self.lines.drain(..MAX_LOG_LINES / 2);
         }
         self.lines.push(format!("[{t:7.2}s] {text}"));
     }
@@ -324,21 +333,22 @@ fn phase_name(phase: Phase) -> &'static str {
     }
 }
 
-/// Marks the replicated mirror of a game object.
+/// Marks a replicated mirror of a session: a few entities a session, whatever its number of objects
+/// (replication walks entities × clients; docs/decisions.md).
 #[derive(Component, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mirror {
-    /// The session entity.
+    /// The session's state ([`SessionView`]).
     Session,
     /// Vive.
     Vive,
-    /// Guard by index.
-    Guard(usize),
-    /// Case by index.
-    Case(usize),
-    /// Item by index.
-    Item(usize),
     /// Phantom's tool.
     Tool,
+    /// Every display case and item ([`Cases`], [`Items`]).
+    Objects,
+    /// The guards Vive could see or hear now, for Vive alone ([`Guards`]).
+    GuardsPerceived,
+    /// Every guard, for Phantom alone.
+    GuardsAll,
 }
 
 /// System sets of the session.
@@ -384,75 +394,144 @@ pub fn spawn_session(commands: &mut Commands, session: Session) -> Entity {
     let tag = SessionTag(session.id);
     let g = &session.game;
     let both = (Replicated, Audience::Both, tag);
-    let mut mirrors = vec![
-        (Mirror::Session, commands.spawn((both, Mirror::Session, session_view(g))).id()),
-        (Mirror::Vive, commands.spawn((both, Mirror::Vive, vive_view(g))).id()),
-        (Mirror::Tool, commands.spawn((both, Mirror::Tool, g.tool)).id()),
+    let perceived = Guards((0..g.guards.len()).filter(|i| g.vive_perceives(*i)).map(|i| guard_view(g, i)).collect());
+    let all = Guards((0..g.guards.len()).map(|i| guard_view(g, i)).collect());
+    let mirrors = [
+        commands.spawn((both, Mirror::Session, session_view(g))).id(),
+        commands.spawn((both, Mirror::Vive, vive_view(g))).id(),
+        commands.spawn((both, Mirror::Tool, g.tool)).id(),
+        commands.spawn((both, Mirror::Objects, cases(g), items(g))).id(),
+        commands.spawn((Replicated, Audience::Only(Role::Vive), tag, Mirror::GuardsPerceived, perceived)).id(),
+        commands.spawn((Replicated, Audience::Only(Role::Phantom), tag, Mirror::GuardsAll, all)).id(),
     ];
-    mirrors.extend((0..g.guards.len()).map(|i| {
-        let guard = (Replicated, guard_audience(g, i), tag, Mirror::Guard(i), guard_view(g, i));
-        (Mirror::Guard(i), commands.spawn(guard).id())
-    }));
-    mirrors.extend(
-        (0..g.cases.len()).map(|i| (Mirror::Case(i), commands.spawn((both, Mirror::Case(i), case_view(g, i))).id())),
-    );
-    mirrors.extend(
-        (0..g.items.len()).map(|i| (Mirror::Item(i), commands.spawn((both, Mirror::Item(i), item_view(g, i))).id())),
-    );
     let entity = commands.spawn((session, tag)).id();
-    for (_, mirror) in mirrors {
+    for mirror in mirrors {
         commands.entity(mirror).insert(MirrorOf(entity));
     }
     entity
 }
 
-/// Who may see guard `i`'s mirror: both players while Vive could perceive the guard, else only Phantom
-/// (interest management: Vive's client never holds a guard he could not see or hear).
-fn guard_audience(g: &Game, i: usize) -> Audience {
-    if g.vive_perceives(i) { Audience::Both } else { Audience::Only(Role::Phantom) }
-}
-
+/// Brings every session's mirrors up to date. A mirror is compared with the game in place and written
+/// (and so replicated) only when it differs: no allocation for a session where nothing changed.
 #[allow(clippy::type_complexity)]
 fn mirror_games(
-    mut commands: Commands,
     sessions: Query<(&Session, &Mirrors)>,
     mut mirrors: Query<(
-        Entity,
         &Mirror,
-        &Audience,
-        AnyOf<(&mut SessionView, &mut ViveAvatar, &mut PhantomTool, &mut GuardView, &mut CaseView, &mut ItemView)>,
+        AnyOf<(&mut SessionView, &mut ViveAvatar, &mut PhantomTool, &mut Cases, &mut Items, &mut Guards)>,
     )>,
 ) {
     for (session, of) in &sessions {
         let g = &session.game;
+        // Which guards Vive perceives, worked out once a tick (line of sight, hearing are not cheap): bit
+        // `i` for guard `i`; a level with more than 64 guards asks again for the rest.
+        let bits = (0..g.guards.len().min(64)).filter(|i| g.vive_perceives(*i)).fold(0u64, |m, i| m | 1 << i);
+        let perceived = |i: usize| if i < 64 { bits & (1 << i) != 0 } else { g.vive_perceives(i) };
         let mut iter = mirrors.iter_many_mut(of.iter());
-        while let Some((entity, mirror, audience, views)) = iter.fetch_next() {
-            if let Mirror::Guard(i) = *mirror {
-                let should = guard_audience(g, i);
-                if *audience != should {
-                    commands.entity(entity).insert(should);
-                }
-            }
+        while let Some((mirror, views)) = iter.fetch_next() {
             match (*mirror, views) {
-                (Mirror::Session, (Some(mut v), ..)) => {
-                    v.set_if_neq(session_view(g));
-                }
-                (Mirror::Vive, (_, Some(mut v), ..)) => {
-                    v.set_if_neq(vive_view(g));
-                }
+                (Mirror::Session, (Some(v), ..)) => sync_session_view(v, g),
+                (Mirror::Vive, (_, Some(v), ..)) => sync_vive_view(v, g),
                 (Mirror::Tool, (_, _, Some(mut v), ..)) => {
                     v.set_if_neq(g.tool);
                 }
-                (Mirror::Guard(i), (_, _, _, Some(mut v), ..)) => {
-                    v.set_if_neq(guard_view(g, i));
+                (Mirror::Objects, (_, _, _, Some(mut c), Some(mut i), _)) => {
+                    if !cases_are(&c.0, g) {
+                        *c = cases(g);
+                    }
+                    if !items_are(&i.0, g) {
+                        *i = items(g);
+                    }
                 }
-                (Mirror::Case(i), (_, _, _, _, Some(mut v), _)) => {
-                    v.set_if_neq(case_view(g, i));
-                }
-                (Mirror::Item(i), (_, _, _, _, _, Some(mut v))) => {
-                    v.set_if_neq(item_view(g, i));
-                }
+                (Mirror::GuardsPerceived, (.., Some(v))) => sync_guards(v, g, perceived),
+                (Mirror::GuardsAll, (.., Some(v))) => sync_guards(v, g, |_| true),
                 _ => {}
+            }
+        }
+    }
+}
+
+/// Brings the session's view up to date in place (its time left changes every tick of a heist).
+fn sync_session_view(mut v: Mut<SessionView>, g: &Game) {
+    let same_targets =
+        v.targets.len() == g.targets.len() && v.targets.iter().zip(&g.targets).all(|(v, t)| *v == (t.kind, t.secured));
+    if v.phase == g.phase
+        && v.time_left_s == g.time_left_s
+        && v.alarm == g.alarm
+        && v.present == g.present
+        && v.difficulty == g.difficulty
+        && same_targets
+    {
+        return;
+    }
+    let v = &mut *v;
+    (v.phase, v.time_left_s, v.alarm, v.present, v.difficulty) =
+        (g.phase, g.time_left_s, g.alarm, g.present, g.difficulty);
+    if !same_targets {
+        v.targets = g.targets.iter().map(|t| (t.kind, t.secured)).collect();
+    }
+}
+
+/// Brings Vive's view up to date in place (he moves most ticks; what he carries rarely changes).
+fn sync_vive_view(mut v: Mut<ViveAvatar>, g: &Game) {
+    let vive = &g.vive;
+    if v.position == vive.position
+        && v.velocity == vive.velocity
+        && v.facing == vive.facing
+        && v.stance == vive.stance
+        && v.carrying == vive.carrying
+        && v.last_input_seq == vive.last_input_seq
+    {
+        return;
+    }
+    let v = &mut *v;
+    (v.position, v.velocity, v.facing, v.stance, v.last_input_seq) =
+        (vive.position, vive.velocity, vive.facing, vive.stance, vive.last_input_seq);
+    if v.carrying != vive.carrying {
+        v.carrying.clone_from(&vive.carrying);
+    }
+}
+
+fn cases(g: &Game) -> Cases {
+    Cases((0..g.cases.len()).map(|i| case_view(g, i)).collect())
+}
+
+fn cases_are(v: &[CaseView], g: &Game) -> bool {
+    v.len() == g.cases.len() && v.iter().enumerate().all(|(i, c)| *c == case_view(g, i))
+}
+
+fn items(g: &Game) -> Items {
+    Items((0..g.items.len()).map(|i| item_view(g, i)).collect())
+}
+
+fn items_are(v: &[ItemView], g: &Game) -> bool {
+    v.len() == g.items.len()
+        && v.iter()
+            .zip(&g.items)
+            .enumerate()
+            .all(|(i, (v, item))| v.id == ItemId(i as u16) && v.place == item.place && v.kind == item.kind)
+}
+
+/// Brings `list` to the guards `shown` picks, as the game has them now: moved in place while the same
+/// guards are listed (no allocation: guards move every tick), rebuilt when one comes or goes.
+fn sync_guards(mut list: Mut<Guards>, g: &Game, shown: impl Fn(usize) -> bool + Copy) {
+    let picked = || g.guards.iter().enumerate().filter(move |(i, _)| shown(*i)).map(|(_, guard)| guard);
+    let same_guards =
+        list.0.len() == picked().count() && list.0.iter().zip(picked()).all(|(v, guard)| v.id == guard.id);
+    if !same_guards {
+        list.0 = picked().map(guard_view_of).collect();
+        return;
+    }
+    let moved = list.0.iter().zip(picked()).any(|(v, guard)| {
+        v.position != guard.position || v.facing != guard.facing || v.alert != guard.alert || v.name != guard.name
+    });
+    if moved {
+        for (v, guard) in list.0.iter_mut().zip(picked()) {
+            v.position = guard.position;
+            v.facing = guard.facing;
+            v.alert = guard.alert;
+            if v.name != guard.name {
+                v.name.clone_from(&guard.name);
             }
         }
     }
@@ -481,7 +560,10 @@ fn vive_view(g: &Game) -> ViveAvatar {
 }
 
 fn guard_view(g: &Game, i: usize) -> GuardView {
-    let guard = &g.guards[i];
+    guard_view_of(&g.guards[i])
+}
+
+fn guard_view_of(guard: &crate::game::Guard) -> GuardView {
     GuardView {
         id: guard.id,
         name: guard.name.clone(),
@@ -541,6 +623,17 @@ mod tests {
             .lines()
             .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("not JSON ({e}): {l}")))
             .collect()
+    }
+
+    #[test]
+    fn a_long_lived_sessions_log_keeps_its_latest_lines_within_the_bound() {
+        let mut log = SessionLog::default();
+        for n in 0..(3 * MAX_LOG_LINES) {
+            log.line(n as f32, format!("line {n}"));
+            assert!(log.lines.len() <= MAX_LOG_LINES, "{} lines after {n}", log.lines.len());
+        }
+        assert!(log.lines.last().is_some_and(|l| l.ends_with(&format!("line {}", 3 * MAX_LOG_LINES - 1))));
+        assert!(log.lines.len() >= MAX_LOG_LINES / 2, "the latest half at least is kept");
     }
 
     #[test]

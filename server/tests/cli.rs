@@ -668,19 +668,26 @@ fn the_fleets_arguments_run_a_server_on_the_passthrough_port_and_a_second_sigter
     use agones_fake::{Declared, FakeAgones};
     use std::process::Stdio;
     use std::time::Duration;
-    let port = std::net::UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
+    let fleet = include_str!("../../deploy/fleet.yaml");
+    let fleet_args = fleet_args(fleet);
+    let shards = (arg_after(&fleet_args, "--max-sessions") / arg_after(&fleet_args, "--shard-size")).ceil() as usize;
+    let free: Vec<u16> =
+        (0..shards).map(|_| std::net::UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port()).collect();
+    let port = free[0];
+    // As Agones' port allocator lists a TCPUDP port (`game`), then the shards' UDP ports.
+    let mut ports = vec![("game-tcp".to_owned(), port), ("game-udp".to_owned(), port)];
+    ports.extend(free.iter().enumerate().skip(1).map(|(i, p)| (heist_server::fleet::agones::game_port_name(i), *p)));
+    let declared_ports = yaml_block(fleet, "ports:");
+    for (name, _) in ports.iter().skip(2) {
+        assert!(declared_ports.iter().any(|l| l.trim() == format!("- name: {name}")), "the fleet declares {name}");
+    }
     let fake = FakeAgones::start(
         "127.0.0.1:0".parse().unwrap(),
-        Declared {
-            counters: vec![("sessions".into(), 32)],
-            lists: vec![("players".into(), 64)],
-            // As Agones' port allocator lists a TCPUDP port.
-            ports: vec![("game-tcp".into(), port), ("game-udp".into(), port)],
-        },
+        Declared { counters: vec![("sessions".into(), 32)], lists: vec![("players".into(), 64)], ports },
     )
     .unwrap();
     // The container's arguments, on loopback (tests bind nothing else) with a free metrics port.
-    let args: Vec<String> = fleet_args(include_str!("../../deploy/fleet.yaml"))
+    let args: Vec<String> = fleet_args
         .into_iter()
         .map(|a| if a.starts_with("0.0.0.0:") { a.replace("0.0.0.0", "127.0.0.1") } else { a })
         .map(|a| if a == "127.0.0.1:9090" { "127.0.0.1:0".to_owned() } else { a })

@@ -25,7 +25,7 @@ fn run_until(
 ) -> bool {
     let deadline = Instant::now() + limit;
     while Instant::now() < deadline {
-        server.app.update();
+        server.update();
         clients.iter_mut().for_each(App::update);
         if done(&fake.recorded()) {
             return true;
@@ -100,12 +100,12 @@ fn agones_hears_ready_health_the_sessions_counter_players_list_a_stall_and_shutd
     assert_eq!(phase, heist_shared::protocol::Phase::Heist, "the heist is under way");
     assert!(server.fleet.drain.request());
     let deadline = Instant::now() + long;
-    while server.app.should_exit().is_none() && Instant::now() < deadline {
-        server.app.update();
+    while server.should_exit().is_none() && Instant::now() < deadline {
+        server.update();
         bots.iter_mut().for_each(App::update);
         std::thread::sleep(Duration::from_millis(1));
     }
-    assert_eq!(server.app.should_exit(), Some(AppExit::Success), "the drained server exits 0");
+    assert_eq!(server.should_exit(), Some(AppExit::Success), "the drained server exits 0");
     assert!(server.sessions().is_empty());
     services.shut_down();
     let r = fake.recorded();

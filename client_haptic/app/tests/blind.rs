@@ -439,7 +439,7 @@ fn the_partner_joining_dropping_and_coming_back_is_heard_in_that_order() {
         let deadline = Instant::now() + Duration::from_secs(120);
         while !host_stop.load(Ordering::Relaxed) && Instant::now() < deadline {
             std::thread::sleep(Duration::from_millis(16));
-            server.app.update();
+            server.update();
             if vive.is_none() && server.game().is_present(Role::Phantom) {
                 let token = heist_server::demo::token(&server, Role::Vive).expect("a token");
                 let mut app = heist_server::demo::stepped_client_app();

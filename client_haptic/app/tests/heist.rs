@@ -45,12 +45,12 @@ fn the_server_a_vive_bot_and_the_touch_bot_win_a_heist_over_loopback_udp() {
     let mut paced_ticks = 0;
     let started = Instant::now();
     for t in 0..max_ticks {
-        server.app.update();
+        server.update();
         vive.update();
         phantom.update();
         if !server.game().is_running() && server.game().phase != Phase::Lobby {
             for _ in 0..30 {
-                server.app.update();
+                server.update();
                 vive.update();
                 phantom.update();
             }

@@ -182,7 +182,7 @@ fn a_blind_player_creates_a_session_on_a_running_server_and_a_partner_joins_with
         let deadline = Instant::now() + Duration::from_secs(90);
         while !serving.load(Ordering::Relaxed) && Instant::now() < deadline {
             std::thread::sleep(Duration::from_millis(16));
-            server.app.update();
+            server.update();
         }
         server.sessions().len()
     });

@@ -83,7 +83,7 @@ fn talk_over(conditions: Option<Conditions>, name: &str) -> Heard {
     let mut heard: Vec<f32> = Vec::with_capacity(total_ticks * PER_TICK);
     let mut mouth_tick = None;
     for t in 0..total_ticks {
-        server.app.update();
+        server.update();
         vive.update();
         phantom.update();
         if let Some(r) = relay.as_mut() {

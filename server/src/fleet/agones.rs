@@ -28,6 +28,11 @@ pub const VERSION_LABEL: &str = "phantom-heist.join-version";
 /// `TCPUDP` port appears in the status as `game-udp` and `game-tcp`).
 pub const GAME_PORT: &str = "game";
 
+/// The GameServer port shard `shard` serves on: [`GAME_PORT`] for the first, `game-1`, `game-2`, ... after.
+pub fn game_port_name(shard: usize) -> String {
+    if shard == 0 { GAME_PORT.to_owned() } else { format!("{GAME_PORT}-{shard}") }
+}
+
 /// How the link to the sidecar behaves.
 #[derive(Clone, Debug)]
 pub struct AgonesOptions {
@@ -97,6 +102,15 @@ fn sdk_port(port: Option<u16>) -> u16 {
 /// before the sockets are bound (a `Passthrough` port is only known then); blocks up to the SDK's
 /// 30 s connection timeout.
 pub fn public_address(options: &AgonesOptions, port_name: &str) -> anyhow::Result<(std::net::IpAddr, Option<u16>)> {
+    let (ip, ports) = public_ports(options, &[port_name.to_owned()])?;
+    Ok((ip, ports.into_iter().next().flatten()))
+}
+
+/// As [`public_address`], for several ports at once (one a shard: [`game_port_name`]).
+pub fn public_ports(
+    options: &AgonesOptions,
+    port_names: &[String],
+) -> anyhow::Result<(std::net::IpAddr, Vec<Option<u16>>)> {
     let port = sdk_port(options.port);
     let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build()?;
     runtime.block_on(async {
@@ -109,12 +123,14 @@ pub fn public_address(options: &AgonesOptions, port_name: &str) -> anyhow::Resul
             anyhow::anyhow!("Agones gives the game server the address {:?}, not an IP address ({e})", status.address)
         })?;
         // A TCPUDP port shows as two of one number, `NAME-udp` and `NAME-tcp` (Agones' port allocator).
-        let names = [port_name.to_owned(), format!("{port_name}-udp"), format!("{port_name}-tcp")];
-        let host_port = names
-            .iter()
-            .find_map(|name| status.ports.iter().find(|p| p.name == *name))
-            .and_then(|p| u16::try_from(p.port).ok());
-        Ok((ip, host_port))
+        let host_port = |port_name: &String| {
+            let names = [port_name.clone(), format!("{port_name}-udp"), format!("{port_name}-tcp")];
+            names
+                .iter()
+                .find_map(|name| status.ports.iter().find(|p| p.name == *name))
+                .and_then(|p| u16::try_from(p.port).ok())
+        };
+        Ok((ip, port_names.iter().map(host_port).collect()))
     })
 }
 

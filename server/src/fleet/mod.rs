@@ -125,6 +125,7 @@ fn end_update(
     mut removed: RemovedComponents<Session>,
     transport: Option<Res<GameTransport>>,
     mut counted: Local<Traffic>,
+    mut seated: Local<(i64, i64)>,
 ) {
     let m = &fleet.metrics;
     m.tick_seconds.observe(start.0.elapsed().as_secs_f64());
@@ -137,8 +138,10 @@ fn end_update(
         players += i64::from(session.roles.vive.is_some()) + i64::from(session.roles.phantom.is_some());
         kept += session.game.kept_seats() as i64;
     }
-    m.players.set(players);
-    m.seats_kept.set(kept);
+    // Every shard counts its own into the shared gauges: each adds what changed since it last did.
+    m.players.inc_by(players - seated.0);
+    m.seats_kept.inc_by(kept - seated.1);
+    *seated = (players, kept);
     if let Some(traffic) = transport.map(|t| t.traffic()) {
         m.bytes_received.inc_by(traffic.received.saturating_sub(counted.received));
         m.bytes_sent.inc_by(traffic.sent.saturating_sub(counted.sent));

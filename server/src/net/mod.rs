@@ -50,6 +50,8 @@ pub struct NetSettings {
     pub auth: Auth,
     /// The sessions, shared with the token endpoint.
     pub registry: Registry,
+    /// Which of the registry's shards this app plays.
+    pub shard: usize,
     /// Refused messages (leaking one per second) tolerated per client before it is disconnected for abuse.
     pub abuse_limit: u32,
     /// The address put in tokens and checked in connection requests, when not the bound one.
@@ -193,7 +195,7 @@ pub const MAX_SESSIONS: usize = 500;
 
 /// Spawns the game of every session the token endpoint opened.
 fn open_sessions(mut commands: Commands, settings: Res<NetSettings>) {
-    for entry in settings.registry.take_opened() {
+    for entry in settings.registry.take_opened(settings.shard) {
         let mut session = settings.new_sessions.session(&entry, None);
         session.log.record(0.0, crate::session::Record::SessionCreated, "session created; waiting for players".into());
         crate::session::spawn_session(&mut commands, session);

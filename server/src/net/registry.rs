@@ -45,11 +45,15 @@ pub struct SessionEntry {
     pub codes: CodeBook,
     /// Its seats.
     pub seats: Seats,
+    /// The shard that plays it: the replication server, on a game port of its own, its players connect to.
+    pub shard: usize,
 }
 
 struct Inner {
     sessions: HashMap<u64, SessionEntry>,
     rooms: HashMap<String, u64>,
+    /// Open sessions per shard.
+    load: Vec<usize>,
     opened: Vec<u64>,
     creates: KeyedLimiter<IpAddr>,
     draining: bool,
@@ -60,6 +64,7 @@ struct Inner {
 pub struct Registry {
     inner: Arc<Mutex<Inner>>,
     max: usize,
+    shard_size: usize,
     code_ttl: Duration,
     started: Instant,
 }
@@ -71,16 +76,24 @@ impl std::fmt::Debug for Registry {
 }
 
 impl Registry {
-    /// No session yet; at most `max` at once, codes valid for `code_ttl`.
+    /// No session yet; at most `max` at once, codes valid for `code_ttl`; one shard.
     pub fn new(max: usize, code_ttl: Duration, limits: CreateLimits) -> Self {
+        Self::sharded(max, max, code_ttl, limits)
+    }
+
+    /// No session yet; at most `max` at once, at most `shard_size` in each of
+    /// `max.div_ceil(shard_size)` shards; codes valid for `code_ttl`.
+    pub fn sharded(max: usize, shard_size: usize, code_ttl: Duration, limits: CreateLimits) -> Self {
+        let shard_size = shard_size.clamp(1, max.max(1));
         let inner = Inner {
             sessions: HashMap::new(),
             rooms: HashMap::new(),
+            load: vec![0; max.max(1).div_ceil(shard_size)],
             opened: Vec::new(),
             draining: false,
             creates: KeyedLimiter::new(limits.each, limits.all, 16_384),
         };
-        Self { inner: Arc::new(Mutex::new(inner)), max, code_ttl, started: Instant::now() }
+        Self { inner: Arc::new(Mutex::new(inner)), max, shard_size, code_ttl, started: Instant::now() }
     }
 
     fn lock(&self) -> MutexGuard<'_, Inner> {
@@ -100,6 +113,16 @@ impl Registry {
     /// The most sessions open at once.
     pub fn max(&self) -> usize {
         self.max
+    }
+
+    /// The shards sessions are spread over.
+    pub fn shards(&self) -> usize {
+        self.lock().load.len()
+    }
+
+    /// The most sessions one shard plays at once.
+    pub fn shard_size(&self) -> usize {
+        self.shard_size
     }
 
     /// Opens a session asked for from `from` (`None`: the host's own, never rate limited): a fresh id,
@@ -130,12 +153,17 @@ impl Registry {
                 break id;
             }
         };
+        // The least busy shard (the first of equals): sessions spread evenly, so each shard's
+        // replication walks as few of them as it can.
+        let (shard, _) = inner.load.iter().enumerate().min_by_key(|(i, n)| (**n, *i)).unwrap_or((0, &0));
         let entry = SessionEntry {
             id,
             room: room.clone(),
             codes: CodeBook::new(&room, self.code_ttl),
             seats: Seats::default(),
+            shard,
         };
+        inner.load[shard] += 1;
         inner.rooms.insert(room, id);
         inner.sessions.insert(id, entry.clone());
         inner.opened.push(id);
@@ -169,11 +197,23 @@ impl Registry {
         ids
     }
 
-    /// The sessions opened since the last call, for the game loop to spawn.
-    pub fn take_opened(&self) -> Vec<SessionEntry> {
+    /// The sessions of `shard` opened since the last call, for its game loop to spawn.
+    pub fn take_opened(&self, shard: usize) -> Vec<SessionEntry> {
         let mut inner = self.lock();
-        let ids = std::mem::take(&mut inner.opened);
-        ids.iter().filter_map(|id| inner.sessions.get(id).cloned()).collect()
+        if inner.opened.is_empty() {
+            return Vec::new();
+        }
+        let Inner { opened, sessions, .. } = &mut *inner;
+        let mut taken = Vec::new();
+        opened.retain(|id| match sessions.get(id) {
+            Some(entry) if entry.shard == shard => {
+                taken.push(entry.clone());
+                false
+            }
+            Some(_) => true,
+            None => false,
+        });
+        taken
     }
 
     /// The session whose room is `room`.
@@ -206,6 +246,9 @@ impl Registry {
         let mut inner = self.lock();
         if let Some(entry) = inner.sessions.remove(&id) {
             inner.rooms.remove(&entry.room);
+            if let Some(n) = inner.load.get_mut(entry.shard) {
+                *n = n.saturating_sub(1);
+            }
         }
     }
 }
@@ -244,8 +287,8 @@ mod tests {
         let (a, b) = (r.open(None).unwrap(), r.open(None).unwrap());
         assert_ne!((a.id, &a.room), (b.id, &b.room));
         assert!(a.codes.current().code.starts_with(&a.room), "{}", a.codes.current().code);
-        assert_eq!(r.take_opened().iter().map(|e| e.id).collect::<Vec<_>>(), [a.id, b.id]);
-        assert!(r.take_opened().is_empty());
+        assert_eq!(r.take_opened(0).iter().map(|e| e.id).collect::<Vec<_>>(), [a.id, b.id]);
+        assert!(r.take_opened(0).is_empty());
         let ticket = SeatTicket::random();
         a.seats.set(Role::Vive, Seat::Taken(ticket));
         assert_eq!(r.by_seat(Role::Vive, &ticket.public_id()).map(|(e, t)| (e.id, t)), Ok((a.id, ticket)));
@@ -255,6 +298,22 @@ mod tests {
         assert!(r.by_room(&a.room).is_none() && r.get(a.id).is_none());
         assert_eq!(r.by_seat(Role::Vive, &ticket.public_id()).map(|(e, _)| e.id), Err(JoinRefusal::NoSeat(Role::Vive)));
         assert_eq!(r.by_room(&b.room).map(|e| e.id), Some(b.id));
+    }
+
+    #[test]
+    fn sessions_spread_over_the_shards_evenly_and_a_closed_one_frees_its_shards_place() {
+        let r = Registry::sharded(7, 3, Duration::from_secs(60), CreateLimits::default());
+        assert_eq!(r.shards(), 3, "7 sessions of at most 3 a shard need 3 shards");
+        let opened: Vec<SessionEntry> = (0..6).map(|_| r.open(None).unwrap()).collect();
+        assert_eq!(opened.iter().map(|e| e.shard).collect::<Vec<_>>(), [0, 1, 2, 0, 1, 2]);
+        assert_eq!(r.take_opened(1).iter().map(|e| e.id).collect::<Vec<_>>(), [opened[1].id, opened[4].id]);
+        assert!(r.take_opened(1).is_empty(), "taken once");
+        assert_eq!(r.take_opened(0).len(), 2, "shard 0's are still there for it");
+        r.close(opened[4].id);
+        assert_eq!(r.open(None).unwrap().shard, 1, "the freed place is the least busy");
+        assert_eq!(r.open(None).unwrap().shard, 0);
+        assert_eq!(r.open(None).map(|e| e.id), Err(JoinRefusal::Full { max: 7 }), "the whole server's limit holds");
+        assert_eq!(Registry::sharded(5, 0, Duration::from_secs(60), CreateLimits::default()).shards(), 5);
     }
 
     #[test]

@@ -30,13 +30,18 @@ pub struct Traffic {
     pub received: u64,
     /// Sent.
     pub sent: u64,
+    /// Datagrams received.
+    pub datagrams_received: u64,
+    /// Datagrams sent.
+    pub datagrams_sent: u64,
 }
 
 /// `send_to` that also counts what it sends.
-fn counted<'a>(socket: &'a UdpSocket, sent: &'a mut u64) -> impl FnMut(SocketAddr, &[u8]) + 'a {
+fn counted<'a>(socket: &'a UdpSocket, traffic: &'a mut Traffic) -> impl FnMut(SocketAddr, &[u8]) + 'a {
     let mut send = send_to(socket);
     move |to, bytes| {
-        *sent += bytes.len() as u64;
+        traffic.sent += bytes.len() as u64;
+        traffic.datagrams_sent += 1;
         send(to, bytes);
     }
 }
@@ -103,10 +108,11 @@ pub(super) fn add_systems(app: &mut App) {
 fn receive(mut transport: ResMut<GameTransport>, mut renet: ResMut<RenetServer>, time: Res<Time<Real>>) {
     let GameTransport { socket, intake, buffer, bytes } = &mut *transport;
     intake.advance(time.delta());
-    let mut received = 0;
-    let mut send = counted(socket, &mut bytes.sent);
+    let (mut received, mut datagrams) = (0, 0);
+    let mut send = counted(socket, bytes);
     let drained = socket::drain(socket, buffer, MAX_DATAGRAMS_PER_FRAME, |from, datagram| {
         received += datagram.len() as u64;
+        datagrams += 1;
         // Refusals are counted and logged (throttled) by the intake.
         let _ = intake.receive(from, datagram, &mut renet, &mut send);
     });
@@ -114,12 +120,14 @@ fn receive(mut transport: ResMut<GameTransport>, mut renet: ResMut<RenetServer>,
         error!("the game socket failed: {e}");
     }
     intake.update(&mut renet, &mut send);
+    drop(send);
     bytes.received += received;
+    bytes.datagrams_received += datagrams;
 }
 
 fn send(mut transport: ResMut<GameTransport>, mut renet: ResMut<RenetServer>) {
     let GameTransport { socket, intake, bytes, .. } = &mut *transport;
-    intake.send_packets(&mut renet, &mut counted(socket, &mut bytes.sent));
+    intake.send_packets(&mut renet, &mut counted(socket, bytes));
 }
 
 fn disconnect_on_exit(

@@ -93,7 +93,7 @@ pub fn host_with_a_vive_bot(
             if stall.load(Ordering::Relaxed) {
                 continue;
             }
-            server.app.update();
+            server.update();
             if vive.is_none() && server.game().is_present(Role::Phantom) {
                 let app = heist_server::demo::join(&server, Role::Vive, |app| {
                     app.add_plugins(heist_bots::ViveBotPlugin { style: heist_bots::ViveStyle::Idle })

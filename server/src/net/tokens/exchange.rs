@@ -193,17 +193,17 @@ async fn exchange(stream: &mut TcpStream, peer: SocketAddr, shared: &Shared) -> 
     let reply = match request {
         Request::Join(entry) => {
             entry.seats.check_join(role).map_err(Failure::Refused)?;
-            let token = mint(&shared.config, entry.id, role, None).map_err(internal)?;
+            let token = mint(&shared.config, &entry, role, None).map_err(internal)?;
             JoinReply::Token { sealed: keys.seal(&token).map_err(internal)? }
         }
         Request::Resume(entry, ticket) => {
-            let token = mint(&shared.config, entry.id, role, Some(ticket)).map_err(internal)?;
+            let token = mint(&shared.config, &entry, role, Some(ticket)).map_err(internal)?;
             JoinReply::Token { sealed: keys.seal(&token).map_err(internal)? }
         }
         Request::Create => {
             let entry = registry.open(Some(peer.ip())).map_err(Failure::Refused)?;
             log::info!("token endpoint: {peer} created a session ({} open)", registry.len());
-            let token = mint(&shared.config, entry.id, role, None).map_err(internal)?;
+            let token = mint(&shared.config, &entry, role, None).map_err(internal)?;
             let created = postcard::to_allocvec(&NewSession { code: entry.codes.current().code, token })
                 .map_err(|e| internal(format!("cannot encode the new session: {e}")))?;
             JoinReply::Created { sealed: keys.seal(&created).map_err(internal)? }
@@ -215,16 +215,22 @@ async fn exchange(stream: &mut TcpStream, peer: SocketAddr, shared: &Shared) -> 
 
 /// A connect token for `role` in netcode's wire format.
 /// A resume's token carries the seat ticket it proved, for admission to check again.
-fn mint(config: &TokenConfig, session: u64, role: Role, ticket: Option<SeatTicket>) -> Result<Vec<u8>, String> {
+fn mint(
+    config: &TokenConfig,
+    session: &SessionEntry,
+    role: Role,
+    ticket: Option<SeatTicket>,
+) -> Result<Vec<u8>, String> {
     let now = SystemTime::now().duration_since(UNIX_EPOCH).unwrap_or_default();
-    let user_data = TokenUserData { role, session, ticket }.encode();
+    let user_data = TokenUserData { role, session: session.id, ticket }.encode();
+    let server = *config.server_addrs.get(session.shard).ok_or_else(|| format!("no shard {}", session.shard))?;
     let token = ConnectToken::generate(
         now,
         PROTOCOL_ID,
         TOKEN_EXPIRE_S,
         rand::random(),
         TIMEOUT_S,
-        vec![config.server_addr],
+        vec![server],
         Some(&user_data),
         &config.private_key,
     )

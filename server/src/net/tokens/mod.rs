@@ -106,7 +106,7 @@ pub struct TokenLimits {
 }
 
 /// How many sessions a `serve` hosts at once unless told otherwise.
-pub const DEFAULT_MAX_SESSIONS: usize = 32;
+pub const DEFAULT_MAX_SESSIONS: usize = 96;
 
 impl Default for TokenLimits {
     fn default() -> Self {
@@ -127,8 +127,9 @@ pub struct TokenConfig {
     pub registry: Registry,
     /// Netcode private key shared with the game server.
     pub private_key: [u8; 32],
-    /// The game server's public UDP address (must equal the server's `public_addresses`).
-    pub server_addr: SocketAddr,
+    /// Each shard's public UDP address (must equal that shard's `public_addresses`): a session's tokens
+    /// name its shard's.
+    pub server_addrs: Vec<SocketAddr>,
     /// Limits.
     pub limits: TokenLimits,
     /// Where refusals are counted.

@@ -8,6 +8,7 @@ mod ids;
 pub mod join;
 mod replicated;
 mod server_msg;
+mod spread;
 mod token;
 mod verify;
 pub mod voice;
@@ -15,12 +16,13 @@ pub mod voice;
 pub use client_msg::{ClientMsg, Gait, LobbyMsg, PhantomMsg, ViveMsg, WarningKind, decode as decode_client_msg};
 pub use ids::{CaseId, GuardId, ItemId, Role};
 pub use replicated::{
-    Audience, CaseView, ClientRole, GuardAlert, GuardView, ItemKind, ItemPlace, ItemView, LossReason, PhantomTool,
-    Phase, REPLICATED, SessionView, Stance, ViveAvatar,
+    Audience, CaseView, Cases, ClientRole, GuardAlert, GuardView, Guards, ItemKind, ItemPlace, ItemView, Items,
+    LossReason, PhantomTool, Phase, REPLICATED, SessionView, Stance, ViveAvatar,
 };
 pub use server_msg::{
     DisconnectReason, GameEvent, NoiseKind, RadioAbout, Refusal, ServerMsg, VerdictOutcome, WorkbenchCopy,
 };
+pub use spread::{Spread, SpreadSystems};
 pub use token::{SeatTicket, TokenUserData, USER_DATA_MAGIC};
 pub use verify::verify;
 pub use voice::{ClientVoice, PartnerVoice, VoiceFrame};
@@ -29,7 +31,7 @@ use bevy::prelude::*;
 use bevy_replicon::prelude::*;
 
 /// Netcode protocol id: bumps whenever the wire format changes.
-pub const PROTOCOL_ID: u64 = 0x5048_4549_5354_0001;
+pub const PROTOCOL_ID: u64 = 0x5048_4549_5354_0002;
 
 /// Server simulation rate (FixedUpdate), Hz.
 pub const TICK_HZ: f64 = 60.0;
@@ -61,6 +63,7 @@ pub struct ProtocolPlugin;
 impl Plugin for ProtocolPlugin {
     fn build(&self, app: &mut App) {
         replicated::register(app);
+        spread::add_systems(app);
         app.add_client_message_with::<ClientMsg>(
             GameChannel::Commands.replicon(),
             client_msg::serialize,

@@ -18,23 +18,42 @@ use crate::artifact::{ArtifactKind, ArtifactLook};
 pub const REPLICATED: &[(&str, &str)] = &[
     ("SessionView", "both"),
     ("ViveAvatar", "both"),
-    ("GuardView", "Phantom always; Vive only while he could see or hear the guard (the server's interest management)"),
-    ("CaseView", "both"),
-    ("ItemView", "both (copies share one look; no real/fake flag exists)"),
     ("PhantomTool", "both"),
+    ("Cases", "both (every display case of the session)"),
+    ("Items", "both (copies share one look; no real/fake flag exists)"),
+    (
+        "Guards",
+        "two per session: one for Vive alone with the guards he could see or hear now (the server's \
+         interest management), one for Phantom alone with every guard",
+    ),
     ("Audience", "both (the visibility filter itself)"),
 ];
 
 pub(super) fn register(app: &mut App) {
     app.replicate::<SessionView>()
         .replicate::<ViveAvatar>()
-        .replicate::<GuardView>()
-        .replicate::<CaseView>()
-        .replicate::<ItemView>()
         .replicate::<PhantomTool>()
+        .replicate::<Cases>()
+        .replicate::<Items>()
+        .replicate::<Guards>()
         .replicate::<Audience>()
         .add_visibility_filter::<Audience>();
 }
+
+/// A session's display cases, in level order: one replicated component for all of them (a server's
+/// replication walks entities × clients, so a session replicates few entities). A client spreads it
+/// into one local entity per case carrying its [`CaseView`], which is what game code queries.
+#[derive(Component, Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Cases(pub Vec<CaseView>);
+
+/// A session's items, in level order; spread on a client into one local [`ItemView`] entity each.
+#[derive(Component, Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Items(pub Vec<ItemView>);
+
+/// Guards, in level order; spread on a client into one local [`GuardView`] entity per guard it was
+/// sent.
+#[derive(Component, Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Guards(pub Vec<GuardView>);
 
 /// Which roles may see a replicated entity.
 #[derive(Component, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -166,7 +185,7 @@ pub enum GuardAlert {
     Searching,
 }
 
-/// A guard.
+/// A guard (on a client, a local entity spread from [`Guards`]).
 #[derive(Component, Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct GuardView {
     /// Which guard.
@@ -181,7 +200,7 @@ pub struct GuardView {
     pub alert: GuardAlert,
 }
 
-/// A display case.
+/// A display case (on a client, a local entity spread from [`Cases`]).
 #[derive(Component, Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CaseView {
     /// Which case.
@@ -223,7 +242,7 @@ pub enum ItemPlace {
     Discarded,
 }
 
-/// An item.
+/// An item (on a client, a local entity spread from [`Items`]).
 #[derive(Component, Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ItemView {
     /// Which item.
