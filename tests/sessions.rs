@@ -154,30 +154,45 @@ fn held(app: &mut bevy::prelude::App) -> [usize; 6] {
     ]
 }
 
+/// A server with `n` sessions, each made by a careful Vive bot and a Phantom bot for one round of
+/// `time_limit_s` that ends `idle_end_s` after its result; `probe` adds a test's systems to every client.
+fn bot_sessions(
+    n: usize,
+    time_limit_s: f32,
+    idle_end_s: f32,
+    probe: impl Fn(&mut bevy::prelude::App) + Copy,
+) -> (heist_server::HostedServer, Vec<bevy::prelude::App>) {
+    let mut options = heist_server::load::load_server_options(n);
+    options.game.time_limit_s = Some(time_limit_s);
+    options.game.idle_end_s = Some(idle_end_s);
+    let server = build_server(options).expect("server starts");
+    let mut clients = Vec::with_capacity(2 * n);
+    for _ in 0..n {
+        clients.extend(heist_server::load::create_bot_pair(&server, ViveStyle::Careful, 1, probe).expect("a pair"));
+    }
+    assert_eq!(server.registry.len(), n);
+    (server, clients)
+}
+
+/// Every one of the `n` sessions has played its round to a result.
+fn all_over(server: &mut heist_server::HostedServer, n: usize) -> bool {
+    let sessions = server.sessions();
+    sessions.len() == n && sessions.iter().all(|s| !s.game.is_running() && s.game.phase != Phase::Lobby)
+}
+
 #[test]
 fn twenty_sessions_of_bot_pairs_play_whole_heists_at_once_and_no_client_sees_another_sessions_entities_or_messages() {
     const SESSIONS: usize = 20;
-    let mut options = heist_server::load::load_server_options(SESSIONS);
-    options.game.time_limit_s = Some(60.0);
-    options.game.idle_end_s = Some(3.0);
-    let mut server = build_server(options).expect("server starts");
     let probe = |app: &mut bevy::prelude::App| {
         app.init_resource::<Heard>().add_systems(bevy::prelude::PreUpdate, hear);
     };
-    let mut clients = Vec::new();
-    for _ in 0..SESSIONS {
-        clients.extend(heist_server::load::create_bot_pair(&server, ViveStyle::Careful, 1, probe).expect("a pair"));
-    }
-    assert_eq!(server.registry.len(), SESSIONS);
+    let (mut server, mut clients) = bot_sessions(SESSIONS, 60.0, 3.0, probe);
     assert!(server.shards.len() > 1, "the sessions are spread over shards, each a replication server of its own");
     let level = heist_shared::level::Level::museum();
     let most = [1, 1, 1, level.guards.len(), level.cases.len(), usize::MAX];
     let mut all_running_at_once = false;
     let mut own_entities_seen = vec![false; clients.len()];
-    let over = |server: &mut heist_server::HostedServer| {
-        let sessions = server.sessions();
-        sessions.len() == SESSIONS && sessions.iter().all(|s| !s.game.is_running() && s.game.phase != Phase::Lobby)
-    };
+    let over = |server: &mut heist_server::HostedServer| all_over(server, SESSIONS);
     let mut ticks = 0;
     while !over(&mut server) && ticks < 90 * HZ {
         server.update();
@@ -243,12 +258,7 @@ fn twenty_sessions_of_bot_pairs_play_whole_heists_at_once_and_no_client_sees_ano
 
     // Over, the sessions end and free what they held: codes, seats, games, mirrors.
     let freed = |server: &mut heist_server::HostedServer| {
-        let mut mirrors = 0;
-        for shard in &mut server.shards {
-            let world = shard.app.world_mut();
-            mirrors += world.query::<&bevy_replicon::prelude::Replicated>().iter(world).count();
-        }
-        server.sessions().is_empty() && server.registry.is_empty() && mirrors == 0
+        server.sessions().is_empty() && server.registry.is_empty() && mirrors(server) == 0
     };
     let mut ticks = 0;
     while !freed(&mut server) && ticks < 30 * HZ {
@@ -277,15 +287,7 @@ fn mirrors(server: &mut heist_server::HostedServer) -> usize {
 #[test]
 fn three_hundred_sessions_in_one_process_are_created_played_and_closed_and_no_client_sees_another_sessions_entities() {
     const SESSIONS: usize = 300;
-    let mut options = heist_server::load::load_server_options(SESSIONS);
-    options.game.time_limit_s = Some(8.0);
-    options.game.idle_end_s = Some(1.0);
-    let mut server = build_server(options).expect("server starts");
-    let mut clients = Vec::with_capacity(2 * SESSIONS);
-    for _ in 0..SESSIONS {
-        clients.extend(heist_server::load::create_bot_pair(&server, ViveStyle::Careful, 1, |_| {}).expect("a pair"));
-    }
-    assert_eq!(server.registry.len(), SESSIONS);
+    let (mut server, mut clients) = bot_sessions(SESSIONS, 8.0, 1.0, |_| {});
     assert_eq!(server.shards.len(), SESSIONS.div_ceil(server.registry.shard_size()), "spread over shards");
     let level = heist_shared::level::Level::museum();
     let most = [1, 1, 1, level.guards.len(), level.cases.len(), usize::MAX];
@@ -295,10 +297,7 @@ fn three_hundred_sessions_in_one_process_are_created_played_and_closed_and_no_cl
         server.update();
         clients.iter_mut().for_each(bevy::prelude::App::update);
     };
-    let over = |server: &mut heist_server::HostedServer| {
-        let sessions = server.sessions();
-        sessions.len() == SESSIONS && sessions.iter().all(|s| !s.game.is_running() && s.game.phase != Phase::Lobby)
-    };
+    let over = |server: &mut heist_server::HostedServer| all_over(server, SESSIONS);
     let mut ticks = 0;
     while !over(&mut server) && ticks < 30 * HZ {
         step(&mut server, &mut clients);

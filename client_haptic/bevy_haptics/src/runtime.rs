@@ -328,7 +328,7 @@ pub(crate) fn read_threads(
         stats.collision.record(s.start_us);
     }
     for s in &frame.samples {
-        stats.record_force(s.force, s.torque);
+        stats.record_force_at(s.t_us, s.force, s.torque);
     }
 }
 

@@ -102,6 +102,9 @@ pub struct HapticStats {
     pub max_force_n: f32,
     /// Largest change of the device's force between two consecutive ticks, N.
     pub max_force_step_n: f32,
+    /// Largest rate of change of the device's force between two consecutive ticks, N/s (a late tick's
+    /// larger step over its longer interval; the safety layer bounds this one).
+    pub max_force_rate_n_per_s: f32,
     /// Largest torque sent to the device, N·m.
     pub max_torque_nm: f32,
     /// Contacts started so far.
@@ -110,6 +113,8 @@ pub struct HapticStats {
     pub non_finite: bool,
     /// The last tick's force, N (for the next step).
     pub(crate) last_force: Option<Vec3>,
+    /// The last timed tick's device time, µs, and force, N.
+    pub(crate) last_timed: Option<(u64, Vec3)>,
 }
 
 impl HapticStats {
@@ -126,6 +131,22 @@ impl HapticStats {
             self.max_force_step_n = self.max_force_step_n.max((force - last).length());
         }
         self.last_force = Some(force);
+    }
+
+    /// Adds one tick's force sent to the device at device time `t_us`: [`HapticStats::record_force`] and
+    /// the rate of change since the previous timed tick.
+    pub fn record_force_at(&mut self, t_us: u64, force: Vec3, torque: Vec3) {
+        self.record_force(force, torque);
+        if !force.is_finite() {
+            return;
+        }
+        if let Some((t0, f0)) = self.last_timed
+            && t_us > t0
+        {
+            let rate = (force - f0).length() / ((t_us - t0) as f32 * 1e-6);
+            self.max_force_rate_n_per_s = self.max_force_rate_n_per_s.max(rate);
+        }
+        self.last_timed = Some((t_us, force));
     }
 }
 
@@ -158,6 +179,12 @@ mod tests {
         stats.record_force(Vec3::X * 2.0, Vec3::ZERO);
         stats.record_force(Vec3::X * 2.5, Vec3::ZERO);
         assert_eq!((stats.max_force_n, stats.max_force_step_n, stats.ticks), (2.5, 2.0, 3));
+        let mut timed = HapticStats::default();
+        timed.record_force_at(1_000, Vec3::ZERO, Vec3::ZERO);
+        timed.record_force_at(2_000, Vec3::X * 0.5, Vec3::ZERO);
+        timed.record_force_at(5_000, Vec3::X * 1.5, Vec3::ZERO);
+        assert_eq!(timed.max_force_step_n, 1.0, "the late tick's step");
+        assert!((timed.max_force_rate_n_per_s - 500.0).abs() < 1e-3, "{}", timed.max_force_rate_n_per_s);
         stats.record_force(Vec3::NAN, Vec3::ZERO);
         assert!(stats.non_finite);
     }

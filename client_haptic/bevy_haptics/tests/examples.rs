@@ -46,9 +46,10 @@ fn check(report: &serde_json::Value, name: &str, seconds: f64, peak_n: f64, coll
     assert!(number(report, "contacts") > 0.0, "the path touches: {report}");
     let force = number(report, "max_force_n");
     assert!(force > 0.05 && force <= peak_n + 1e-3, "a force within the device's peak: {report}");
-    // The safety layer moves the force by at most 500 N/s: 0.5 N a tick at 1 kHz (a little more on a
-    // late tick).
-    assert!(number(report, "max_force_step_n") <= 1.0, "{report}");
+    // The safety layer moves the force by at most 500 N/s × the tick's interval: 0.5 N a tick at 1 kHz,
+    // more on a late tick (a busy machine), so the rate is what is bounded (device time and the safety
+    // layer's clock may differ by a little).
+    assert!(number(report, "max_force_rate_n_per_s") <= 550.0, "{report}");
     let threads: &[&str] = if collision { &["haptic", "collision"] } else { &["haptic"] };
     for thread in threads {
         assert!(number(report, &format!("{thread}_hz_median")) >= 800.0, "{thread}: {report}");

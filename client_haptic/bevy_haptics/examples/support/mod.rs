@@ -165,6 +165,7 @@ fn end(
         "contacts": stats.contacts_started,
         "max_force_n": stats.max_force_n,
         "max_force_step_n": stats.max_force_step_n,
+        "max_force_rate_n_per_s": stats.max_force_rate_n_per_s,
         "max_torque_nm": stats.max_torque_nm,
         "ticks": stats.ticks,
         "non_finite": stats.non_finite,
