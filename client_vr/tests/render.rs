@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use client_vr::space;
 use heist_server::{ServerOptions, build_server};
-use heist_shared::protocol::{GuardView, TICK_HZ};
+use heist_shared::protocol::TICK_HZ;
 
 fn decode(path: &std::path::Path) -> (u32, u32, Vec<[u8; 3]>) {
     let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).expect("screenshot exists")));
@@ -102,9 +102,16 @@ fn desktop_mode_joins_a_server_and_shows_the_museum() {
     // patrol, glowing, 1.9 m up) lies within 10 px of his server position projected to the screen.
     let level = heist_shared::level::Level::museum();
     let walls = heist_shared::level::WallSet::new(&level);
+    // The server's guard lists (Vive's perceived ones and Phantom's whole list), each guard once.
     let guards: Vec<(String, glam::Vec2)> = {
         let world = server.world_mut();
-        world.query::<&GuardView>().iter(world).map(|g| (g.name.clone(), g.position)).collect()
+        let mut all: Vec<(String, glam::Vec2)> = Vec::new();
+        for list in world.query::<&heist_shared::protocol::Guards>().iter(world) {
+            for g in list.0.iter().filter(|g| all.iter().all(|(name, _)| *name != g.name)) {
+                all.push((g.name.clone(), g.position));
+            }
+        }
+        all
     };
     let eye = space::world(level.vive_spawn, space::EYE_HEIGHT_M);
     // The desktop camera faces east (facing 0) with the default pitch until the mouse moves it.
