@@ -107,8 +107,10 @@ fn desktop_mode_joins_a_server_and_shows_the_museum() {
         let world = server.world_mut();
         let mut all: Vec<(String, glam::Vec2)> = Vec::new();
         for list in world.query::<&heist_shared::protocol::Guards>().iter(world) {
-            for g in list.0.iter().filter(|g| all.iter().all(|(name, _)| *name != g.name)) {
-                all.push((g.name.clone(), g.position));
+            for g in &list.0 {
+                if all.iter().all(|(name, _)| *name != g.name) {
+                    all.push((g.name.clone(), g.position));
+                }
             }
         }
         all
