@@ -4,4 +4,4 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/deps.sh
-cargo run --release --locked -p heist_server -- demo "$@"
+cargo run --release --locked -p heist_server --features bots -- demo "$@"

@@ -23,7 +23,8 @@ pub struct Embedded {
     pub code: String,
 }
 
-/// The `host` command's flags, the same in both clients.
+/// The `host` command's flags, the same in both clients (the `cli` feature).
+#[cfg(feature = "cli")]
 #[derive(clap::Args, Clone, Copy, Debug)]
 pub struct HostFlags {
     /// Where the server listens (UDP game, TCP join endpoint); 0.0.0.0 for players on other machines.
@@ -46,6 +47,7 @@ pub struct HostFlags {
     pub server: Option<SocketAddr>,
 }
 
+#[cfg(feature = "cli")]
 impl HostFlags {
     /// The server to start here (when `--server` names none).
     pub fn options(&self) -> HostOptions {

@@ -4,10 +4,12 @@
 //! binary, the demo and the end-to-end tests all start the same server in-process.
 #![warn(missing_docs)]
 
+#[cfg(feature = "bots")]
 pub mod demo;
 pub mod embedded;
 pub mod fleet;
 pub mod game;
+#[cfg(feature = "bots")]
 pub mod load;
 pub mod net;
 pub mod session;

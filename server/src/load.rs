@@ -244,7 +244,9 @@ pub fn run_load(options: &LoadOptions, mut progress: impl FnMut(&str)) -> anyhow
     let mut server =
         build_server(ServerOptions { shard_size: options.shard_size, ..load_server_options(options.sessions) })?;
     let fleet = crate::fleet::FleetOptions { metrics: options.metrics, agones: None };
-    let services = crate::fleet::FleetServices::start(&server, &fleet)?;
+    let game =
+        crate::fleet::agones::GameServerInfo { registry: server.registry.clone(), advertised: server.advertised };
+    let services = crate::fleet::FleetServices::start(&server.fleet, game, &fleet)?;
     if let Some(http) = &services.http {
         progress(&format!("health and metrics on http://{}/healthz and /metrics", http.addr));
     }

@@ -10,7 +10,7 @@ use agones_fake::{Declared, FakeAgones, Recorded};
 use bevy::prelude::*;
 use heist_bots::ViveStyle;
 use heist_server::build_server;
-use heist_server::fleet::agones::{AgonesOptions, PLAYERS_LIST, SESSIONS_COUNTER};
+use heist_server::fleet::agones::{AgonesOptions, GameServerInfo, PLAYERS_LIST, SESSIONS_COUNTER};
 use heist_server::fleet::{FleetOptions, FleetServices};
 use heist_server::load::{create_bot_pair, load_server_options};
 
@@ -52,7 +52,9 @@ fn agones_hears_ready_health_the_sessions_counter_players_list_a_stall_and_shutd
         health_every: Duration::from_millis(50),
         sync_every: Duration::from_millis(50),
     };
-    let services = FleetServices::start(&server, &FleetOptions { metrics: None, agones: Some(agones) }).unwrap();
+    let game = GameServerInfo { registry: server.registry.clone(), advertised: server.advertised };
+    let services =
+        FleetServices::start(&server.fleet, game, &FleetOptions { metrics: None, agones: Some(agones) }).unwrap();
     let long = Duration::from_secs(30);
 
     // Ready once the sockets are bound, the address and version told, capacities set from --max-sessions;

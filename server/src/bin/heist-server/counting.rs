@@ -1,4 +1,4 @@
-//! The binary's allocator: the system's, counting the net bytes allocated while a thread is flagged as
+//! The binary's allocator (a build with the `bots` feature, for `load`): the system's, counting the net bytes allocated while a thread is flagged as
 //! doing the server's work, so `load` can tell the server's heap from its bots' in one process.
 
 use std::alloc::{GlobalAlloc, Layout, System};
