@@ -7,8 +7,8 @@
 use bevy::prelude::*;
 use heist_bots::{Seen, ViveBrain, ViveStyle};
 
-use crate::client::ViveState;
 use crate::intent::{Action, Intent, IntentSystems};
+use crate::state::ViveState;
 
 /// The bot's play style (default careful).
 #[derive(Resource, Clone, Copy, Debug, Default)]

@@ -8,7 +8,7 @@ use bevy::input::mouse::AccumulatedMouseMotion;
 use bevy::prelude::*;
 use bevy::window::{CursorGrabMode, CursorOptions, PrimaryWindow};
 use glam::{Vec2, Vec3};
-use heist_shared::protocol::{CaseView, Gait, ItemKind, ItemView, Phase};
+use heist_shared::protocol::{CaseId, CaseView, Gait, ItemId, ItemKind, ItemView, Phase};
 use heist_shared::rules;
 
 use crate::client::{ViveState, ViveSystems};
@@ -48,7 +48,10 @@ impl Plugin for DesktopPlugin {
             .add_systems(Startup, spawn_camera)
             .add_systems(Update, follow_body.in_set(ViveSystems::Present).before(crate::world::WorldSystems));
         if self.input {
-            app.add_systems(RunFixedMainLoop, (capture_cursor, look, keys).chain().in_set(IntentSystems::Gather));
+            app.init_resource::<DesktopInput>().add_systems(
+                RunFixedMainLoop,
+                (capture_cursor, look, read_keys, use_keys).chain().in_set(IntentSystems::Gather),
+            );
         }
     }
 }
@@ -113,74 +116,153 @@ pub fn walk_direction(forward: bool, back: bool, left: bool, right: bool, facing
     (ahead * f + side * s).normalize_or_zero()
 }
 
-#[allow(clippy::too_many_arguments)]
-fn keys(
+/// This frame's keyboard and mouse, as the desktop player uses them.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
+pub struct DesktopInput {
+    /// W, S, A, D held: forward, back, left, right.
+    pub walk: [bool; 4],
+    /// Ctrl held.
+    pub crouch: bool,
+    /// Shift held.
+    pub run: bool,
+    /// Enter pressed.
+    pub enter: bool,
+    /// E pressed: break.
+    pub break_case: bool,
+    /// The left button clicked with the cursor captured (the first click only captures it).
+    pub click: bool,
+    /// F pressed: place.
+    pub place: bool,
+    /// Q pressed: drop.
+    pub drop: bool,
+}
+
+/// Where the desktop player stands, as far as the keys care.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DesktopSituation<'a> {
+    /// The session's phase.
+    pub phase: Phase,
+    /// The view's heading, radians.
+    pub facing: f32,
+    /// The view's pitch, radians (negative looks down).
+    pub pitch: f32,
+    /// The body is placed (the level arrived).
+    pub placed: bool,
+    /// What Vive carries, oldest first.
+    pub carrying: &'a [ItemId],
+    /// The item in front, within reach.
+    pub item_ahead: Option<ItemId>,
+    /// The unbroken case in front, within reach.
+    pub case_ahead: Option<CaseId>,
+    /// A carried copy (the first), for the workbench.
+    pub carried_copy: Option<ItemId>,
+    /// Where the body is (throws start there).
+    pub body: Vec2,
+}
+
+/// What the desktop player's input asks for: how to walk, and the actions for the server in order.
+pub fn decide(input: &DesktopInput, at: &DesktopSituation) -> (Vec2, Gait, Vec<Action>) {
+    let [forward, back, left, right] = input.walk;
+    let movement = walk_direction(forward, back, left, right, at.facing);
+    let gait = if input.crouch {
+        Gait::Crouch
+    } else if input.run {
+        Gait::Run
+    } else {
+        Gait::Walk
+    };
+    let mut actions = Vec::new();
+    if input.enter
+        && let Some(action) = enter_action(at.phase)
+    {
+        actions.push(action);
+    }
+    if !at.placed {
+        return (movement, gait, actions);
+    }
+    if input.break_case
+        && let Some(case) = at.case_ahead
+    {
+        actions.push(Action::Break(case));
+    }
+    if input.click {
+        let hands_full = at.carrying.len() >= rules::CARRY_LIMIT;
+        match (hands_full, at.item_ahead, at.carrying.first()) {
+            (false, Some(item), _) => actions.push(Action::PickUp(item)),
+            (_, _, Some(&item)) => {
+                // Throw where the view meets the floor.
+                let down = (-at.pitch).max(0.05);
+                let distance = space::EYE_HEIGHT_M / down.tan();
+                let aim = Aim { from: at.body, towards: Vec2::new(at.facing.cos(), at.facing.sin()) };
+                actions.push(Action::Throw { item, target: aim.throw_target(distance) });
+            }
+            _ => {}
+        }
+    }
+    if input.place
+        && let Some(item) = at.carried_copy
+    {
+        actions.push(Action::Place(item));
+    }
+    if input.drop
+        && let Some(&item) = at.carrying.last()
+    {
+        actions.push(Action::Drop(item));
+    }
+    (movement, gait, actions)
+}
+
+/// Reads the keyboard and the mouse's buttons into [`DesktopInput`].
+fn read_keys(
     keys: Res<ButtonInput<KeyCode>>,
     buttons: Res<ButtonInput<MouseButton>>,
     cursor: Query<&CursorOptions, With<PrimaryWindow>>,
+    mut input: ResMut<DesktopInput>,
+) {
+    let captured = cursor.single().is_ok_and(|c| c.grab_mode != CursorGrabMode::None);
+    *input = DesktopInput {
+        walk: [KeyCode::KeyW, KeyCode::KeyS, KeyCode::KeyA, KeyCode::KeyD].map(|k| keys.pressed(k)),
+        crouch: keys.any_pressed([KeyCode::ControlLeft, KeyCode::ControlRight]),
+        run: keys.any_pressed([KeyCode::ShiftLeft, KeyCode::ShiftRight]),
+        enter: keys.just_pressed(KeyCode::Enter),
+        break_case: keys.just_pressed(KeyCode::KeyE),
+        click: buttons.just_pressed(MouseButton::Left) && captured,
+        place: keys.just_pressed(KeyCode::KeyF),
+        drop: keys.just_pressed(KeyCode::KeyQ),
+    };
+}
+
+/// Turns the desktop input into the intent (see [`decide`]).
+fn use_keys(
+    input: Res<DesktopInput>,
     view: Res<Look>,
     mut intent: ResMut<Intent>,
     state: Res<ViveState>,
     cases: Query<&CaseView>,
     items: Query<&ItemView>,
 ) {
-    intent.movement = walk_direction(
-        keys.pressed(KeyCode::KeyW),
-        keys.pressed(KeyCode::KeyS),
-        keys.pressed(KeyCode::KeyA),
-        keys.pressed(KeyCode::KeyD),
-        intent.facing,
-    );
-    intent.gait = if keys.any_pressed([KeyCode::ControlLeft, KeyCode::ControlRight]) {
-        Gait::Crouch
-    } else if keys.any_pressed([KeyCode::ShiftLeft, KeyCode::ShiftRight]) {
-        Gait::Run
-    } else {
-        Gait::Walk
-    };
-    if keys.just_pressed(KeyCode::Enter)
-        && let Some(action) = enter_action(state.phase)
-    {
-        intent.actions.push(action);
-    }
-    let Some(body) = state.body() else { return };
-    let aim = Aim { from: body, towards: Vec2::new(intent.facing.cos(), intent.facing.sin()) };
+    let body = state.body();
+    let aim = Aim { from: body.unwrap_or_default(), towards: Vec2::new(intent.facing.cos(), intent.facing.sin()) };
     let case_refs: Vec<&CaseView> = cases.iter().collect();
-    if keys.just_pressed(KeyCode::KeyE)
-        && let Some(case) = aim.case(cases)
-    {
-        intent.actions.push(Action::Break(case));
-    }
-    // The first click only captures the cursor.
-    let captured = cursor.single().is_ok_and(|c| c.grab_mode != CursorGrabMode::None);
-    if buttons.just_pressed(MouseButton::Left) && captured {
-        let hands_full = state.carrying.len() >= rules::CARRY_LIMIT;
-        match (hands_full, aim.item(items.iter(), &case_refs), state.carrying.first()) {
-            (false, Some(item), _) => intent.actions.push(Action::PickUp(item)),
-            (_, _, Some(&item)) => {
-                // Throw where the view meets the floor.
-                let down = (-view.pitch).max(0.05);
-                let distance = space::EYE_HEIGHT_M / down.tan();
-                intent.actions.push(Action::Throw { item, target: aim.throw_target(distance) });
-            }
-            _ => {}
-        }
-    }
-    if keys.just_pressed(KeyCode::KeyF) {
-        let copy = state
+    let situation = DesktopSituation {
+        phase: state.phase,
+        facing: intent.facing,
+        pitch: view.pitch,
+        placed: body.is_some(),
+        carrying: &state.carrying,
+        item_ahead: body.and_then(|_| aim.item(items.iter(), &case_refs)),
+        case_ahead: body.and_then(|_| aim.case(cases.iter())),
+        carried_copy: state
             .carrying
             .iter()
             .copied()
-            .find(|c| items.iter().any(|i| i.id == *c && matches!(i.kind, ItemKind::Copy { .. })));
-        if let Some(item) = copy {
-            intent.actions.push(Action::Place(item));
-        }
-    }
-    if keys.just_pressed(KeyCode::KeyQ)
-        && let Some(&item) = state.carrying.last()
-    {
-        intent.actions.push(Action::Drop(item));
-    }
+            .find(|c| items.iter().any(|i| i.id == *c && matches!(i.kind, ItemKind::Copy { .. }))),
+        body: body.unwrap_or_default(),
+    };
+    let (movement, gait, actions) = decide(&input, &situation);
+    intent.movement = movement;
+    intent.gait = gait;
+    intent.actions.extend(actions);
 }
 
 /// The camera sits at the body's predicted position, eyes lower when crouching; carried items are held
@@ -209,6 +291,59 @@ fn follow_body(
 mod tests {
     use super::*;
     use std::f32::consts::FRAC_PI_2;
+
+    fn heist<'a>(carrying: &'a [ItemId], item_ahead: Option<u16>, case_ahead: Option<u16>) -> DesktopSituation<'a> {
+        DesktopSituation {
+            phase: Phase::Heist,
+            facing: FRAC_PI_2,
+            pitch: -0.3,
+            placed: true,
+            carrying,
+            item_ahead: item_ahead.map(ItemId),
+            case_ahead: case_ahead.map(CaseId),
+            carried_copy: None,
+            body: Vec2::new(5.0, 5.0),
+        }
+    }
+
+    #[test]
+    fn wasd_walks_the_way_the_view_faces_shift_runs_and_ctrl_crouches() {
+        let forward = DesktopInput { walk: [true, false, false, false], run: true, ..Default::default() };
+        let (movement, gait, actions) = decide(&forward, &heist(&[], None, None));
+        assert!((movement - Vec2::Y).length() < 1e-5 && gait == Gait::Run && actions.is_empty());
+        let crouching = DesktopInput { crouch: true, run: true, ..Default::default() };
+        assert_eq!(decide(&crouching, &heist(&[], None, None)).1, Gait::Crouch, "crouching wins over running");
+    }
+
+    #[test]
+    fn a_click_picks_up_the_item_in_front_and_with_full_hands_throws_where_the_view_meets_the_floor() {
+        let click = DesktopInput { click: true, ..Default::default() };
+        assert_eq!(decide(&click, &heist(&[], Some(4), None)).2, [Action::PickUp(ItemId(4))]);
+        let full = [ItemId(1), ItemId(2)];
+        let (_, _, actions) = decide(&click, &heist(&full, Some(4), None));
+        let [Action::Throw { item, target }] = actions.as_slice() else { panic!("a throw: {actions:?}") };
+        let ahead = space::EYE_HEIGHT_M / 0.3f32.tan();
+        assert_eq!(*item, ItemId(1));
+        assert!((*target - Vec2::new(5.0, 5.0 + ahead)).length() < 1e-3, "{target}");
+    }
+
+    #[test]
+    fn e_breaks_the_case_in_front_f_places_a_carried_copy_and_q_drops_the_last_item() {
+        let keys = DesktopInput { break_case: true, place: true, drop: true, ..Default::default() };
+        let carrying = [ItemId(1), ItemId(2)];
+        let situation = DesktopSituation { carried_copy: Some(ItemId(2)), ..heist(&carrying, None, Some(3)) };
+        assert_eq!(
+            decide(&keys, &situation).2,
+            [Action::Break(CaseId(3)), Action::Place(ItemId(2)), Action::Drop(ItemId(2))]
+        );
+    }
+
+    #[test]
+    fn before_the_body_is_placed_only_enter_and_walking_count() {
+        let keys = DesktopInput { enter: true, break_case: true, click: true, ..Default::default() };
+        let lobby = DesktopSituation { phase: Phase::Lobby, placed: false, ..heist(&[], Some(1), Some(1)) };
+        assert_eq!(decide(&keys, &lobby).2, [Action::Ready]);
+    }
 
     #[test]
     fn enter_readies_in_the_lobby_and_asks_for_another_round_after_a_result() {

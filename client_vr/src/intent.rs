@@ -203,7 +203,7 @@ pub fn send(
     mut intent: ResMut<Intent>,
     mut sent: ResMut<Sent>,
     mut out: MessageWriter<ClientMsg>,
-    mut state: ResMut<crate::client::ViveState>,
+    mut state: ResMut<crate::state::ViveState>,
 ) {
     sent.ticks = sent.ticks.wrapping_add(1);
     for action in intent.actions.drain(..) {

@@ -23,6 +23,7 @@ pub mod palette;
 pub mod predict;
 pub mod sound;
 pub mod space;
+pub mod state;
 pub mod textures;
 pub mod walkie;
 pub mod world;

@@ -10,7 +10,11 @@ use heist_shared::artifact::ArtifactLook;
 use heist_shared::protocol::GuardAlert;
 
 use crate::textures::{self, SIZE};
-use crate::world::{METER_WIDTH_M, PEDESTAL_M, alert_colour, look_mesh};
+
+/// Height of a case's pedestal top, metres.
+pub const PEDESTAL_M: f32 = 1.0;
+/// Width of a full awareness meter, metres.
+pub const METER_WIDTH_M: f32 = 0.6;
 
 /// Every alert state, in the order of [`Palette::alert`].
 pub const ALERTS: [GuardAlert; 6] = [
@@ -173,5 +177,27 @@ impl Palette {
         let handles = (meshes.add(look_mesh(look)), material);
         self.looks.push((look.clone(), handles.clone()));
         handles
+    }
+}
+
+/// The mesh of an artifact's look: every copy of a kind gets the same one.
+pub fn look_mesh(look: &ArtifactLook) -> Mesh {
+    let [w, h, _] = look.size_m;
+    match look.style_id {
+        0 => Torus::new(w * 0.35, w * 0.5).into(),
+        1 => Capsule3d::new(w * 0.5, (h - w).max(0.01)).into(),
+        _ => Cuboid::new(w, h, w * 0.6).into(),
+    }
+}
+
+/// The colour of a guard's alert lamp.
+pub fn alert_colour(alert: GuardAlert) -> Color {
+    match alert {
+        GuardAlert::Patrolling => Color::srgb(0.2, 0.9, 0.3),
+        GuardAlert::Suspicious => Color::srgb(1.0, 0.85, 0.1),
+        GuardAlert::Investigating => Color::srgb(1.0, 0.5, 0.05),
+        GuardAlert::Chasing => Color::srgb(1.0, 0.1, 0.1),
+        GuardAlert::Returning => Color::srgb(0.3, 0.6, 1.0),
+        GuardAlert::Searching => Color::srgb(1.0, 0.3, 0.6),
     }
 }

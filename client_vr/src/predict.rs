@@ -1,8 +1,9 @@
 //! Client-side prediction of Vive's own movement, reconciled with the authoritative server.
 //!
 //! Every movement intent the client sends carries a sequence number. The client moves its body at once
-//! with the same rule the server uses ([`rules::move_body`]) and keeps the inputs the server has not yet
-//! acknowledged. When a server state arrives (position after input `ack`), the prediction restarts from
+//! with the same rule the server uses
+//! ([`WallSet::move_body`](heist_shared::level::WallSet::move_body)) and keeps the inputs the server has
+//! not yet acknowledged. When a server state arrives (position after input `ack`), the prediction restarts from
 //! it and replays the unacknowledged inputs. What the replay changes is the prediction error; it is
 //! hidden by a visual offset that decays over [`SMOOTHING_S`] instead of a jump, unless it is larger
 //! than [`SNAP_DISTANCE_M`] (a teleport, a catch), which snaps.
@@ -11,7 +12,6 @@ use std::collections::VecDeque;
 
 use glam::Vec2;
 use heist_shared::level::WallSet;
-use heist_shared::rules;
 
 /// Inputs kept while unacknowledged: 4 s at 60 Hz; older ones are dropped (the server has long moved on).
 pub const MAX_PENDING: usize = 240;
@@ -87,7 +87,7 @@ impl Predictor {
 
     /// Applies a new input locally (call when it is sent).
     pub fn apply(&mut self, seq: u32, direction: Vec2, speed: f32, dt: f32) {
-        self.position = rules::move_body(&self.walls, self.position, direction, speed, dt);
+        self.position = self.walls.move_body(self.position, direction, speed, dt);
         if self.pending.len() == MAX_PENDING {
             self.pending.pop_front();
         }
@@ -123,7 +123,7 @@ impl Predictor {
         let before = self.shown();
         let mut p = server;
         for input in self.pending.iter_mut() {
-            p = rules::move_body(&self.walls, p, input.direction, input.speed, input.dt);
+            p = self.walls.move_body(p, input.direction, input.speed, input.dt);
             input.predicted = p;
         }
         self.position = p;
@@ -157,6 +157,7 @@ impl Predictor {
 mod tests {
     use super::*;
     use heist_shared::level::Level;
+    use heist_shared::rules;
 
     fn open_room() -> (WallSet, Vec2) {
         let level = Level::museum();
@@ -178,7 +179,7 @@ mod tests {
             let angle = tick as f32 * 0.01;
             let dir = Vec2::new(angle.cos(), angle.sin());
             client.apply(tick + 1, dir, rules::WALK_SPEED, dt);
-            server = rules::move_body(&walls, server, dir, rules::WALK_SPEED, dt);
+            server = walls.move_body(server, dir, rules::WALK_SPEED, dt);
             in_flight.push_back((tick + delay, server, tick + 1));
             while in_flight.front().is_some_and(|m| m.0 <= tick) {
                 let (_, pos, ack) = in_flight.pop_front().expect("a state is due");

@@ -1,123 +1,129 @@
-//! Spatial sound for Vive (kira through `heist_audio`): footsteps, glass, thuds, barks and the alarm,
-//! placed around the listener at the predicted body, turned with the view.
+//! Spatial sound for Vive (kira through `heist_audio`): the museum's cues (`heist_audio::museum`, the
+//! same as Phantom's) placed around the listener at the predicted body, turned with the view; a thrown
+//! item heard when it is drawn landing; the alarm ringing on while raised.
 
 use bevy::prelude::*;
-use glam::Vec2;
+use glam::{Vec2, Vec3};
+use heist_audio::museum::{self, MuseumCue, Sound};
 use heist_audio::{AudioEngine, AudioSettings};
-use heist_shared::protocol::{GameEvent, GuardAlert, GuardView, NoiseKind, Phase, Stance, ViveAvatar};
+use heist_shared::protocol::{GuardView, Phase, ViveAvatar};
+use heist_shared::rules;
 
 use crate::client::{Happened, ViveState, ViveSystems};
 use crate::flight;
 use crate::intent::Intent;
 use crate::space;
 
-/// Farthest a footstep is played from, metres.
-pub const STEP_RANGE_M: f32 = 20.0;
 /// Seconds between repeats of the alarm while it is raised.
 pub const ALARM_EVERY_S: f32 = 3.0;
+/// Most thuds waiting for their thrown item to land (older ones are played at once).
+const MAX_PENDING_THUDS: usize = 8;
 
 /// Starts the engine and adds the sound systems.
 pub fn add(app: &mut App, settings: &AudioSettings) -> Result<(), heist_audio::AudioError> {
     let engine = AudioEngine::new(settings)?;
-    app.insert_non_send(engine).init_resource::<Steps>().add_systems(Update, play.in_set(ViveSystems::Present));
+    app.insert_non_send(engine)
+        .init_resource::<Steps>()
+        .init_resource::<Thuds>()
+        .init_resource::<AlarmBell>()
+        .add_systems(Update, (hear_events, land_thuds, hear_steps, ring_alarm).in_set(ViveSystems::Present));
     Ok(())
 }
 
-/// Most thuds waiting for their thrown item to land (older ones are played at once).
-const MAX_PENDING_THUDS: usize = 8;
-
+/// Every walker's last step.
 #[derive(Resource, Default)]
-struct Steps {
-    guards: Vec<(u16, Vec2)>,
-    own: Option<Vec2>,
-    alarm_s: f32,
-    /// Thuds of thrown items still in the air: (clock time it lands, where).
-    thuds: Vec<(f64, Vec2)>,
+struct Steps(museum::Steps);
+
+/// Thuds of thrown items still in the air: (clock time it lands, its cue).
+#[derive(Resource, Default)]
+struct Thuds(Vec<(f64, MuseumCue)>);
+
+/// Seconds since the alarm last rang.
+#[derive(Resource, Default)]
+struct AlarmBell(f32);
+
+/// Where Vive hears a floor point at a height: his offset, from the predicted body and the view's facing.
+fn ears(state: &ViveState, intent: &Intent) -> Option<impl Fn(&MuseumCue) -> Vec3> {
+    let (me, facing) = (state.body()?, intent.facing);
+    Some(move |cue: &MuseumCue| space::listener_offset(me, facing, space::EYE_HEIGHT_M, cue.at, cue.height_m))
 }
 
-#[allow(clippy::too_many_arguments)]
-fn play(
+/// The game's events as the museum's cues; a thud waits for its item to land.
+fn hear_events(
     mut happened: MessageReader<Happened>,
     mut audio: NonSendMut<AudioEngine>,
-    mut steps: ResMut<Steps>,
+    mut thuds: ResMut<Thuds>,
     state: Res<ViveState>,
     intent: Res<Intent>,
-    guards: Query<&GuardView>,
-    avatar: Query<&ViveAvatar>,
     time: Res<Time>,
 ) {
-    let Some(me) = state.body() else { return };
-    let ears = space::EYE_HEIGHT_M;
-    let at = |p: Vec2, h: f32| space::listener_offset(me, intent.facing, ears, p, h);
-    for Happened(e) in happened.read() {
-        match e {
-            GameEvent::Noise { kind: NoiseKind::Glass, position, .. } => audio.glass(at(*position, 1.2)),
-            GameEvent::Noise { kind: NoiseKind::Thud, position, .. } => {
-                // The server lands a throw at once; it is drawn flying there, so it is heard landing then.
-                if steps.thuds.len() == MAX_PENDING_THUDS {
-                    let (_, p) = steps.thuds.remove(0);
-                    audio.thud(at(p, 0.0));
-                }
-                let lands = time.elapsed_secs_f64() + flight::flight_time_s(position.distance(me)) as f64;
-                steps.thuds.push((lands, *position));
-            }
-            GameEvent::Noise { kind: NoiseKind::Alarm, position, .. } => audio.alarm(at(*position, 2.8)),
-            GameEvent::GuardAlert { alert, position, .. }
-                if matches!(alert, GuardAlert::Suspicious | GuardAlert::Chasing) =>
-            {
-                audio.play_at(
-                    heist_audio::synth::bark(*alert == GuardAlert::Chasing),
-                    at(*position, 1.7),
-                    "guard bark",
-                );
-            }
-            _ => {}
+    let (Some(me), Some(offset)) = (state.body(), ears(&state, &intent)) else { return };
+    for cue in happened.read().filter_map(|Happened(e)| museum::event_cue(e)) {
+        if cue.sound != Sound::Thud {
+            audio.play_cue(&cue, offset(&cue));
+            continue;
         }
+        // The server lands a throw at once; it is drawn flying there, so it is heard landing then.
+        if thuds.0.len() == MAX_PENDING_THUDS {
+            let (_, early) = thuds.0.remove(0);
+            audio.play_cue(&early, offset(&early));
+        }
+        let lands = time.elapsed_secs_f64() + flight::flight_time_s(cue.at.distance(me)) as f64;
+        thuds.0.push((lands, cue));
     }
+}
+
+/// Plays the thuds whose items have landed.
+fn land_thuds(
+    mut audio: NonSendMut<AudioEngine>,
+    mut thuds: ResMut<Thuds>,
+    state: Res<ViveState>,
+    intent: Res<Intent>,
+    time: Res<Time>,
+) {
+    let Some(offset) = ears(&state, &intent) else { return };
     let now = time.elapsed_secs_f64();
-    while let Some(i) = steps.thuds.iter().position(|(lands, _)| *lands <= now) {
-        let (_, p) = steps.thuds.remove(i);
-        audio.thud(at(p, 0.0));
+    while let Some(i) = thuds.0.iter().position(|(lands, _)| *lands <= now) {
+        let (_, cue) = thuds.0.remove(i);
+        audio.play_cue(&cue, offset(&cue));
     }
-    // A step every 0.7 m a guard walks, when near enough to hear.
-    for g in &guards {
-        let slot = match steps.guards.iter().position(|(id, _)| *id == g.id.0) {
-            Some(i) => i,
-            None => {
-                steps.guards.push((g.id.0, g.position));
-                steps.guards.len() - 1
-            }
-        };
-        let last = steps.guards[slot].1;
-        if g.position.distance(last) > 0.7 {
-            steps.guards[slot].1 = g.position;
-            if g.position.distance(me) < STEP_RANGE_M {
-                audio.footstep(at(g.position, 0.0), 0.6, "guard footstep");
-            }
-        }
+}
+
+/// The guards' steps within their earshot (the rules' `GUARD_STEP_LOUDNESS`) and Vive's own.
+fn hear_steps(
+    mut audio: NonSendMut<AudioEngine>,
+    mut steps: ResMut<Steps>,
+    guards: Query<&GuardView>,
+    avatar: Query<&ViveAvatar>,
+    state: Res<ViveState>,
+    intent: Res<Intent>,
+) {
+    let (Some(me), Some(offset)) = (state.body(), ears(&state, &intent)) else { return };
+    let heard = |at: Vec2| at.distance(me) < rules::GUARD_STEP_LOUDNESS;
+    for cue in guards.iter().filter_map(|g| steps.0.guard(g.id.0, g.position)).filter(|c| heard(c.at)) {
+        audio.play_cue(&cue, offset(&cue));
     }
-    // Vive's own steps, soft unless running.
-    if let Ok(v) = avatar.single() {
-        let last = *steps.own.get_or_insert(me);
-        if me.distance(last) > 0.7 {
-            steps.own = Some(me);
-            let loud = match v.stance {
-                Stance::Crouching => 0.08,
-                Stance::Running => 0.5,
-                Stance::Standing => 0.2,
-            };
-            audio.footstep(at(me, 0.0), loud, "own footstep");
-        }
+    if let Some(cue) = avatar.single().ok().and_then(|v| steps.0.vive(me, v.stance)) {
+        audio.play_cue(&cue, offset(&cue));
     }
-    // The alarm keeps ringing while raised.
-    if state.alarm > 0 && state.phase == Phase::Heist {
-        steps.alarm_s += time.delta_secs();
-        if steps.alarm_s > ALARM_EVERY_S
-            && let Some(level) = state.level.as_ref()
-        {
-            steps.alarm_s = 0.0;
-            audio.alarm(at(level.workbench, 2.8));
-        }
+}
+
+/// The alarm rings on from the workbench every few seconds while raised.
+fn ring_alarm(
+    mut audio: NonSendMut<AudioEngine>,
+    mut bell: ResMut<AlarmBell>,
+    state: Res<ViveState>,
+    intent: Res<Intent>,
+    time: Res<Time>,
+) {
+    if state.alarm == 0 || state.phase != Phase::Heist {
+        return;
+    }
+    bell.0 += time.delta_secs();
+    if let (true, Some(level), Some(offset)) = (bell.0 > ALARM_EVERY_S, state.level.as_ref(), ears(&state, &intent)) {
+        bell.0 = 0.0;
+        let cue = museum::alarm_cue(level.workbench);
+        audio.play_cue(&cue, offset(&cue));
     }
 }
 
@@ -126,6 +132,7 @@ mod tests {
     use super::*;
     use heist_audio::{AudioOutput, SpatialMode};
     use heist_shared::level::WallSet;
+    use heist_shared::protocol::{GameEvent, NoiseKind};
 
     fn energy(frames: &[(f32, f32)]) -> (f32, f32) {
         frames.iter().fold((0.0, 0.0), |(l, r), f| (l + f.0 * f.0, r + f.1 * f.1))

@@ -9,7 +9,6 @@
 
 use bevy::prelude::*;
 use glam::{Vec2, Vec3};
-use heist_shared::artifact::ArtifactLook;
 use heist_shared::level::Level;
 use heist_shared::protocol::{CaseView, GuardAlert, GuardView, ItemKind, ItemPlace, ItemView, PhantomTool};
 
@@ -17,14 +16,12 @@ use crate::client::{ViveState, ViveSystems};
 use crate::figure::{self, Gait, Limb, Neck};
 use crate::flight::Flight;
 use crate::interp::{DELAY_S, Track};
-use crate::palette::Palette;
+use crate::palette::{METER_WIDTH_M, PEDESTAL_M, Palette};
 use crate::space::{self, BENCH_TOP_M};
 use crate::textures::tile_uvs;
 
 /// Height of the walls, metres.
 pub const WALL_HEIGHT_M: f32 = 3.0;
-/// Height of a case's pedestal top, metres.
-pub const PEDESTAL_M: f32 = 1.0;
 /// The night sky's colour.
 pub const SKY: Color = Color::srgb(0.01, 0.015, 0.04);
 /// Moonlight through the open roof, lux (a dim blue wash: the museum is dark but readable).
@@ -97,9 +94,6 @@ struct AlertLamp;
 /// The awareness meter over a guard's head: a bar that fills as he grows alert.
 #[derive(Component)]
 pub struct AwarenessMeter;
-
-/// Width of a full awareness meter, metres.
-pub const METER_WIDTH_M: f32 = 0.6;
 
 /// How full a guard's awareness meter is, as stealth games show it: empty on patrol, a third when
 /// something caught his eye, two thirds while he investigates or searches, full in a chase; a guard
@@ -302,16 +296,6 @@ fn spawn_museum(
     ));
 }
 
-/// The mesh of an artifact's look: every copy of a kind gets the same one.
-pub fn look_mesh(look: &ArtifactLook) -> Mesh {
-    let [w, h, _] = look.size_m;
-    match look.style_id {
-        0 => Torus::new(w * 0.35, w * 0.5).into(),
-        1 => Capsule3d::new(w * 0.5, (h - w).max(0.01)).into(),
-        _ => Cuboid::new(w, h, w * 0.6).into(),
-    }
-}
-
 fn dress_cases(mut commands: Commands, cases: Query<(Entity, &CaseView), Without<Dressed>>, palette: Res<Palette>) {
     for (e, case) in &cases {
         commands
@@ -470,18 +454,6 @@ fn move_items(
             }
             None => *vis = Visibility::Hidden,
         }
-    }
-}
-
-/// The colour of a guard's alert lamp.
-pub fn alert_colour(alert: GuardAlert) -> Color {
-    match alert {
-        GuardAlert::Patrolling => Color::srgb(0.2, 0.9, 0.3),
-        GuardAlert::Suspicious => Color::srgb(1.0, 0.85, 0.1),
-        GuardAlert::Investigating => Color::srgb(1.0, 0.5, 0.05),
-        GuardAlert::Chasing => Color::srgb(1.0, 0.1, 0.1),
-        GuardAlert::Returning => Color::srgb(0.3, 0.6, 1.0),
-        GuardAlert::Searching => Color::srgb(1.0, 0.3, 0.6),
     }
 }
 

@@ -11,8 +11,7 @@ use heist_shared::protocol::{
 };
 
 use crate::game::Game;
-use crate::net::NetSystems;
-use crate::net::Roles;
+use crate::net::seats::Roles;
 use crate::net::seats::Seats;
 
 /// One hosted session: its game, who plays it, and its log.
@@ -367,7 +366,6 @@ impl Plugin for SessionPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<HostSession>()
             .add_visibility_filter::<SessionTag>()
-            .configure_sets(PostUpdate, SessionSystems::Mirror.before(NetSystems::Send))
             .add_systems(FixedUpdate, step_games.in_set(SessionSystems::Step))
             .add_systems(PostUpdate, mirror_games.in_set(SessionSystems::Mirror));
     }

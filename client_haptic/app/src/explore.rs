@@ -58,12 +58,11 @@ pub const ROUGH_ABOVE: f32 = 0.45;
 pub const ATTEMPTS: u32 = 3;
 /// A tick this much later than the one before means the haptic loop stalled, µs.
 const STALL_US: u64 = 50_000;
-/// Contact data older than this trips the safety layer's watchdog (its default
-/// [`forcecomp::SafetyConfig::watchdog_timeout_s`]), µs.
-const STALE_US: u32 = 32_000;
-/// How long forces are suspect after a stall or stale data: the watchdog's ramp back in (2 s) and a
-/// margin, µs.
-const RECOVER_US: u64 = 2_500_000;
+/// Contact data older than this trips the safety layer's watchdog (at its default timeout), µs.
+const STALE_US: u32 = (forcecomp::safety::DEFAULT_WATCHDOG_TIMEOUT_S * 1e6) as u32;
+/// How long forces are suspect after a stall or stale data: the watchdog's ramp back in (its default)
+/// and half a second's margin, µs.
+const RECOVER_US: u64 = ((forcecomp::safety::DEFAULT_RAMP_IN_S + 0.5) * 1e6) as u64;
 
 /// Resting force over depth² (see [`Findings::pressure_n_per_m2`]) above which a copy feels hard through
 /// the volumetric rendering, N/m², whatever its kind and roughness: the gemstone is measured against the

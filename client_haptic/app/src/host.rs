@@ -9,45 +9,15 @@ use std::time::Duration;
 use anyhow::Context as _;
 use heist_shared::protocol::Role;
 
-use crate::cli::ClientArgs;
-
-/// Arguments of `host`.
-#[derive(clap::Args, Debug, Clone)]
-pub struct HostArgs {
-    /// Where and what to host.
-    #[command(flatten)]
-    pub host: heist_server::embedded::HostFlags,
-    /// Device, window, audio and bot settings, as for `join`.
-    #[command(flatten)]
-    pub client: ClientArgs,
-}
-
-/// The NATO word (or the digit's name) for each character of a join code; the dash is a pause.
-pub fn spell(code: &str) -> String {
-    const NATO: [&str; 26] = [
-        "alfa", "bravo", "charlie", "delta", "echo", "foxtrot", "golf", "hotel", "india", "juliett", "kilo", "lima",
-        "mike", "november", "oscar", "papa", "quebec", "romeo", "sierra", "tango", "uniform", "victor", "whiskey",
-        "x-ray", "yankee", "zulu",
-    ];
-    const DIGITS: [&str; 10] = ["zero", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine"];
-    let words: Vec<&str> = code
-        .chars()
-        .filter_map(|c| match c.to_ascii_uppercase() {
-            c @ 'A'..='Z' => Some(NATO[usize::from(c as u8 - b'A')]),
-            c @ '0'..='9' => Some(DIGITS[usize::from(c as u8 - b'0')]),
-            '-' => Some("then"),
-            _ => None,
-        })
-        .collect();
-    words.join(", ")
-}
+use crate::cli::HostArgs;
+use crate::prompt::spell;
 
 /// Runs `host`: starts the server, joins it as Phantom, says the code, plays until the session ends; a
 /// failure to start is said as well as printed.
 pub fn host(args: &HostArgs) -> anyhow::Result<()> {
     let mut settings = args.client.settings().map_err(anyhow::Error::msg)?;
     let mut prompter = crate::prompt::Prompter::new(&mut settings)?;
-    crate::cli::check_device(&mut prompter, &settings)?;
+    crate::commands::check_device(&mut prompter, &settings)?;
     let started = match args.host.server {
         Some(server) => match heist_client::create_session(server, Role::Phantom, Duration::from_secs(5)) {
             Ok((code, token)) => Ok((server, server, code, token)),
@@ -71,7 +41,7 @@ pub fn host(args: &HostArgs) -> anyhow::Result<()> {
         }
     };
     let voices = prompter.into_parts();
-    let mut app = crate::cli::app(settings, args.client.headless, None, Some(voices))?;
+    let mut app = crate::assemble::app(settings, args.client.headless, None, Some(voices))?;
     args.client.request_shot(&mut app);
     app.finish();
     app.cleanup();
@@ -92,18 +62,4 @@ fn host_here(args: &HostArgs) -> anyhow::Result<(SocketAddr, SocketAddr, String,
     let token = heist_client::request_token(here.endpoint, &here.code, Role::Phantom, Duration::from_secs(5))
         .with_context(|| format!("joining the session hosted on {}", here.endpoint))?;
     Ok((here.advertised, here.endpoint, here.code, token))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_code_is_spelled_in_the_nato_alphabet_with_digits_by_name() {
-        assert_eq!(
-            spell("K7QX-2M4P-R9TC"),
-            "kilo, seven, quebec, x-ray, then, two, mike, four, papa, then, romeo, nine, tango, charlie"
-        );
-        assert_eq!(spell("ab"), "alfa, bravo");
-    }
 }

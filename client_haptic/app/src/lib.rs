@@ -8,26 +8,32 @@
 //! (a window for sighted onlookers).
 #![warn(missing_docs)]
 
+pub mod assemble;
 pub mod bench;
 pub mod cli;
 pub mod client;
+pub mod commands;
 pub mod device;
 pub mod error;
 pub mod explore;
 pub mod haptics;
 pub mod host;
+pub mod input;
 pub mod practice;
 pub mod prompt;
+pub mod schedule;
 pub mod settings;
+pub mod sound;
 #[cfg(feature = "spectator")]
 pub mod spectator;
 pub mod speech;
+pub mod state;
 pub mod status;
 pub mod terminal;
 pub mod touch_bench;
 pub mod walkie;
 
-pub use client::{PhantomClientPlugin, PhantomSettings, PhantomState, start};
+pub use client::{PhantomClientPlugin, PhantomSettings, Workbench, start};
 pub use error::ClientError;
 /// The sounds (the shared `heist_audio` crate).
 pub use heist_audio as audio;

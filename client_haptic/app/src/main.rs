@@ -1,7 +1,8 @@
 //! `client_haptic`: join a Phantom Heist session as Phantom (see `client_haptic::cli`).
 
 use clap::Parser;
-use client_haptic::cli::{Cli, Command, devices, join, practice};
+use client_haptic::cli::{Cli, Command};
+use client_haptic::commands::{devices, join, practice};
 
 /// Errors end the program on one line (`error: what: why`), never with a backtrace, even with
 /// `RUST_BACKTRACE` set.

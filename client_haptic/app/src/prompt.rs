@@ -280,7 +280,7 @@ Backspace deletes."
             let typed = self.ask(&question)?.to_ascii_uppercase();
             match heist_shared::protocol::join::room_of(&typed) {
                 Ok(_) => {
-                    self.say(format!("Code {}. Joining.", crate::host::spell(&typed)));
+                    self.say(format!("Code {}. Joining.", spell(&typed)));
                     return Some(typed);
                 }
                 Err(why) => question = format!("That is not a join code: {why}. Type the code again."),
@@ -293,6 +293,26 @@ Backspace deletes."
         self.pump();
         (self.audio, self.speaker)
     }
+}
+
+/// The NATO word (or the digit's name) for each character of a join code; the dash is a pause.
+pub fn spell(code: &str) -> String {
+    const NATO: [&str; 26] = [
+        "alfa", "bravo", "charlie", "delta", "echo", "foxtrot", "golf", "hotel", "india", "juliett", "kilo", "lima",
+        "mike", "november", "oscar", "papa", "quebec", "romeo", "sierra", "tango", "uniform", "victor", "whiskey",
+        "x-ray", "yankee", "zulu",
+    ];
+    const DIGITS: [&str; 10] = ["zero", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine"];
+    let words: Vec<&str> = code
+        .chars()
+        .filter_map(|c| match c.to_ascii_uppercase() {
+            c @ 'A'..='Z' => Some(NATO[usize::from(c as u8 - b'A')]),
+            c @ '0'..='9' => Some(DIGITS[usize::from(c as u8 - b'0')]),
+            '-' => Some("then"),
+            _ => None,
+        })
+        .collect();
+    words.join(", ")
 }
 
 #[cfg(test)]
@@ -336,5 +356,14 @@ mod tests {
                 .0
                 .contains("Someone already plays Phantom")
         );
+    }
+
+    #[test]
+    fn a_code_is_spelled_in_the_nato_alphabet_with_digits_by_name() {
+        assert_eq!(
+            spell("K7QX-2M4P-R9TC"),
+            "kilo, seven, quebec, x-ray, then, two, mike, four, papa, then, romeo, nine, tango, charlie"
+        );
+        assert_eq!(spell("ab"), "alfa, bravo");
     }
 }

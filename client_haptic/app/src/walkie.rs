@@ -31,7 +31,7 @@ impl Plugin for WalkiePlugin {
     fn build(&self, app: &mut App) {
         app.add_systems(
             Update,
-            (push_to_talk, place_vives_voice, tell_the_walkie).chain().in_set(crate::client::PhantomSystems::Sound),
+            (push_to_talk, place_vives_voice, tell_the_walkie).chain().in_set(crate::schedule::PhantomSystems::Sound),
         );
     }
 }

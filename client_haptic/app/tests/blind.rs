@@ -99,7 +99,7 @@ fn the_recognizer_hears_every_letter_and_digit_of_a_spelled_code_and_not_the_sen
     // (server/src/net/tokens: no 0, 1, I or O), so a word the recognizer cannot hear fails here, every time.
     let vocabulary = listen::Vocabulary::new(&code_words(), client_haptic::client::SPELLING_WPM);
     for code in ["ABCD-EFGH-JKLM", "NPQR-STUV-WXYZ", "2345-6789-QX7M"] {
-        let line = format!("The code, spelled: {}. R repeats it.", client_haptic::host::spell(code));
+        let line = format!("The code, spelled: {}. R repeats it.", client_haptic::prompt::spell(code));
         let said = listen::espeak(&line, client_haptic::client::SPELLING_WPM);
         let words = vocabulary.transcribe(&said);
         for (s, e) in listen::utterances(&said) {

@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 use bevy::prelude::*;
 use client_haptic::audio::{AudioOutput, AudioSettings};
 use client_haptic::bench::LoopRates;
-use client_haptic::{PhantomSettings, PhantomState};
+use client_haptic::{PhantomSettings, Workbench};
 use heist_bots::{ViveBotPlugin, ViveStyle};
 use heist_server::demo::join;
 use heist_server::{ServerOptions, build_server};
@@ -57,7 +57,7 @@ fn the_server_a_vive_bot_and_the_touch_bot_win_a_heist_over_loopback_udp() {
             break;
         }
         // Keep to wall-clock time while Phantom feels a copy.
-        if phantom.world().resource::<PhantomState>().busy() {
+        if phantom.world().resource::<Workbench>().busy() {
             let (since, t0) = *paced_since.get_or_insert((Instant::now(), t));
             let due = since + tick * (t - t0 + 1) as u32;
             if let Some(wait) = due.checked_duration_since(Instant::now()) {
@@ -70,7 +70,7 @@ fn the_server_a_vive_bot_and_the_touch_bot_win_a_heist_over_loopback_udp() {
         assert!(started.elapsed() < Duration::from_secs(1500), "the heist took too long in wall-clock time");
     }
     let game = server.game();
-    let state = phantom.world().resource::<PhantomState>();
+    let state = phantom.world().resource::<Workbench>();
     println!(
         "heist over after {:.0} s of game time ({:.0} s felt in real time), {:.0} s wall clock: {:?}",
         game.elapsed_s,

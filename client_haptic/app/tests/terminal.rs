@@ -233,7 +233,7 @@ fn host_and_hear_a_partner_join(args: &[&str], addr: &str) {
     assert!(status.success(), "client_haptic exited with {status}: {lines:#?}");
     let hosted = lines.iter().find(|l| l.starts_with("You host the heist.")).expect("the host line");
     let code = hosted.split("with the code ").nth(1).expect("a code").trim_end_matches('.');
-    let spelled = format!("The code, spelled: {}. R repeats it.", client_haptic::host::spell(code));
+    let spelled = format!("The code, spelled: {}. R repeats it.", client_haptic::prompt::spell(code));
     let at = |l: &str| lines.iter().position(|x| x == l);
     let welcome = lines.iter().position(|l| l.starts_with("Welcome")).expect("welcomed");
     assert!(at(&spelled).is_some_and(|s| s > welcome), "the spelled code comes last, for R: {lines:#?}");

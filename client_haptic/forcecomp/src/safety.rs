@@ -23,6 +23,11 @@ use haptic_common::ForceTorque;
 
 use crate::error::{ForceCompError, Result, non_negative, positive};
 
+/// [`SafetyConfig::watchdog_timeout_s`]'s default, s: contact data older than this trips the watchdog.
+pub const DEFAULT_WATCHDOG_TIMEOUT_S: f32 = 0.032;
+/// [`SafetyConfig::ramp_in_s`]'s default, s.
+pub const DEFAULT_RAMP_IN_S: f32 = 2.0;
+
 /// Limits and timings of the safety layer.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SafetyConfig {
@@ -38,9 +43,9 @@ pub struct SafetyConfig {
     pub engage_threshold_n: f32,
     /// ... for more than this many ticks (default 3).
     pub engage_ticks: u32,
-    /// Ramp-in time after engagement or after the watchdog recovers, s (default 2).
+    /// Ramp-in time after engagement or after the watchdog recovers, s (default [`DEFAULT_RAMP_IN_S`]).
     pub ramp_in_s: f32,
-    /// Contact data older than this trips the watchdog, s (default 0.032).
+    /// Contact data older than this trips the watchdog, s (default [`DEFAULT_WATCHDOG_TIMEOUT_S`]).
     pub watchdog_timeout_s: f32,
     /// Ramp-out time once the watchdog trips, s (default 0.05).
     pub ramp_out_s: f32,
@@ -89,8 +94,8 @@ impl SafetyConfig {
             max_torque_rate_nm_per_s: 10.0,
             engage_threshold_n: 0.2,
             engage_ticks: 3,
-            ramp_in_s: 2.0,
-            watchdog_timeout_s: 0.032,
+            ramp_in_s: DEFAULT_RAMP_IN_S,
+            watchdog_timeout_s: DEFAULT_WATCHDOG_TIMEOUT_S,
             ramp_out_s: 0.05,
             continuous_force_n: max_force_n,
             heat_time_s: 30.0,

@@ -6,7 +6,7 @@
 
 use haptic_common::{Delegator, DeviceState, ForceOnHapticTick, ForceTorque, OnTransform};
 
-use crate::Device;
+use crate::device::Device;
 
 /// The two events the haptic thread broadcasts each tick.
 #[derive(Debug)]

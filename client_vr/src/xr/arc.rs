@@ -8,10 +8,11 @@ use glam::{Vec2, Vec3};
 use heist_shared::level::{Level, Segment, WallSet};
 use heist_shared::rules::BODY_RADIUS;
 
-use super::TELEPORT_RANGE_M;
 use crate::space;
 use crate::world::WALL_HEIGHT_M;
 
+/// Farthest teleport, metres.
+pub const TELEPORT_RANGE_M: f32 = 4.0;
 /// Speed the arc leaves the hand at, m/s (a 45° arc from the floor reaches 4.3 m).
 pub const ARC_SPEED: f32 = 6.5;
 /// Time between the arc's points, seconds.

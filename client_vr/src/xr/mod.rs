@@ -22,6 +22,7 @@
 //! Controllers pulse on a grab and on breaking glass ([`Pulse`]).
 
 pub mod arc;
+pub mod hands;
 pub mod probe;
 
 use std::borrow::Cow;
@@ -37,14 +38,15 @@ use bevy_mod_openxr::session::OxrSession;
 use bevy_mod_openxr::{openxr_session_available, openxr_session_running};
 use bevy_mod_xr::session::{XrPreDestroySession, XrSessionCreated, XrTrackingRoot};
 use glam::{Vec2, Vec3};
-use heist_shared::protocol::{CaseView, Gait, ItemPlace, ItemView, Phase};
-use heist_shared::rules;
+use heist_shared::protocol::{CaseView, ItemPlace, ItemView};
 use openxr::{Action, ActionSet, Haptic, Path, Posef, Vector2f};
 
+pub use arc::TELEPORT_RANGE_M;
+pub use hands::{CROUCH_BELOW_M, HEAD_LEASH_M, SNAP_TURN, throw_landing};
 pub use probe::{XrProbe, probe, probe_from_env};
 
 use crate::client::{Pulse, ViveState};
-use crate::intent::{Action as Do, Aim, Intent, IntentSystems};
+use crate::intent::{Aim, Intent, IntentSystems};
 use crate::space;
 use crate::world::Hands;
 
@@ -78,15 +80,6 @@ pub struct XrOptions {
     /// The main hand.
     pub hand: Handedness,
 }
-
-/// Snap-turn angle, radians.
-pub const SNAP_TURN: f32 = std::f32::consts::PI / 6.0;
-/// Farthest teleport, metres.
-pub const TELEPORT_RANGE_M: f32 = 4.0;
-/// How far the head may lead the body before walls hold the view back, metres.
-pub const HEAD_LEASH_M: f32 = 0.6;
-/// Head height below which a standing player crouches, metres.
-pub const CROUCH_BELOW_M: f32 = 1.15;
 
 /// The action set and its actions.
 #[derive(Resource)]
@@ -133,26 +126,44 @@ pub const VIGNETTE_OPEN_M: (f32, f32) = (0.25, 0.07);
 /// How far ahead of the eyes the ring sits, metres.
 pub const VIGNETTE_DISTANCE_M: f32 = 0.15;
 
-/// What the hands are doing, frame to frame.
+/// This frame's controls, read from OpenXR: the head and both hands (`hands[0]` left, `hands[1]` right).
 #[derive(Resource, Default)]
-struct HandState {
-    squeezed: [bool; 2],
-    triggered: [bool; 2],
-    positions: [[Vec3; 6]; 2],
-    holding: [Option<heist_shared::protocol::ItemId>; 2],
-    stick_was: [Vec2; 2],
+struct XrInput {
+    /// The head was tracked and the actions exist: the rest is this frame's.
+    ready: bool,
+    /// The head in the tracking room's frame (what the room is recentred by).
+    head_local: Vec3,
+    head_rot_local: Quat,
+    /// The head in the world.
+    head: Vec3,
+    /// The view's heading, radians.
+    facing: f32,
+    hands: [hands::HandInput; 2],
+    /// Which hand is the main one (its stick turns; the other's moves).
+    main: usize,
+    /// Seconds since the last frame.
+    dt: f32,
+}
+
+/// What the hands remember, frame to frame, and what they asked of the view this frame.
+#[derive(Resource, Default)]
+struct XrHands {
+    hands: [hands::HandMemory; 2],
+    /// The off hand's stick click toggled running on.
     running: bool,
-    travel: Option<Vec2>,
-    recentre_s: f32,
+    /// The main hand's stick snapped the view round by this much this frame, radians.
+    turn: f32,
+}
+
+/// How the body and the view move, frame to frame (locomotion, the comfort fade and vignette, the
+/// recentring hold).
+#[derive(Resource, Default)]
+struct XrMotion {
+    moving: hands::Moving,
+    /// The room was recentred on the body once (on joining).
     recentred: bool,
-    last_body: Option<Vec2>,
-    locomoting: bool,
-    fade: f32,
-    vignette: f32,
-    /// The teleport arc while the off hand's stick is pushed.
-    arc: Option<arc::TeleportArc>,
-    /// What each empty hand would pick up if its grip closed now (shown by a highlight ring).
-    grabbable: [Option<heist_shared::protocol::ItemId>; 2],
+    /// Seconds both grips have been held with empty hands.
+    recentre_hold_s: f32,
 }
 
 /// The ring around what an empty hand would pick up (one per hand).
@@ -171,7 +182,9 @@ pub struct XrInputPlugin {
 impl Plugin for XrInputPlugin {
     fn build(&self, app: &mut App) {
         app.insert_resource(self.options)
-            .init_resource::<HandState>()
+            .init_resource::<XrInput>()
+            .init_resource::<XrHands>()
+            .init_resource::<XrMotion>()
             .insert_resource(bevy::winit::WinitSettings::continuous())
             .add_systems(Startup, create_actions.run_if(openxr_session_available))
             .add_systems(OxrSendActionBindings, suggest_bindings)
@@ -180,7 +193,10 @@ impl Plugin for XrInputPlugin {
             .add_systems(PreUpdate, sync_set.before(OxrActionSetSyncSet).run_if(openxr_session_running))
             .add_systems(
                 RunFixedMainLoop,
-                (read_hands, comfort).chain().in_set(IntentSystems::Gather).run_if(openxr_session_running),
+                (read_hands, use_hands, place_view, walk, comfort)
+                    .chain()
+                    .in_set(IntentSystems::Gather)
+                    .run_if(openxr_session_running),
             )
             .add_systems(Startup, spawn_highlights)
             .add_systems(Update, talk_button.run_if(openxr_session_running))
@@ -464,226 +480,177 @@ fn despawn_tracked(q: Query<Entity, Or<(With<Head>, With<Grip>, With<Pointer>)>>
     }
 }
 
-/// Where a throw from `hand` (world) at `velocity` (world, m/s) lands on the floor: ballistic flight,
-/// capped at the throw range.
-pub fn throw_landing(hand: Vec3, velocity: Vec3) -> Vec2 {
-    let g = 9.81;
-    let h = hand.y.max(0.0);
-    let vy = velocity.y;
-    let t = (vy + (vy * vy + 2.0 * g * h).sqrt()) / g;
-    let from = space::floor(hand);
-    let flight = space::floor(Vec3::new(velocity.x, 0.0, velocity.z)) * t;
-    from + flight.clamp_length_max(rules::THROW_RANGE)
+/// The tracked spaces a frame's controls are read from: the runtime's views, the grips, the aims and the
+/// tracking room.
+#[derive(bevy::ecs::system::SystemParam)]
+struct Tracked<'w, 's> {
+    views: Res<'w, OxrViews>,
+    grips: Query<'w, 's, (&'static Grip, &'static GlobalTransform)>,
+    pointers: Query<'w, 's, (&'static Pointer, &'static GlobalTransform)>,
+    root: Query<'w, 's, &'static Transform, With<XrTrackingRoot>>,
 }
 
-#[allow(clippy::too_many_arguments)]
+/// Reads the head, the hands' poses and their buttons into [`XrInput`]; shows where the hands are.
 fn read_hands(
     actions: Option<Res<XrActions>>,
     session: Res<OxrSession>,
-    views: Res<OxrViews>,
+    tracked: Tracked,
     options: Res<XrOptions>,
     time: Res<Time>,
-    mut hs: ResMut<HandState>,
-    mut intent: ResMut<Intent>,
+    mut input: ResMut<XrInput>,
     mut hands_out: ResMut<Hands>,
+) {
+    input.ready = false;
+    let (Some(a), Ok(root), Some(view)) = (actions, tracked.root.single(), tracked.views.first()) else { return };
+    let head_local = view.pose.position.to_vec3();
+    let head_rot_local = view.pose.orientation.to_quat();
+    let head = root.transform_point(head_local);
+    let head_rot = root.rotation * head_rot_local;
+    let facing = space::facing(head_rot);
+    let main = match options.hand {
+        Handedness::Right => 1,
+        Handedness::Left => 0,
+    };
+    let mut hands = [hands::HandInput {
+        position: head,
+        pointing: Vec2::new(facing.cos(), facing.sin()),
+        aim_from: head,
+        aim_along: head_rot * Vec3::NEG_Z,
+        ..Default::default()
+    }; 2];
+    for (g, t) in &tracked.grips {
+        hands[g.0.min(1)].position = t.translation();
+    }
+    for (p, t) in &tracked.pointers {
+        let hand = &mut hands[p.0.min(1)];
+        let forward = t.forward().as_vec3();
+        (hand.aim_from, hand.aim_along) = (t.translation(), forward);
+        let f = space::floor(forward);
+        if f.length() > 0.1 {
+            hand.pointing = f;
+        }
+    }
+    for (hand, path) in hands.iter_mut().zip(a.hands) {
+        hand.squeeze = a.squeeze.state(&session, path).map(|s| s.current_state).unwrap_or(false);
+        hand.trigger = a.trigger.state(&session, path).map(|s| s.current_state).unwrap_or(0.0) > hands::TRIGGER_PULLED;
+        hand.stick = a.stick.state(&session, path).map(|s| s.current_state.to_vec2()).unwrap_or_default();
+        hand.click = a.stick_click.state(&session, path).is_ok_and(|s| s.current_state && s.changed_since_last_sync);
+    }
+    hands_out.main = hands[main].position;
+    hands_out.other = hands[1 - main].position;
+    *input =
+        XrInput { ready: true, head_local, head_rot_local, head, facing, hands, main, dt: time.delta_secs().max(1e-4) };
+}
+
+/// What each hand does (`hands::decide_hand`): the server's actions, running toggled, the view turned.
+fn use_hands(
+    input: Res<XrInput>,
+    mut memory: ResMut<XrHands>,
+    mut intent: ResMut<Intent>,
     state: Res<ViveState>,
-    grips: Query<(&Grip, &GlobalTransform)>,
-    pointers: Query<(&Pointer, &GlobalTransform)>,
-    mut root: Query<&mut Transform, With<XrTrackingRoot>>,
     cases: Query<&CaseView>,
     items: Query<&ItemView>,
 ) {
-    let (Some(a), Ok(mut root), Some(view), Some(body)) = (actions, root.single_mut(), views.first(), state.body())
-    else {
+    memory.turn = 0.0;
+    if !input.ready || state.body().is_none() {
         return;
-    };
-    let dt = time.delta_secs().max(1e-4);
-    let (main, off) = match options.hand {
-        Handedness::Right => (1, 0),
-        Handedness::Left => (0, 1),
-    };
-    let head_local = view.pose.position.to_vec3();
-    let head = root.transform_point(head_local);
-    let head_rot = root.rotation * view.pose.orientation.to_quat();
-    intent.facing = space::facing(head_rot);
+    }
+    intent.facing = input.facing;
+    let case_refs: Vec<&CaseView> = cases.iter().collect();
+    let bench = state.level.as_ref().map(|l| l.workbench);
+    for hand in 0..2 {
+        let control = &input.hands[hand];
+        let aim = Aim { from: space::floor(control.position), towards: control.pointing };
+        let held = memory.hands[hand].holding;
+        let around = hands::AroundHand {
+            phase: state.phase,
+            item: aim.item(items.iter(), &case_refs),
+            case: if control.trigger { aim.case(cases.iter()) } else { None },
+            bench,
+            held_taken: held.is_some_and(|id| items.iter().any(|i| i.id == id && i.place != ItemPlace::Carried)),
+        };
+        let out = hands::decide_hand(&mut memory.hands[hand], control, &around, hand == input.main, input.dt);
+        intent.actions.extend(out.actions);
+        if out.toggle_running {
+            memory.running = !memory.running;
+        }
+        memory.turn += out.turn.unwrap_or(0.0);
+    }
+}
 
+/// Keeps the view on the body: recentred on joining and on the recentring hold, carried with the body
+/// the sticks moved, turned by the main stick.
+fn place_view(
+    input: Res<XrInput>,
+    memory: Res<XrHands>,
+    mut motion: ResMut<XrMotion>,
+    state: Res<ViveState>,
+    options: Res<XrOptions>,
+    mut root: Query<&mut Transform, With<XrTrackingRoot>>,
+) {
+    let (true, Some(body), Ok(mut root)) = (input.ready, state.body(), root.single_mut()) else { return };
+    let recentre_here = |root: &mut Transform| {
+        recentre(root, input.head_local, input.head_rot_local, body, input.facing, options.seated)
+    };
     // Keep the body under the head: on joining, recentre on the body.
-    if !hs.recentred {
-        recentre(&mut root, head_local, view.pose.orientation.to_quat(), body, intent.facing, options.seated);
-        hs.recentred = true;
+    if !motion.recentred {
+        recentre_here(&mut root);
+        motion.recentred = true;
     }
     // The body moved because of the sticks: carry the room along.
-    if let (Some(last), true) = (hs.last_body, hs.locomoting) {
-        let d = body - last;
+    if let Some(d) = hands::carry(&mut motion.moving, body) {
         root.translation += space::world(d, 0.0);
     }
-    hs.last_body = Some(body);
+    if memory.turn != 0.0 {
+        root.rotate_around(input.head, Quat::from_rotation_y(memory.turn));
+    }
+    let XrMotion { recentre_hold_s, .. } = &mut *motion;
+    if hands::hold_to_recentre(&memory.hands, recentre_hold_s, input.dt) {
+        recentre_here(&mut root);
+    }
+}
 
-    let state_of = |hand: usize| {
-        let p = a.hands[hand];
-        (
-            a.squeeze.state(&session, p).map(|s| s.current_state).unwrap_or(false),
-            a.trigger.state(&session, p).map(|s| s.current_state).unwrap_or(0.0) > 0.6,
-            a.stick.state(&session, p).map(|s| s.current_state.to_vec2()).unwrap_or_default(),
-            a.stick_click.state(&session, p).is_ok_and(|s| s.current_state && s.changed_since_last_sync),
-        )
+/// Moves the body: the off hand's stick (smooth, or a teleport arc), the head leading it; walls hold the
+/// view back.
+fn walk(
+    input: Res<XrInput>,
+    memory: Res<XrHands>,
+    mut motion: ResMut<XrMotion>,
+    mut intent: ResMut<Intent>,
+    state: Res<ViveState>,
+    options: Res<XrOptions>,
+    mut root: Query<&mut Transform, With<XrTrackingRoot>>,
+) {
+    let (true, Some(body), Ok(mut root)) = (input.ready, state.body(), root.single_mut()) else { return };
+    let off = &input.hands[1 - input.main];
+    let stick = memory.hands[1 - input.main].stick_was;
+    let standing = hands::Standing {
+        facing: input.facing,
+        head: input.head,
+        body,
+        seated: options.seated,
+        smooth: options.locomotion == Locomotion::Smooth,
+        running: memory.running,
+        dt: input.dt,
     };
-    let mut hand_pos = [head; 2];
-    for (g, t) in &grips {
-        hand_pos[g.0.min(1)] = t.translation();
-    }
-    let mut pointing = [Vec2::new(intent.facing.cos(), intent.facing.sin()); 2];
-    let mut aims = [(head, head_rot * Vec3::NEG_Z); 2];
-    for (p, t) in &pointers {
-        let forward = t.forward().as_vec3();
-        aims[p.0.min(1)] = (t.translation(), forward);
-        let f = space::floor(forward);
-        if f.length() > 0.1 {
-            pointing[p.0.min(1)] = f;
+    let aimed = match (&state.level, &state.walls) {
+        (Some(level), Some(walls)) if !standing.smooth && hands::aiming(stick) => {
+            Some(arc::teleport_arc(off.aim_from, off.aim_along, body, level, walls))
         }
-    }
-    hands_out.main = hand_pos[main];
-    hands_out.other = hand_pos[off];
-    let case_refs: Vec<&CaseView> = cases.iter().collect();
-
-    for hand in 0..2 {
-        let (squeeze, trigger, stick, click) = state_of(hand);
-        let history = &mut hs.positions[hand];
-        history.rotate_left(1);
-        history[5] = hand_pos[hand];
-        let velocity = (history[5] - history[0]) / (5.0 * dt);
-        let aim = Aim { from: space::floor(hand_pos[hand]), towards: pointing[hand] };
-        hs.grabbable[hand] = if hs.holding[hand].is_none() { aim.item(items.iter(), &case_refs) } else { None };
-        if squeeze
-            && !hs.squeezed[hand]
-            && hs.holding[hand].is_none()
-            && let Some(item) = aim.item(items.iter(), &case_refs)
-        {
-            intent.actions.push(Do::PickUp(item));
-            hs.holding[hand] = Some(item);
-        }
-        if !squeeze
-            && hs.squeezed[hand]
-            && !hs.triggered[hand]
-            && let Some(item) = hs.holding[hand].take()
-        {
-            let bench = state.level.as_ref().map(|l| l.workbench);
-            let at_bench = bench.is_some_and(|b| b.distance(space::floor(hand_pos[hand])) < rules::REACH);
-            intent.actions.push(if at_bench { Do::Place(item) } else { Do::Drop(item) });
-        }
-        if trigger && !hs.triggered[hand] && matches!(state.phase, Phase::Won | Phase::Lost(_)) {
-            intent.actions.push(Do::Rematch);
-        }
-        if trigger
-            && !hs.triggered[hand]
-            && hs.holding[hand].is_none()
-            && let Some(case) = aim.case(cases)
-        {
-            intent.actions.push(Do::Break(case));
-        }
-        if !trigger
-            && hs.triggered[hand]
-            && let Some(item) = hs.holding[hand].take()
-        {
-            intent.actions.push(Do::Throw { item, target: throw_landing(hand_pos[hand], velocity) });
-        }
-        hs.squeezed[hand] = squeeze;
-        hs.triggered[hand] = trigger;
-        if click && hand == off {
-            hs.running = !hs.running;
-        }
-        if hand == main {
-            let was = hs.stick_was[main];
-            if stick.x.abs() > 0.7 && was.x.abs() <= 0.7 {
-                let angle = -stick.x.signum() * SNAP_TURN;
-                root.rotate_around(head, Quat::from_rotation_y(angle));
-            }
-        }
-        // Let go of an item the server took away (delivered, secured).
-        if let Some(item) = hs.holding[hand]
-            && items.iter().any(|i| i.id == item && i.place != ItemPlace::Carried)
-            && !squeeze
-        {
-            hs.holding[hand] = None;
-        }
-        hs.stick_was[hand] = stick;
-    }
-
-    // Recentre: both grips held with empty hands.
-    if hs.squeezed == [true, true] && hs.holding == [None, None] {
-        hs.recentre_s += dt;
-        if hs.recentre_s > 1.5 {
-            recentre(&mut root, head_local, view.pose.orientation.to_quat(), body, intent.facing, options.seated);
-            hs.recentre_s = f32::NEG_INFINITY;
-        }
-    } else {
-        hs.recentre_s = 0.0;
-    }
-
-    // Locomotion.
-    let stick = hs.stick_was[off];
-    let yaw_dir = Vec2::new(intent.facing.cos(), intent.facing.sin());
-    let right = Vec2::new(intent.facing.sin(), -intent.facing.cos());
-    let crouching = !options.seated && head.y < CROUCH_BELOW_M;
-    let gait = if crouching {
-        Gait::Crouch
-    } else if hs.running {
-        Gait::Run
-    } else {
-        Gait::Walk
+        _ => None,
     };
-    intent.gait = gait;
-    hs.locomoting = false;
-    match options.locomotion {
-        Locomotion::Smooth => {
-            hs.locomoting = stick.length() > 0.1;
-            intent.movement = (yaw_dir * stick.y + right * stick.x).clamp_length_max(1.0);
-            hs.vignette = intent.movement.length();
-        }
-        Locomotion::Teleport => {
-            if stick.y > 0.6 {
-                // Aiming: the arc from the off hand shows where, green when the body may go there.
-                if let (Some(level), Some(walls)) = (state.level.as_ref(), state.walls.as_ref()) {
-                    let (from, along) = aims[off];
-                    hs.arc = Some(arc::teleport_arc(from, along, body, level, walls));
-                }
-                hs.travel = None;
-                hs.fade = 0.0;
-            } else if let Some(aimed) = hs.arc.take() {
-                // Let go: a valid target blinks the body there (the view goes dark while the server
-                // walks it); a refused one does nothing.
-                if aimed.valid() {
-                    hs.travel = Some(aimed.landing);
-                    hs.fade = 0.95;
-                }
-            } else if let Some(target) = hs.travel {
-                let d = target - body;
-                if d.length() < 0.1 {
-                    hs.travel = None;
-                    hs.fade = 0.0;
-                } else {
-                    intent.movement = d.normalize();
-                    hs.fade = 0.85;
-                    hs.locomoting = true;
-                }
-            }
-        }
-    }
-    // Walking in the room pulls the body along; walls hold the head back.
-    let lead = space::floor(head) - body;
-    if intent.movement == Vec2::ZERO && lead.length() > 0.15 {
-        intent.movement = (lead / (rules::gait_speed(gait) * dt)).clamp_length_max(1.0);
-    }
-    if lead.length() > HEAD_LEASH_M {
-        let back = lead - lead.normalize() * HEAD_LEASH_M;
+    let step = hands::decide_move(&mut motion.moving, stick, &standing, aimed);
+    intent.movement = step.movement;
+    intent.gait = step.gait;
+    if let Some(back) = step.leash {
         root.translation -= space::world(back, 0.0);
     }
 }
 
 /// Draws the teleport arc while aiming: green to a valid target (with a ring where the body will
 /// stand), red and ending where it is refused.
-fn draw_arc(hs: Res<HandState>, mut gizmos: Gizmos) {
-    let Some(aimed) = hs.arc.as_ref() else { return };
+fn draw_arc(motion: Res<XrMotion>, mut gizmos: Gizmos) {
+    let Some(aimed) = motion.moving.arc.as_ref() else { return };
     let colour = if aimed.valid() { Color::srgb(0.2, 1.0, 0.4) } else { Color::srgb(1.0, 0.2, 0.15) };
     gizmos.linestrip(aimed.points.iter().copied(), colour);
     let ring = Isometry3d::new(space::world(aimed.landing, 0.02), Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2));
@@ -716,12 +683,12 @@ fn spawn_highlights(
 /// Puts each hand's highlight ring around the item it would pick up, where that item is drawn; hides it
 /// when the hand holds something or reaches nothing.
 fn show_grab_highlights(
-    hs: Res<HandState>,
+    memory: Res<XrHands>,
     items: Query<(&ItemView, &Transform), Without<GrabHighlight>>,
     mut rings: Query<(&GrabHighlight, &mut Transform, &mut Visibility)>,
 ) {
     for (hand, mut t, mut vis) in &mut rings {
-        let target = hs.grabbable[hand.0.min(1)].and_then(|id| items.iter().find(|(i, _)| i.id == id));
+        let target = memory.hands[hand.0.min(1)].grabbable.and_then(|id| items.iter().find(|(i, _)| i.id == id));
         match target {
             Some((_, at)) => {
                 t.translation = at.translation;
@@ -749,18 +716,19 @@ pub fn vignette_opening(strength: f32) -> f32 {
 }
 
 fn comfort(
-    hs: Res<HandState>,
+    motion: Res<XrMotion>,
     q: Query<&MeshMaterial3d<StandardMaterial>, With<Comfort>>,
     mut ring: Query<(&mut Transform, &mut Visibility), With<Vignette>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
 ) {
     for (mut t, mut vis) in &mut ring {
-        t.scale = Vec3::splat(vignette_opening(hs.vignette) / 0.5);
-        *vis = if hs.vignette > 0.05 { Visibility::Inherited } else { Visibility::Hidden };
+        let vignette = motion.moving.vignette;
+        t.scale = Vec3::splat(vignette_opening(vignette) / 0.5);
+        *vis = if vignette > 0.05 { Visibility::Inherited } else { Visibility::Hidden };
     }
     for m in &q {
         if let Some(mut mat) = materials.get_mut(&m.0) {
-            let alpha = hs.fade.clamp(0.0, 0.95);
+            let alpha = motion.moving.fade.clamp(0.0, 0.95);
             if (mat.base_color.alpha() - alpha).abs() > 0.01 {
                 mat.base_color = Color::srgba(0.0, 0.0, 0.0, alpha);
             }
@@ -793,12 +761,13 @@ fn pulse(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use heist_shared::rules;
 
     #[test]
     fn each_empty_hand_rings_what_it_would_pick_up_where_that_is_drawn() {
         use heist_shared::protocol::{ItemId, ItemKind};
         let mut app = App::new();
-        app.init_resource::<HandState>().add_systems(Update, show_grab_highlights);
+        app.init_resource::<XrHands>().add_systems(Update, show_grab_highlights);
         let at = Vec3::new(3.0, 1.1, -4.0);
         app.world_mut().spawn((
             ItemView { id: ItemId(7), kind: ItemKind::Prop, place: ItemPlace::Floor(Vec2::new(3.0, 4.0)) },
@@ -816,10 +785,11 @@ mod tests {
                 })
                 .collect::<Vec<_>>()
         };
-        app.world_mut().resource_mut::<HandState>().grabbable = [None, Some(ItemId(7))];
+        app.world_mut().resource_mut::<XrHands>().hands[1].grabbable = Some(ItemId(7));
         app.update();
         assert_eq!(shown(&app), vec![None, Some(at)], "the right hand's ring is round the item");
-        app.world_mut().resource_mut::<HandState>().grabbable = [Some(ItemId(9)), None];
+        let mut memory = app.world_mut().resource_mut::<XrHands>();
+        (memory.hands[0].grabbable, memory.hands[1].grabbable) = (Some(ItemId(9)), None);
         app.update();
         assert_eq!(shown(&app), vec![None, None], "an item not drawn is not ringed; an empty reach shows nothing");
     }

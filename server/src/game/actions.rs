@@ -122,7 +122,7 @@ impl Game {
             return Err(Refusal::NotCarried);
         }
         self.take_from_hands(id)?;
-        let landing = rules::throw_landing(&self.level, &self.walls, self.vive.position, target);
+        let landing = self.walls.throw_landing(&self.level, self.vive.position, target);
         self.items[usize::from(id.0)].place = ItemPlace::Floor(landing);
         self.noise(NoiseKind::Thud, landing, rules::THUD_LOUDNESS);
         Ok(())

@@ -11,10 +11,9 @@ mod setup;
 
 pub use guard::{Guard, GuardState, Perception};
 pub use radio::Radio;
-pub use setup::CopyTruth;
 
 use glam::Vec2;
-use heist_shared::artifact::{ArtifactKind, Briefing};
+use heist_shared::artifact::{ArtifactKind, Briefing, CopyTraits, HapticMesh, Material};
 use heist_shared::level::{Level, NavGraph, WallSet};
 use heist_shared::protocol::{
     CaseId, ClientMsg, GameEvent, ItemId, ItemKind, ItemPlace, LobbyMsg, LossReason, NoiseKind, PhantomMsg,
@@ -148,6 +147,21 @@ pub struct Item {
     pub truth: Option<CopyTruth>,
 }
 
+/// What only the server knows about a copy.
+#[derive(Clone, Debug)]
+pub struct CopyTruth {
+    /// Index of its target in `Game::targets`.
+    pub target: usize,
+    /// What touch can tell.
+    pub traits: CopyTraits,
+    /// The one real copy of its target?
+    pub real: bool,
+    /// Its haptic geometry (generated once at set-up).
+    pub mesh: HapticMesh,
+    /// Its material.
+    pub material: Material,
+}
+
 /// A target artifact's progress.
 #[derive(Clone, Debug)]
 pub struct Target {
@@ -240,11 +254,6 @@ fn set(pair: &mut (bool, bool), role: Role, value: bool) {
 }
 
 impl Game {
-    /// A new session in the lobby.
-    pub fn new(level: Level, options: &GameOptions) -> Self {
-        setup::new_game(level, options)
-    }
-
     /// A player connected with the join code; the other is told, and the newcomer gets what its view
     /// of a running heist needs ([`Game::catch_up`]).
     pub fn join(&mut self, role: Role) {
@@ -395,7 +404,7 @@ impl Game {
         }
         let mut options = self.options.clone();
         options.seed = if self.options.random_rounds { rand::random() } else { next_round_seed(self.seed) };
-        let mut next = setup::new_game(self.level.clone(), &options);
+        let mut next = Game::new(self.level.clone(), &options);
         next.options = self.options.clone();
         next.round = self.round + 1;
         next.present = self.present;
@@ -553,7 +562,7 @@ impl Game {
     fn apply_next_input(&mut self, dt: f32) -> bool {
         let Some(input) = self.vive.inputs.pop_front() else { return false };
         let from = self.vive.position;
-        self.vive.position = rules::move_body(&self.walls, from, input.direction, input.speed, dt);
+        self.vive.position = self.walls.move_body(from, input.direction, input.speed, dt);
         self.vive.stance = input.stance;
         self.vive.facing = input.facing;
         self.vive.last_input_seq = input.seq;
@@ -594,16 +603,9 @@ impl Game {
             .map(|(i, c)| (i, c.position))
             .collect();
         for i in 0..self.guards.len() {
-            let perception = guard::perceive(
-                &self.guards[i],
-                &self.vive,
-                &self.walls,
-                &self.nav,
-                &self.noises,
-                &unreported,
-                alarm,
-                &t,
-            );
+            let vive = guard::Body { position: self.vive.position, crouching: self.vive.stance == Stance::Crouching };
+            let perception =
+                guard::perceive(&self.guards[i], vive, &self.walls, &self.nav, &self.noises, &unreported, alarm, &t);
             let before = self.guards[i].alert;
             let acted = guard::think_and_act(&mut self.guards[i], &perception, &self.walls, &self.nav, alarm, &t, dt);
             let g = &self.guards[i];

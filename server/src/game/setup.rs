@@ -1,7 +1,7 @@
 //! Building a session from a level and a seed: copies, their hidden truth, cases, guards.
 
 use glam::Vec2;
-use heist_shared::artifact::{self, CopyTraits, HapticMesh, Material};
+use heist_shared::artifact;
 use heist_shared::level::{Level, NavGraph, WallSet};
 use heist_shared::protocol::{CaseId, GuardId, ItemId, ItemKind, ItemPlace, Phase};
 use rand::SeedableRng;
@@ -9,101 +9,97 @@ use rand::seq::SliceRandom;
 use rand_chacha::ChaCha8Rng;
 
 use super::guard::Guard;
-use super::{Case, Game, GameOptions, Item, Target, Vive};
+use super::{Case, CopyTruth, Game, GameOptions, Item, Target, Vive};
 
-/// What only the server knows about a copy.
-#[derive(Clone, Debug)]
-pub struct CopyTruth {
-    /// Index of its target in `Game::targets`.
-    pub target: usize,
-    /// What touch can tell.
-    pub traits: CopyTraits,
-    /// The one real copy of its target?
-    pub real: bool,
-    /// Its haptic geometry (generated once at set-up).
-    pub mesh: HapticMesh,
-    /// Its material.
-    pub material: Material,
-}
+impl Game {
+    /// A new session in the lobby.
+    pub fn new(level: Level, options: &GameOptions) -> Self {
+        let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+        let walls = WallSet::new(&level);
+        let nav = NavGraph::new(&level);
 
-pub(super) fn new_game(level: Level, options: &GameOptions) -> Game {
-    let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
-    let walls = WallSet::new(&level);
-    let nav = NavGraph::new(&level);
-
-    // Copies first, each tagged with its truth; then shuffle so item ids and cases say nothing.
-    let mut copies = Vec::new();
-    let mut targets = Vec::new();
-    for (t, spec) in level.targets.iter().enumerate() {
-        let target_seed = artifact::target_seed(options.seed, t);
-        let (traits, real_index) = artifact::generate_copies(spec.kind, target_seed, spec.copies);
-        targets.push(Target { kind: spec.kind, briefing: artifact::briefing(&traits[real_index]), secured: false });
-        for (c, tr) in traits.into_iter().enumerate() {
-            let mesh = artifact::build_mesh(&tr, artifact::copy_mesh_seed(target_seed, c));
-            let material = tr.material.material();
-            let kind = ItemKind::Copy { artifact: spec.kind, look: artifact::look(spec.kind) };
-            copies.push((kind, CopyTruth { target: t, traits: tr, real: c == real_index, mesh, material }));
+        // Copies first, each tagged with its truth; then shuffle so item ids and cases say nothing.
+        let mut copies = Vec::new();
+        let mut targets = Vec::new();
+        for (t, spec) in level.targets.iter().enumerate() {
+            let target_seed = artifact::target_seed(options.seed, t);
+            let (traits, real_index) = artifact::generate_copies(spec.kind, target_seed, spec.copies);
+            targets.push(Target { kind: spec.kind, briefing: artifact::briefing(&traits[real_index]), secured: false });
+            for (c, tr) in traits.into_iter().enumerate() {
+                let mesh = artifact::build_mesh(&tr, artifact::copy_mesh_seed(target_seed, c));
+                let material = tr.material.material();
+                let kind = ItemKind::Copy { artifact: spec.kind, look: artifact::look(spec.kind) };
+                copies.push((kind, CopyTruth { target: t, traits: tr, real: c == real_index, mesh, material }));
+            }
         }
-    }
-    copies.shuffle(&mut rng);
-    let mut case_order: Vec<usize> = (0..level.cases.len()).collect();
-    case_order.shuffle(&mut rng);
+        copies.shuffle(&mut rng);
+        let mut case_order: Vec<usize> = (0..level.cases.len()).collect();
+        case_order.shuffle(&mut rng);
 
-    let mut items: Vec<Item> = copies
-        .into_iter()
-        .zip(&case_order)
-        .map(|((kind, truth), &case)| Item { kind, place: ItemPlace::InCase(CaseId(case as u16)), truth: Some(truth) })
-        .collect();
-    items.extend(level.props.iter().map(|&p| Item { kind: ItemKind::Prop, place: ItemPlace::Floor(p), truth: None }));
+        let mut items: Vec<Item> = copies
+            .into_iter()
+            .zip(&case_order)
+            .map(|((kind, truth), &case)| Item {
+                kind,
+                place: ItemPlace::InCase(CaseId(case as u16)),
+                truth: Some(truth),
+            })
+            .collect();
+        items.extend(level.props.iter().map(|&p| Item {
+            kind: ItemKind::Prop,
+            place: ItemPlace::Floor(p),
+            truth: None,
+        }));
 
-    let tuning = level.tuning(options.difficulty);
-    let guards = level
-        .guards
-        .iter()
-        .take(tuning.guards.unwrap_or(usize::MAX))
-        .enumerate()
-        .map(|(i, g)| Guard::new(GuardId(i as u16), g.name.clone(), g.route.clone()))
-        .collect();
-    let cases = level.cases.iter().map(|c| Case { position: c.at, broken: false, reported: false }).collect();
-    let vive = Vive { position: level.vive_spawn, facing: 0.0, ..Default::default() };
-    let time_left_s = options.time_limit_s.unwrap_or(level.time_limit_s * tuning.time_scale);
+        let tuning = level.tuning(options.difficulty);
+        let guards = level
+            .guards
+            .iter()
+            .take(tuning.guards.unwrap_or(usize::MAX))
+            .enumerate()
+            .map(|(i, g)| Guard::new(GuardId(i as u16), g.name.clone(), g.route.clone()))
+            .collect();
+        let cases = level.cases.iter().map(|c| Case { position: c.at, broken: false, reported: false }).collect();
+        let vive = Vive { position: level.vive_spawn, facing: 0.0, ..Default::default() };
+        let time_left_s = options.time_limit_s.unwrap_or(level.time_limit_s * tuning.time_scale);
 
-    Game {
-        walls,
-        nav,
-        phase: Phase::Lobby,
-        time_left_s,
-        elapsed_s: 0.0,
-        alarm: 0,
-        vive,
-        guards,
-        difficulty: options.difficulty,
-        tuning,
-        cases,
-        items,
-        targets,
-        workbench: None,
-        present: (false, false),
-        ready: (false, false),
-        absent_s: 0.0,
-        noises: Vec::new(),
-        outgoing: Vec::new(),
-        rng,
-        radio: Default::default(),
-        patrols_for: None,
-        caught_by: None,
-        level,
-        seed: options.seed,
-        round: 1,
-        closed: false,
-        draining: false,
-        options: options.clone(),
-        rematch: (false, false),
-        kept: [None, None],
-        idle_s: 0.0,
-        warned_ending: false,
-        joined_once: false,
-        tool: Default::default(),
+        Game {
+            walls,
+            nav,
+            phase: Phase::Lobby,
+            time_left_s,
+            elapsed_s: 0.0,
+            alarm: 0,
+            vive,
+            guards,
+            difficulty: options.difficulty,
+            tuning,
+            cases,
+            items,
+            targets,
+            workbench: None,
+            present: (false, false),
+            ready: (false, false),
+            absent_s: 0.0,
+            noises: Vec::new(),
+            outgoing: Vec::new(),
+            rng,
+            radio: Default::default(),
+            patrols_for: None,
+            caught_by: None,
+            level,
+            seed: options.seed,
+            round: 1,
+            closed: false,
+            draining: false,
+            options: options.clone(),
+            rematch: (false, false),
+            kept: [None, None],
+            idle_s: 0.0,
+            warned_ending: false,
+            joined_once: false,
+            tool: Default::default(),
+        }
     }
 }
 

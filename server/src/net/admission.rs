@@ -10,8 +10,8 @@ use heist_shared::protocol::{ClientRole, DisconnectReason, Role, SeatTicket, Ser
 
 use super::limits::MessageLimits;
 use super::seats::Seat;
+use super::settings::{Auth, NetSettings};
 use super::transport::GameTransport;
-use super::{Auth, NetSettings};
 use crate::session::{HostSession, Session, SessionTag};
 
 /// An admitted player's client entity.
@@ -31,32 +31,6 @@ pub struct Player {
     pub limits: MessageLimits,
     /// Where it connects from (for the log).
     pub peer: Option<std::net::SocketAddr>,
-}
-
-/// Which client entity plays which role in a session.
-#[derive(Default, Debug)]
-pub struct Roles {
-    /// Vive's client.
-    pub vive: Option<Entity>,
-    /// Phantom's client.
-    pub phantom: Option<Entity>,
-}
-
-impl Roles {
-    /// The client playing `role`.
-    pub fn get(&self, role: Role) -> Option<Entity> {
-        match role {
-            Role::Vive => self.vive,
-            Role::Phantom => self.phantom,
-        }
-    }
-
-    pub(super) fn slot(&mut self, role: Role) -> &mut Option<Entity> {
-        match role {
-            Role::Vive => &mut self.vive,
-            Role::Phantom => &mut self.phantom,
-        }
-    }
 }
 
 /// Disconnects `client` after telling it why.

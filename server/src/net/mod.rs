@@ -5,11 +5,13 @@
 //! replicon's send).
 
 mod admission;
+pub mod codes;
 pub mod limits;
 pub mod receive;
 pub mod registry;
 pub mod seats;
 pub mod send;
+mod settings;
 pub mod tokens;
 pub mod transport;
 pub mod voice;
@@ -25,79 +27,11 @@ use heist_shared::protocol::{PROTOCOL_ID, Role};
 use heist_transport::IntakeLimits;
 use heist_transport::renetcode::{ServerAuthentication, ServerConfig};
 
-pub use admission::{Player, Roles};
-use registry::{Registry, SessionEntry};
+pub use admission::Player;
+pub use seats::Roles;
+pub use settings::{Auth, NetSettings, NewSessions};
 
-use crate::game::{Game, GameOptions};
-use crate::session::{HostSession, LogEcho, Session, SessionLog};
-
-/// How clients prove who they are.
-#[derive(Clone)]
-pub enum Auth {
-    /// Signed connect tokens from the token endpoint (the default).
-    Secure {
-        /// Netcode private key.
-        private_key: [u8; 32],
-    },
-    /// Any client may claim any role: LAN development only.
-    Insecure,
-}
-
-/// Network settings of the server.
-#[derive(Resource, Clone)]
-pub struct NetSettings {
-    /// Authentication mode.
-    pub auth: Auth,
-    /// The sessions, shared with the token endpoint.
-    pub registry: Registry,
-    /// Which of the registry's shards this app plays.
-    pub shard: usize,
-    /// Refused messages (leaking one per second) tolerated per client before it is disconnected for abuse.
-    pub abuse_limit: u32,
-    /// The address put in tokens and checked in connection requests, when not the bound one.
-    pub advertise: Option<std::net::SocketAddr>,
-    /// What every session created on request plays: the level, and options whose seed is replaced by a
-    /// fresh random one.
-    pub new_sessions: NewSessions,
-    /// Where refusals and resumes are counted.
-    pub metrics: crate::fleet::Metrics,
-}
-
-/// What a session created on request plays.
-#[derive(Clone)]
-pub struct NewSessions {
-    /// The level.
-    pub level: heist_shared::level::Level,
-    /// Options (time limit, idle end); each session draws its own seeds.
-    pub game: GameOptions,
-    /// Where its log goes.
-    pub echo: LogEcho,
-}
-
-impl NewSessions {
-    /// A session for `entry`: a fresh random seed (and random later rounds), unless `game` is given.
-    pub fn session(&self, entry: &SessionEntry, game: Option<&GameOptions>) -> Session {
-        let options = game.cloned().unwrap_or_else(|| GameOptions {
-            seed: rand::random(),
-            random_rounds: true,
-            ends_unjoined: true,
-            ..self.game.clone()
-        });
-        Session {
-            id: entry.id,
-            game: Game::new(self.level.clone(), &options),
-            log: SessionLog {
-                echo: self.echo,
-                id: format!("{:08x}", rand::random::<u32>()),
-                round: 1,
-                ..Default::default()
-            },
-            roles: Roles::default(),
-            seats: entry.seats.clone(),
-            closed_at: None,
-        }
-    }
-}
+use crate::session::{HostSession, Session};
 
 /// The bound game socket, waiting for the transport to be created at start-up.
 #[derive(Resource)]
@@ -141,6 +75,8 @@ impl Plugin for ServerNetPlugin {
             .add_observer(log_disconnect)
             .configure_sets(PreUpdate, NetSystems::Receive.after(ServerSystems::Receive))
             .configure_sets(PostUpdate, NetSystems::Send.before(ServerSystems::Send))
+            // The sessions' mirrors are up to date before what is sent.
+            .configure_sets(PostUpdate, crate::session::SessionSystems::Mirror.before(NetSystems::Send))
             .add_systems(
                 PreUpdate,
                 (receive::apply_client_messages, voice::relay_voice).chain().in_set(NetSystems::Receive),

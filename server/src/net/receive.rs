@@ -4,8 +4,8 @@ use bevy::prelude::*;
 use bevy_replicon::prelude::*;
 use heist_shared::protocol::{ClientMsg, DisconnectReason, LobbyMsg, ServerMsg};
 
-use super::NetSettings;
 use super::admission::{Player, refuse_and_disconnect};
+use super::settings::NetSettings;
 use crate::session::Session;
 
 /// A gap between two frames longer than this in wall-clock time (whatever the app's clock says: a stepped

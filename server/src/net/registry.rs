@@ -16,8 +16,8 @@ use heist_shared::protocol::join::JoinRefusal;
 use heist_shared::protocol::{Role, SeatTicket};
 use heist_transport::limit::{KeyedLimiter, Rate, address_key};
 
+use super::codes::{CodeBook, new_room};
 use super::seats::{Seat, Seats};
-use super::tokens::CodeBook;
 
 /// How fast sessions may be created.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -142,7 +142,7 @@ impl Registry {
             }
         }
         let room = loop {
-            let room = super::tokens::new_room();
+            let room = new_room();
             if !inner.rooms.contains_key(&room) {
                 break room;
             }

@@ -1,4 +1,4 @@
-//! A session's two seats (Vive's, Phantom's) and their tickets, shared by the game loop, which admits
+//! A session's two seats (Vive's, Phantom's), their tickets and the clients in them ([`Roles`]), shared by the game loop, which admits
 //! and lets go, and the token endpoint, which decides who may get a token for which seat.
 //!
 //! A seat is free, taken by a connected player, or kept for the player who dropped from it: then only
@@ -7,6 +7,7 @@
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Instant;
 
+use bevy::prelude::Entity;
 use heist_shared::protocol::join::JoinRefusal;
 use heist_shared::protocol::{Role, SeatTicket};
 use heist_shared::rules;
@@ -69,6 +70,32 @@ impl Seats {
         match self.get(role) {
             Seat::Free => Err(JoinRefusal::NoSeat(role)),
             Seat::Taken(ticket) | Seat::Kept { ticket, .. } => Ok(ticket),
+        }
+    }
+}
+
+/// Which client entity plays which role in a session.
+#[derive(Default, Debug)]
+pub struct Roles {
+    /// Vive's client.
+    pub vive: Option<Entity>,
+    /// Phantom's client.
+    pub phantom: Option<Entity>,
+}
+
+impl Roles {
+    /// The client playing `role`.
+    pub fn get(&self, role: Role) -> Option<Entity> {
+        match role {
+            Role::Vive => self.vive,
+            Role::Phantom => self.phantom,
+        }
+    }
+
+    pub(super) fn slot(&mut self, role: Role) -> &mut Option<Entity> {
+        match role {
+            Role::Vive => &mut self.vive,
+            Role::Phantom => &mut self.phantom,
         }
     }
 }

@@ -5,9 +5,9 @@ use bevy::prelude::*;
 use bevy_replicon::prelude::*;
 use heist_shared::protocol::{ClientVoice, DisconnectReason, PartnerVoice, ServerMsg};
 
-use super::NetSettings;
 use super::admission::{Player, refuse_and_disconnect};
 use super::limits::VOICE_STRIKE;
+use super::settings::NetSettings;
 use crate::session::Session;
 
 /// Relays every voice frame received this frame; a malformed one counts as a refusal, one over the rate

@@ -4,13 +4,15 @@
 //! You need this crate to play anything. [`AudioEngine`] owns kira's manager (sound card, or memory
 //! when there is none or in tests), a pool of binaural voices (sub-tracks with the [`binaural`] effect),
 //! one voice for speech straight ahead, and the endless contact sound placed at the workbench. The game
-//! side calls [`AudioEngine::play_at`] with an offset in the listener's frame; [`listener_offset`] turns
-//! a museum floor position into one.
+//! side maps what happens to the museum's cues with [`museum`] and plays them with
+//! [`AudioEngine::play_cue`] (or any sound with [`AudioEngine::play_at`]) at an offset in the listener's
+//! frame; [`listener_offset`] turns a museum floor position into one.
 #![warn(missing_docs)]
 
 pub mod backend;
 pub mod binaural;
 pub mod hrir;
+pub mod museum;
 pub mod synth;
 
 /// Audio could not start (the reason, for the player).
@@ -315,19 +317,18 @@ impl AudioEngine {
         self.play_at(s, offset, what);
     }
 
-    /// Breaking glass from `offset`.
-    pub fn glass(&mut self, offset: Vec3) {
-        self.play_at(self.glass.clone(), offset, "glass");
-    }
-
-    /// A thrown object landing at `offset`.
-    pub fn thud(&mut self, offset: Vec3) {
-        self.play_at(self.thud.clone(), offset, "thud");
-    }
-
-    /// A second of the alarm from `offset`.
-    pub fn alarm(&mut self, offset: Vec3) {
-        self.play_at(self.alarm.clone(), offset, "alarm");
+    /// Plays a museum cue (from [`museum`]) at `offset`, where the listener hears its floor point and
+    /// height (listener frame, m).
+    pub fn play_cue(&mut self, cue: &museum::MuseumCue, offset: Vec3) {
+        use museum::Sound;
+        match cue.sound {
+            Sound::Glass => self.play_at(self.glass.clone(), offset, cue.what),
+            Sound::Thud => self.play_at(self.thud.clone(), offset, cue.what),
+            Sound::Alarm => self.play_at(self.alarm.clone(), offset, cue.what),
+            Sound::Step { volume } => self.footstep(offset, volume, cue.what),
+            Sound::Bark { chasing } => self.play_at(synth::bark(chasing), offset, cue.what),
+            Sound::Radio => self.play_at(synth::radio_squawk(), offset, cue.what),
+        }
     }
 
     /// An earcon, centred in the head.

@@ -24,7 +24,10 @@ const ANGLE_MARGIN: f32 = 0.25;
 const ALL_ROUND_MARGIN: f32 = 1.0;
 /// A spot is worth stopping at (a harbour) when it stays unseen this long, seconds: long enough for
 /// the guards nearby to walk past and turn round.
-pub const HOLD_S: f32 = 10.0;
+pub const HARBOUR_HOLD_S: f32 = 10.0;
+/// Seconds between the moments a forecast checks along a walk or a hold (a quarter second: a guard turns
+/// or walks little in between).
+const CHECK_EVERY_S: f32 = 0.25;
 /// An alerted guard (unpredictable) is assumed to come at the bot this long, seconds, then stay.
 const ALERT_APPROACH_S: f32 = 5.0;
 
@@ -404,11 +407,11 @@ impl Forecast {
 
     /// True when a crouching Vive at `p` from `t` seconds on stays unseen for `hold` seconds more.
     fn holdable_for(&self, p: Vec2, t: f32, hold: f32, walls: &WallSet) -> bool {
-        (0..=(hold * 4.0) as usize).all(|k| !self.seen(p, t + k as f32 * 0.25, true, walls))
+        (0..=(hold / CHECK_EVERY_S) as usize).all(|k| !self.seen(p, t + k as f32 * CHECK_EVERY_S, true, walls))
     }
 
-    /// Walks the polyline from `from` through `path` at `speed` (crouching or not; a quarter second a
-    /// step), `until` seconds at most, asking `stop` at each step (where, when).
+    /// Walks the polyline from `from` through `path` at `speed` (crouching or not; a step every
+    /// [`CHECK_EVERY_S`]), `until` seconds at most, asking `stop` at each step (where, when).
     fn walk(
         &self,
         from: Vec2,
@@ -418,7 +421,7 @@ impl Forecast {
         walls: &WallSet,
         mut stop: impl FnMut(Vec2, f32) -> bool,
     ) -> Walk {
-        let (mut at, mut t, step) = (from, 0.0, 0.25);
+        let (mut at, mut t, step) = (from, 0.0, CHECK_EVERY_S);
         for &wp in path {
             while at.distance(wp) > 1e-3 {
                 if self.seen(at, t, crouching, walls) {
@@ -439,10 +442,10 @@ impl Forecast {
     }
 
     /// True when the whole walk from `from` through `path` at `speed` stays unseen and its end then
-    /// stays unseen for [`HOLD_S`] (a hiding place worth going to).
+    /// stays unseen for [`HARBOUR_HOLD_S`] (a hiding place worth going to).
     pub fn hiding_place(&self, from: Vec2, path: &[Vec2], speed: f32, crouching: bool, walls: &WallSet) -> bool {
         match self.walk(from, path, (speed, crouching), 60.0, walls, |_, _| false) {
-            Walk::Arrived(at, t) => self.holdable_for(at, t, HOLD_S, walls),
+            Walk::Arrived(at, t) => self.holdable_for(at, t, HARBOUR_HOLD_S, walls),
             _ => false,
         }
     }

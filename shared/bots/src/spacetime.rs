@@ -2,14 +2,14 @@
 //! sees Vive on the way to its goal.
 //!
 //! The floor is a grid of 1 m cells (those inside a room and clear of the walls; doorways included),
-//! time is ticks of [`TICK_S`]. From where Vive stands it steps to a cell near it; from a cell it can
+//! time is ticks of [`PLAN_TICK_S`]. From where Vive stands it steps to a cell near it; from a cell it can
 //! wait (crouching) or step to a neighbour walking, crouching, or running where no guard would hear it.
 //! Each step takes the ticks its gait needs and costs them, plus, for every tick a guard of the
 //! forecast would see Vive (in the cell it leaves for the first half of the step, the one it enters
 //! for the second), ten seconds when only within the bot's caution margins and a hundred when in
 //! plain sight. An A* search over (cell, tick), guided by the walking time to the goal through the
 //! grid, finds the cheapest plan that ends within reach of the goal and then stays there
-//! [`HOLD_S`] (its sightings counted too), or, when the goal is beyond the 20 s horizon or every way
+//! [`END_HOLD_S`] (its sightings counted too), or, when the goal is beyond the 20 s horizon or every way
 //! to it is watched, the cheapest one that ends at the horizon, paying the walk still left to the
 //! goal: progress while staying hidden. A plan's `seen_s` says how much it is seen (0: never);
 //! `None`: Vive stands nowhere near the grid.
@@ -27,13 +27,13 @@ use heist_shared::rules;
 use crate::forecast::{Forecast, Moment, Sighting};
 
 /// Seconds per tick of a plan.
-pub const TICK_S: f32 = 0.25;
+pub const PLAN_TICK_S: f32 = 0.25;
 /// How far ahead a plan looks, ticks (20 s).
 const HORIZON: usize = 80;
 /// Seconds the end of a plan must then stay unseen (a crouching Vive there).
-pub const HOLD_S: f32 = 4.0;
-/// Ticks of [`HOLD_S`].
-const HOLD: usize = (HOLD_S / TICK_S) as usize;
+const END_HOLD_S: f32 = 4.0;
+/// Ticks of [`END_HOLD_S`].
+const HOLD: usize = (END_HOLD_S / PLAN_TICK_S) as usize;
 /// Ticks one wait lasts.
 const WAIT: usize = 2;
 /// A plan may end this many ticks before the horizon (a step may not fit in the last ones).
@@ -165,7 +165,7 @@ impl Grid {
 
 /// Ticks a step of `len` metres takes at `speed` (rounded up: the plan is never ahead of Vive).
 fn step_ticks(len: f32, speed: f32) -> usize {
-    (len / speed / TICK_S - 1e-3).ceil().max(1.0) as usize
+    (len / speed / PLAN_TICK_S - 1e-3).ceil().max(1.0) as usize
 }
 
 /// One step of a plan: leave for `to` at `leave_s` (seconds after the plan was made), at `gait`.
@@ -276,7 +276,7 @@ pub fn plan(grid: &Grid, forecast: &Forecast, walls: &WallSet, from: Vec2, goal:
         walls,
         points: &points,
         doorways: &grid.doorways,
-        moments: (0..ticks).map(|t| forecast.moment(t as f32 * TICK_S)).collect(),
+        moments: (0..ticks).map(|t| forecast.moment(t as f32 * PLAN_TICK_S)).collect(),
         known: vec![0; ticks * n * 2],
     };
     let state = |cell: usize, tick: usize| tick * n + cell;
@@ -357,17 +357,17 @@ pub fn plan(grid: &Grid, forecast: &Forecast, walls: &WallSet, from: Vec2, goal:
         .filter(|pair| pair[0].0 != pair[1].0)
         .map(|pair| Step {
             to: points[pair[1].0],
-            leave_s: pair[0].1 as f32 * TICK_S,
-            arrive_s: pair[1].1 as f32 * TICK_S,
+            leave_s: pair[0].1 as f32 * PLAN_TICK_S,
+            arrive_s: pair[1].1 as f32 * PLAN_TICK_S,
             gait: pair[1].2,
         })
         .collect();
     if arrives && cell != start {
         // The last little way, from the cell to the goal itself (the bot acts once within reach).
-        let t = tick as f32 * TICK_S;
-        steps.push(Step { to: goal, leave_s: t, arrive_s: t + TICK_S, gait: Gait::Walk });
+        let t = tick as f32 * PLAN_TICK_S;
+        steps.push(Step { to: goal, leave_s: t, arrive_s: t + PLAN_TICK_S, gait: Gait::Walk });
     }
-    Some(Way { steps, arrives, seen_s: (seen_s * TICK_S * 4.0).floor() / 4.0 })
+    Some(Way { steps, arrives, seen_s: (seen_s * PLAN_TICK_S * 4.0).floor() / 4.0 })
 }
 
 /// The gait to go at now: the plan's, unless Vive standing at `me` would be in a guard's plain sight
@@ -375,7 +375,7 @@ pub fn plan(grid: &Grid, forecast: &Forecast, walls: &WallSet, from: Vec2, goal:
 /// creeps on (and the plan is made again if that makes it late).
 pub fn safe_gait(forecast: &Forecast, walls: &WallSet, me: Vec2, gait: Gait) -> Gait {
     let in_plain_sight = |t: f32| forecast.sighting(&forecast.moment(t), me, false, walls) == Sighting::Seen;
-    if gait != Gait::Crouch && [0.0, TICK_S, 2.0 * TICK_S].into_iter().any(in_plain_sight) {
+    if gait != Gait::Crouch && [0.0, PLAN_TICK_S, 2.0 * PLAN_TICK_S].into_iter().any(in_plain_sight) {
         Gait::Crouch
     } else {
         gait
@@ -425,7 +425,7 @@ impl Timed {
                 // is what lets a guard's look pass.
                 let before = self.done.checked_sub(1).map_or(0.0, |i| self.way.steps[i].arrive_s);
                 let straight_on = before >= step.leave_s;
-                let early = if straight_on { TICK_S } else { 0.0 };
+                let early = if straight_on { PLAN_TICK_S } else { 0.0 };
                 return if t + early + 1e-3 >= step.leave_s { Order::Go(step.to, step.gait) } else { Order::Hold };
             }
             self.done += 1;
@@ -439,11 +439,11 @@ impl Timed {
     pub fn seen_ahead(&self, forecast: &Forecast, walls: &WallSet, now: f32, me: Vec2) -> bool {
         let t0 = now - self.made_at;
         let steps = &self.way.steps[self.done.min(self.way.steps.len())..];
-        let end = steps.last().map_or(t0, |s| s.arrive_s) + HOLD_S;
-        let ticks = ((end - t0) / TICK_S).floor().max(0.0) as usize;
-        let moments: Vec<Moment> = (0..=ticks + 1).map(|k| forecast.moment(k as f32 * TICK_S)).collect();
+        let end = steps.last().map_or(t0, |s| s.arrive_s) + END_HOLD_S;
+        let ticks = ((end - t0) / PLAN_TICK_S).floor().max(0.0) as usize;
+        let moments: Vec<Moment> = (0..=ticks + 1).map(|k| forecast.moment(k as f32 * PLAN_TICK_S)).collect();
         (0..=ticks).any(|k| {
-            let (at, crouching) = pose_at(steps, me, t0 + k as f32 * TICK_S);
+            let (at, crouching) = pose_at(steps, me, t0 + k as f32 * PLAN_TICK_S);
             moments[k.saturating_sub(1)..=k + 1].iter().any(|m| forecast.sees(m, at, crouching, walls))
         })
     }
@@ -506,10 +506,10 @@ mod tests {
 
     /// Where `way` has Vive every tick from `from` (and whether crouching), to its end and the hold.
     fn walked(way: &Way, from: Vec2) -> Vec<(f32, Vec2, bool)> {
-        let end = way.steps.last().map_or(0.0, |s| s.arrive_s) + HOLD_S;
-        (0..=(end / TICK_S) as usize)
+        let end = way.steps.last().map_or(0.0, |s| s.arrive_s) + END_HOLD_S;
+        (0..=(end / PLAN_TICK_S) as usize)
             .map(|k| {
-                let t = k as f32 * TICK_S;
+                let t = k as f32 * PLAN_TICK_S;
                 let (at, crouching) = pose_at(&way.steps, from, t);
                 (t, at, crouching)
             })
@@ -566,7 +566,7 @@ mod tests {
         let forecast = m.forecast(&[clara], from);
         // Walking straight over is seen: the test means something.
         let straight = (0..=40).any(|k| {
-            let t = k as f32 * TICK_S;
+            let t = k as f32 * PLAN_TICK_S;
             let p = from.lerp(goal, (t * rules::WALK_SPEED / 10.0).min(1.0));
             forecast.sighting(&forecast.moment(t), p, false, &m.walls) == Sighting::Seen
         });

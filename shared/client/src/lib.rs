@@ -7,6 +7,8 @@
 #![warn(missing_docs)]
 
 mod error;
+mod inbox;
+mod link;
 pub mod notice;
 pub mod rejoin;
 pub mod seats;
@@ -16,68 +18,19 @@ pub mod transport;
 
 pub use error::JoinError;
 pub use heist_transport::renetcode::ConnectToken;
+pub use inbox::{Inbox, MessageCounts};
+pub use link::{LEAVE_WAIT_S, Leaving, Link, SILENCE_LOST_S};
 pub use rejoin::{Reconnect, Rejoin};
 pub use seats::{Joining, SeatCache, SeatKeeper, hold_seat, join_or_resume};
 pub use token::{create_session, request_resume_token, request_token};
+pub use transport::connection_config;
 
 use std::time::{SystemTime, UNIX_EPOCH};
 
 use bevy::prelude::*;
 use bevy_replicon::prelude::*;
-use bevy_replicon_renet::RenetChannelsExt;
-use bevy_replicon_renet::renet::ConnectionConfig;
-use heist_shared::artifact::Briefing;
-use heist_shared::level::Level;
-use heist_shared::protocol::{DisconnectReason, GameEvent, Refusal, Role, SeatTicket, ServerMsg, WorkbenchCopy};
+use heist_shared::protocol::{GameEvent, Role, ServerMsg};
 use heist_transport::renetcode::ClientAuthentication;
-
-/// What the server has told this client, kept for the app's systems to read.
-#[derive(Resource, Default, Debug)]
-pub struct Inbox {
-    /// The role granted by the server (after `Welcome`).
-    pub role: Option<Role>,
-    /// The level the server plays (after `Welcome`).
-    pub level: Option<Level>,
-    /// Briefings (Phantom only).
-    pub briefings: Vec<Briefing>,
-    /// The latest copy on the workbench not yet taken by the app (Phantom only).
-    pub workbench: Option<WorkbenchCopy>,
-    /// Game events not yet taken by the app, oldest first.
-    pub events: Vec<GameEvent>,
-    /// Every refusal received.
-    pub refusals: Vec<Refusal>,
-    /// Why the server disconnected us, if it said so.
-    pub disconnect: Option<DisconnectReason>,
-    /// Our seat's ticket (after `Welcome`): what takes the seat back after a lost connection.
-    pub seat: Option<SeatTicket>,
-    /// True when the last `Welcome` took a kept seat back.
-    pub resumed: bool,
-    /// The last `RoundStarted` (0 before one: a session's first round sends none; [`Inbox::current_round`]
-    /// reads it). A new round clears the briefings and the workbench.
-    pub round: u32,
-    /// Count of each kind of message received, for tests: (welcome, briefings, workbench, events).
-    pub received: MessageCounts,
-}
-
-impl Inbox {
-    /// The round being played: 1 until a `RoundStarted` says otherwise.
-    pub fn current_round(&self) -> u32 {
-        self.round.max(1)
-    }
-}
-
-/// How many server messages of each kind arrived.
-#[derive(Default, Debug, Clone, Copy, PartialEq, Eq)]
-pub struct MessageCounts {
-    /// `Welcome`.
-    pub welcome: u32,
-    /// `Briefings`.
-    pub briefings: u32,
-    /// `Workbench`.
-    pub workbench: u32,
-    /// `Event`.
-    pub events: u32,
-}
 
 /// System sets of the client core.
 #[derive(SystemSet, Debug, Clone, PartialEq, Eq, Hash)]
@@ -102,7 +55,7 @@ impl Plugin for ClientNetPlugin {
             .init_resource::<Reconnect>()
             .configure_sets(PreUpdate, ClientNetSystems::Receive.after(ClientSystems::Receive))
             .add_systems(PreUpdate, (fill_inbox, watch_link, rejoin::drive).chain().in_set(ClientNetSystems::Receive))
-            .add_systems(Update, (leave, seats::keep_seat));
+            .add_systems(Update, (link::leave, seats::keep_seat));
         transport::add_systems(app);
     }
 }
@@ -151,24 +104,6 @@ fn fill_inbox(
     }
 }
 
-/// Seconds of silence from the server after which the connection counts as lost (netcode sends a
-/// keep-alive several times a second when there is nothing else to send).
-pub const SILENCE_LOST_S: f64 = 3.0;
-
-/// The connection to the server, as the player should hear of it.
-#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Link {
-    /// Nothing heard from the server yet.
-    #[default]
-    Connecting,
-    /// The server was heard within [`SILENCE_LOST_S`].
-    Up,
-    /// Silent for [`SILENCE_LOST_S`] or more: the connection may come back until netcode gives up.
-    Silent,
-    /// The transport stopped: the server let us go, or went silent until netcode's timeout (6 s).
-    Gone,
-}
-
 /// Updates [`Link`] from the transport (only on a change, so `is_changed` means a new state).
 fn watch_link(transport: Option<Res<transport::ClientTransport>>, time: Res<Time<Real>>, mut link: ResMut<Link>) {
     let Some(transport) = transport else { return };
@@ -192,53 +127,6 @@ pub fn connection_over(link: Link, inbox: &Inbox, reconnect: &Reconnect) -> bool
     inbox.disconnect.is_some()
         || matches!(reconnect, Reconnect::GaveUp(_))
         || (link == Link::Gone && !reconnect.is_trying())
-}
-
-/// Leaving on purpose: set [`Leaving::since`] (or call [`Leaving::start`]) and the client says `Leave` to
-/// the server (so the partner hears "left", not "dropped"), waits for the server to close the connection
-/// (at most [`LEAVE_WAIT_S`]) and exits the app.
-#[derive(Resource, Default, Debug)]
-pub struct Leaving {
-    /// When the player asked to leave (app time, seconds); `None` while staying.
-    pub since: Option<f64>,
-    sent: bool,
-}
-
-/// Seconds a leaving client waits for the server to let it go before exiting anyway.
-pub const LEAVE_WAIT_S: f64 = 1.0;
-
-impl Leaving {
-    /// Starts leaving now (`now`: the app's real time, seconds).
-    pub fn start(&mut self, now: f64) {
-        self.since.get_or_insert(now);
-    }
-}
-
-fn leave(
-    mut leaving: ResMut<Leaving>,
-    inbox: Res<Inbox>,
-    time: Res<Time<Real>>,
-    mut out: MessageWriter<heist_shared::protocol::ClientMsg>,
-    mut exit: MessageWriter<AppExit>,
-) {
-    let Some(since) = leaving.since else { return };
-    if !leaving.sent {
-        leaving.sent = true;
-        out.write(heist_shared::protocol::ClientMsg::Lobby(heist_shared::protocol::LobbyMsg::Leave));
-    }
-    if inbox.disconnect.is_some() || time.elapsed_secs_f64() - since > LEAVE_WAIT_S {
-        exit.write(AppExit::Success);
-    }
-}
-
-/// renet's channels for the registered protocol: the same on the server and every client (call after all
-/// protocol registration).
-pub fn connection_config(channels: &RepliconChannels) -> ConnectionConfig {
-    ConnectionConfig {
-        server_channels_config: channels.server_configs(),
-        client_channels_config: channels.client_configs(),
-        ..Default::default()
-    }
 }
 
 /// Creates the netcode transport for `token` (call after [`ClientNetPlugin`] is added and all protocol

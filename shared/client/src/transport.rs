@@ -7,7 +7,8 @@ use std::time::{SystemTime, UNIX_EPOCH};
 
 use bevy::prelude::*;
 use bevy_replicon::prelude::RepliconChannels;
-use bevy_replicon_renet::{RenetClient, RenetClientPlugin, RenetReceive, RenetSend};
+use bevy_replicon_renet::renet::ConnectionConfig;
+use bevy_replicon_renet::{RenetChannelsExt, RenetClient, RenetClientPlugin, RenetReceive, RenetSend};
 use heist_transport::renetcode::{ClientAuthentication, ConnectToken, DisconnectReason, NetcodeError};
 use heist_transport::socket::{self, send_to};
 use heist_transport::{ClientIntake, TransportError};
@@ -137,5 +138,15 @@ pub(crate) fn open(
     let now = SystemTime::now().duration_since(UNIX_EPOCH).unwrap_or_default();
     let intake = ClientIntake::new(now, auth).map_err(|e| JoinError::Transport(e.to_string()))?;
     let transport = ClientTransport::new(socket, intake).map_err(JoinError::Socket)?;
-    Ok((RenetClient::new(crate::connection_config(channels)), transport))
+    Ok((RenetClient::new(connection_config(channels)), transport))
+}
+
+/// renet's channels for the registered protocol: the same on the server and every client (call after all
+/// protocol registration).
+pub fn connection_config(channels: &RepliconChannels) -> ConnectionConfig {
+    ConnectionConfig {
+        server_channels_config: channels.server_configs(),
+        client_channels_config: channels.client_configs(),
+        ..Default::default()
+    }
 }

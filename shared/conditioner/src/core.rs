@@ -3,7 +3,7 @@
 use std::net::{SocketAddr, UdpSocket};
 use std::time::Duration;
 
-use crate::{Conditions, Stats, loopback};
+use crate::link::{Conditions, Stats};
 
 /// Largest datagram relayed, bytes (ours are at most 1400).
 const BUFFER: usize = 2048;
@@ -121,4 +121,11 @@ impl Core {
             }
         }
     }
+}
+
+/// A bound loopback UDP socket that does not block.
+fn loopback() -> std::io::Result<UdpSocket> {
+    let socket = UdpSocket::bind("127.0.0.1:0")?;
+    socket.set_nonblocking(true)?;
+    Ok(socket)
 }

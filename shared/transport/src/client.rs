@@ -9,8 +9,9 @@ use std::time::Duration;
 use renet::RenetClient;
 use renetcode::{ClientAuthentication, DisconnectReason, NetcodeClient, NetcodeError};
 
+use crate::datagram::DatagramRefusal;
 use crate::datagram::{Direction, check_datagram};
-use crate::error::{DatagramRefusal, TransportError};
+use crate::error::TransportError;
 use crate::payload::SliceGuard;
 use crate::server::{Refused, Send};
 

@@ -1,46 +1,7 @@
-//! Why a datagram or a payload was turned away, as data.
+//! Why a payload was turned away, as data, and why a transport stopped (a datagram's refusal is
+//! [`crate::datagram::DatagramRefusal`], beside its check).
 
 use thiserror::Error;
-
-use crate::datagram::PacketKind;
-
-/// Why a datagram never reached netcode.
-#[derive(Clone, Copy, Debug, Error, PartialEq, Eq)]
-pub enum DatagramRefusal {
-    /// Shorter than its header and tag.
-    #[error("datagram of {0} bytes is too short for its header")]
-    TooShort(usize),
-    /// Longer than netcode's largest packet.
-    #[error("datagram of {0} bytes is longer than netcode's 1400")]
-    TooLong(usize),
-    /// The prefix names no netcode packet type.
-    #[error("unknown netcode packet type {0}")]
-    UnknownType(u8),
-    /// A packet type the other side never sends.
-    #[error("{0:?} packets do not travel this way")]
-    WrongDirection(PacketKind),
-    /// The prefix announces a sequence longer than 8 bytes (the renetcode 2.0.0 panic).
-    #[error("sequence length {0} in the prefix (at most 8)")]
-    BadSequenceLength(u8),
-    /// A sequence number no connection reaches (netcode's replay window overflows near `u64::MAX`).
-    #[error("sequence number beyond 2^63")]
-    SequenceOutOfRange,
-    /// A connection request whose prefix is not 0.
-    #[error("connection request with prefix {0:#04x}")]
-    BadPrefix(u8),
-    /// A connection request of the wrong size.
-    #[error("connection request of {0} bytes (must be 1078)")]
-    BadRequestSize(usize),
-    /// A connection request for another protocol version.
-    #[error("connection request for another netcode version")]
-    BadVersion,
-    /// From an address that is not the server's (client side).
-    #[error("datagram from an address that is not the server")]
-    NotFromServer,
-    /// Over this address's rate of connection requests, or the server's.
-    #[error("connection requests over the rate limit")]
-    RateLimited,
-}
 
 /// Why a decrypted renet packet never reached renet.
 #[derive(Clone, Copy, Debug, Error, PartialEq, Eq)]

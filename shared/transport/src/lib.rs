@@ -20,7 +20,8 @@ pub mod socket;
 pub mod throttle;
 
 pub use client::ClientIntake;
-pub use error::{DatagramRefusal, PayloadRefusal, TransportError};
+pub use datagram::DatagramRefusal;
+pub use error::{PayloadRefusal, TransportError};
 pub use server::{Departure, IntakeLimits, IntakeStats, Refused, ServerIntake};
 
 pub use renet;

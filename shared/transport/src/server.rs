@@ -11,8 +11,9 @@ use std::time::Duration;
 use renet::RenetServer;
 use renetcode::{NETCODE_USER_DATA_BYTES, NetcodeServer, ServerConfig, ServerResult};
 
+use crate::datagram::DatagramRefusal;
 use crate::datagram::{Direction, PacketKind, check_datagram};
-use crate::error::{DatagramRefusal, PayloadRefusal};
+use crate::error::PayloadRefusal;
 use crate::limit::{Bucket, KeyedLimiter, Rate, address_key};
 use crate::payload::SliceGuard;
 use crate::throttle::RefusalLog;

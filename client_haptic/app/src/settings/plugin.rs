@@ -70,7 +70,7 @@ impl Plugin for SettingsPlugin {
         app.init_resource::<Settings>()
             .add_message::<OpenSettings>()
             .add_systems(Startup, warn_of_a_bad_file)
-            .add_systems(Update, settings_keys.before(crate::client::PhantomSystems::Play));
+            .add_systems(Update, settings_keys.before(crate::schedule::PhantomSystems::Play));
     }
 }
 

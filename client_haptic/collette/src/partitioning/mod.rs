@@ -4,14 +4,15 @@
 //! [`crate::packing::build`] and query it with [`crate::query`]. Split by operation: `build` (top-down
 //! volume-weighted clustering), `traverse` (visiting nodes), `validate` (checking loaded trees).
 
+mod block;
 mod build;
 mod traverse;
 mod validate;
 mod wide;
 
+pub(crate) use block::ChildBlock;
 pub use build::LEAF_SIZE;
 pub use traverse::for_each_leaf_in_sphere;
-pub(crate) use wide::ChildBlock;
 
 use crate::shape::Sphere;
 

@@ -10,7 +10,7 @@ mod act;
 mod perceive;
 
 pub use act::think_and_act;
-pub use perceive::perceive;
+pub use perceive::{Body, perceive};
 
 use glam::Vec2;
 use heist_shared::protocol::{GuardAlert, GuardId};

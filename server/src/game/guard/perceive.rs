@@ -3,18 +3,25 @@
 
 use glam::Vec2;
 use heist_shared::level::{NavGraph, WallSet};
-use heist_shared::protocol::Stance;
 use heist_shared::rules::GuardTuning;
 
 use super::{Guard, Perception};
-use crate::game::Vive;
+
+/// What a guard can sense of Vive's body: where it is and whether he crouches.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Body {
+    /// Where, metres.
+    pub position: Vec2,
+    /// Crouching (seen nearer only).
+    pub crouching: bool,
+}
 
 /// Sight and hearing for one guard. `unreported` are the broken cases nobody has reported yet
 /// (index, position).
 #[allow(clippy::too_many_arguments)]
 pub fn perceive(
     guard: &Guard,
-    vive: &Vive,
+    vive: Body,
     walls: &WallSet,
     nav: &NavGraph,
     noises: &[(Vec2, f32)],
@@ -22,9 +29,8 @@ pub fn perceive(
     alarm: u8,
     t: &GuardTuning,
 ) -> Perception {
-    let crouching = vive.stance == Stance::Crouching;
     let sees_vive =
-        guard.in_cone(vive.position, crouching, alarm, t) && walls.line_of_sight(guard.position, vive.position);
+        guard.in_cone(vive.position, vive.crouching, alarm, t) && walls.line_of_sight(guard.position, vive.position);
     let hearing = t.hearing_at(alarm);
     let heard = noises
         .iter()

@@ -13,7 +13,7 @@ use tokio::net::TcpStream;
 
 use super::super::registry::SessionEntry;
 use super::guesses::Outcome;
-use super::{Closer, Shared, TokenConfig, lock};
+use super::shared::{Closer, Shared, TokenConfig, lock};
 
 /// Largest frame a client sends, bytes (a hello is ~40).
 const MAX_CLIENT_FRAME: usize = 256;

@@ -5,12 +5,12 @@ use glam::Vec2;
 use heist_shared::protocol::{Gait, GuardAlert, ItemKind, ItemPlace, ViveMsg};
 use heist_shared::rules;
 
-use super::View;
 use super::decide::{LURE_AFTER_S, Perception, Plan};
 use super::goal::Goal;
 use super::map::Map;
 use super::memory::Memory;
-use crate::forecast::{Forecast, HOLD_S, Noise};
+use super::view::View;
+use crate::forecast::{Forecast, HARBOUR_HOLD_S, Noise};
 use crate::spacetime::{self, Order, Timed};
 
 /// Closer than this beyond a guard's all-round noticing radius counts as exposed, seen or not (walls
@@ -116,7 +116,7 @@ pub(crate) fn perceive(
     } else {
         memory.quiet_since = None;
     }
-    p.hidden_here = forecast.hidden_for(me, HOLD_S, &map.walls);
+    p.hidden_here = forecast.hidden_for(me, HARBOUR_HOLD_S, &map.walls);
     let lure_due = memory.lured_at.is_none_or(|t| memory.clock_s - t > LURE_AFTER_S);
     if lure_due {
         let nearest = view.guards.iter().min_by(|a, b| a.position.distance(me).total_cmp(&b.position.distance(me)));
@@ -146,7 +146,7 @@ fn lure_aim(map: &Map, me: Vec2, guard: Vec2, hearing: f32) -> Option<Vec2> {
     [0.0f32, 0.3, -0.3, 0.6, -0.6]
         .into_iter()
         .map(|turn| me + Vec2::from_angle(turn).rotate(ahead.normalize()) * rules::THROW_RANGE)
-        .map(|aim| (aim, rules::throw_landing(&map.level, &map.walls, me, aim)))
+        .map(|aim| (aim, map.walls.throw_landing(&map.level, me, aim)))
         .filter(|(_, landing)| {
             landing.distance(me) > ahead.length() + LURE_BEYOND_M
                 && map.nav.heard_margin(*landing, guard, rules::THUD_LOUDNESS * hearing) >= 0.0
@@ -206,7 +206,7 @@ pub(crate) fn carry_out(
         Plan::Wait => (Vec2::ZERO, Gait::Crouch, None),
         Plan::Throw(item, target) => {
             memory.lured_at = Some(memory.clock_s);
-            let landing = rules::throw_landing(&map.level, &map.walls, me, target);
+            let landing = map.walls.throw_landing(&map.level, me, target);
             memory.noises.push(Noise {
                 at: landing,
                 when_s: memory.clock_s,
@@ -354,7 +354,7 @@ mod tests {
         // In the open gallery: the prop lands past him, where he hears it.
         let (me, guard) = (Vec2::new(13.0, 3.0), Vec2::new(17.0, 4.0));
         let aim = lure_aim(&map, me, guard, 1.0).expect("a throw past him");
-        let landing = rules::throw_landing(&map.level, &map.walls, me, aim);
+        let landing = map.walls.throw_landing(&map.level, me, aim);
         assert!(landing.distance(me) > guard.distance(me) + LURE_BEYOND_M, "lands at {landing}");
         assert!(map.nav.heard_margin(landing, guard, rules::THUD_LOUDNESS) >= 0.0);
     }

@@ -5,8 +5,8 @@ use glam::Vec2;
 use heist_shared::protocol::{CaseId, GuardAlert, ItemId, ItemKind, ItemPlace, ItemView};
 use heist_shared::rules;
 
-use super::View;
 use super::memory::Memory;
+use super::view::View;
 
 /// A second copy this close is worth the detour before delivering, metres.
 const SECOND_COPY_DETOUR_M: f32 = 6.0;

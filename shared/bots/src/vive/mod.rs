@@ -16,7 +16,6 @@ use heist_client::Inbox;
 use heist_shared::protocol::{
     CaseView, ClientMsg, Gait, GameEvent, GuardView, ItemView, LobbyMsg, Phase, SessionView, ViveAvatar, ViveMsg,
 };
-use heist_shared::rules;
 
 use crate::forecast::{Forecast, Heard, Known};
 
@@ -40,6 +39,9 @@ mod decide;
 mod goal;
 mod map;
 mod memory;
+mod view;
+
+use view::View;
 
 /// The Vive bot: what it knows of the museum (built once) apart from what it remembers.
 #[derive(Resource, Default)]
@@ -71,18 +73,6 @@ impl Plugin for ViveBotPlugin {
         app.insert_resource(ViveBrain::new(self.style))
             .add_systems(Update, (play, crate::rounds::ask_for_another_round));
     }
-}
-
-/// Everything the bot sees this frame.
-pub(crate) struct View<'a> {
-    me: &'a ViveAvatar,
-    alarm: u8,
-    tuning: rules::GuardTuning,
-    /// The guards: those in sight, and those out of sight where they are likely now.
-    guards: Vec<&'a GuardView>,
-    cases: Vec<&'a CaseView>,
-    items: Vec<&'a ItemView>,
-    secured: Vec<heist_shared::artifact::ArtifactKind>,
 }
 
 /// What the bot decided in one frame.

@@ -2,7 +2,8 @@
 
 use glam::Vec2;
 
-use super::{Level, Room};
+use super::Level;
+use crate::rules;
 
 /// A wall segment on the floor plane.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,22 +41,6 @@ impl Segment {
     }
 }
 
-/// Which wall two rooms share at `p`: `Some(true)` for a wall at constant x, `Some(false)` at constant z.
-pub(crate) fn shared_wall_axis(a: &Room, b: &Room, p: Vec2) -> Option<bool> {
-    const EPS: f32 = 1e-3;
-    let on_x = |r: &Room| (p.x - r.min.x).abs() < EPS || (p.x - r.max.x).abs() < EPS;
-    let on_z = |r: &Room| (p.y - r.min.y).abs() < EPS || (p.y - r.max.y).abs() < EPS;
-    let within_z = |r: &Room| p.y > r.min.y && p.y < r.max.y;
-    let within_x = |r: &Room| p.x > r.min.x && p.x < r.max.x;
-    if on_x(a) && on_x(b) && within_z(a) && within_z(b) {
-        Some(true)
-    } else if on_z(a) && on_z(b) && within_x(a) && within_x(b) {
-        Some(false)
-    } else {
-        None
-    }
-}
-
 /// The walls of a level: room outlines with door openings cut out, plus closed doors as
 /// sight-blocking (but walkable) segments.
 #[derive(Clone, Debug, Default)]
@@ -67,6 +52,34 @@ pub struct WallSet {
 }
 
 impl WallSet {
+    /// Where a thrown object lands: aimed at `target`, at most [`rules::THROW_RANGE`] away, it flies
+    /// (checked every 25 cm) until the next step would cross one of these walls or leave `level`'s rooms, and lands
+    /// just before. The server throws with this and the Vive bot plans its lures with it.
+    pub fn throw_landing(&self, level: &Level, from: Vec2, target: Vec2) -> Vec2 {
+        let mut aim = target - from;
+        if aim.length() > rules::THROW_RANGE {
+            aim = aim.normalize() * rules::THROW_RANGE;
+        }
+        let mut landing = from;
+        let steps = (aim.length() / 0.25).ceil().max(1.0) as usize;
+        for s in 1..=steps {
+            let p = from + aim * (s as f32 / steps as f32);
+            if self.walls.iter().any(|w| w.intersects(landing, p)) || level.room_at(p).is_none() {
+                break;
+            }
+            landing = p;
+        }
+        landing
+    }
+
+    /// Where Vive's body ends up after `dt` seconds of moving along `direction` (|d| ≤ 1) at `speed` m/s
+    /// from `from`, sliding along these walls (his body is [`rules::BODY_RADIUS`] round). The server moves
+    /// Vive with this and the Vive client predicts with it, so both agree to the bit when they see the same
+    /// inputs.
+    pub fn move_body(&self, from: Vec2, direction: Vec2, speed: f32, dt: f32) -> Vec2 {
+        self.slide(from, direction * speed * dt, rules::BODY_RADIUS)
+    }
+
     /// Builds the walls of `level`.
     pub fn new(level: &Level) -> Self {
         let mut walls = Vec::new();
@@ -109,7 +122,7 @@ impl WallSet {
             let ra = level.room_index(&door.between.0);
             let rb = level.room_index(&door.between.1);
             if let (Some(ra), Some(rb)) = (ra, rb) {
-                let along = match shared_wall_axis(&level.rooms[ra], &level.rooms[rb], door.at) {
+                let along = match level.rooms[ra].shared_wall_axis(&level.rooms[rb], door.at) {
                     Some(true) => Vec2::Y,
                     _ => Vec2::X,
                 };
@@ -159,6 +172,7 @@ impl WallSet {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::level::Room;
 
     fn level() -> Level {
         Level::museum()

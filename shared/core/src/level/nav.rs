@@ -50,7 +50,7 @@ impl NavGraph {
                 let (min, max) = rooms[r];
                 let c = (min + max) * 0.5;
                 let d = c - door.at;
-                if super::geometry::shared_wall_axis(&level.rooms[a], &level.rooms[b], door.at) == Some(true) {
+                if level.rooms[a].shared_wall_axis(&level.rooms[b], door.at) == Some(true) {
                     Vec2::new(d.x.signum(), 0.0)
                 } else {
                     Vec2::new(0.0, d.y.signum())

@@ -38,44 +38,6 @@ pub fn gait_speed(gait: crate::protocol::Gait) -> f32 {
     }
 }
 
-/// Where Vive's body ends up after `dt` seconds of moving along `direction` (|d| ≤ 1) at `speed` m/s from
-/// `from`, sliding along walls. The server moves Vive with this and the Vive client predicts with it, so
-/// both agree to the bit when they see the same inputs.
-pub fn move_body(
-    walls: &crate::level::WallSet,
-    from: glam::Vec2,
-    direction: glam::Vec2,
-    speed: f32,
-    dt: f32,
-) -> glam::Vec2 {
-    walls.slide(from, direction * speed * dt, BODY_RADIUS)
-}
-
-/// Where a thrown object lands: aimed at `target`, at most [`THROW_RANGE`] away, it flies (checked
-/// every 25 cm) until the next step would cross a wall or leave the rooms, and lands just before. The
-/// server throws with this and the Vive bot plans its lures with it.
-pub fn throw_landing(
-    level: &crate::level::Level,
-    walls: &crate::level::WallSet,
-    from: glam::Vec2,
-    target: glam::Vec2,
-) -> glam::Vec2 {
-    let mut aim = target - from;
-    if aim.length() > THROW_RANGE {
-        aim = aim.normalize() * THROW_RANGE;
-    }
-    let mut landing = from;
-    let steps = (aim.length() / 0.25).ceil().max(1.0) as usize;
-    for s in 1..=steps {
-        let p = from + aim * (s as f32 / steps as f32);
-        if walls.walls.iter().any(|w| w.intersects(landing, p)) || level.room_at(p).is_none() {
-            break;
-        }
-        landing = p;
-    }
-    landing
-}
-
 /// Farthest Vive sees a guard in a clear line (he turns his head at will, so in every direction),
 /// metres: generous, so a guard never pops into view in the middle of a gallery.
 pub const VIVE_SIGHT_RANGE: f32 = 30.0;

@@ -22,8 +22,9 @@
 use super::affine::WideAffine;
 use super::batch::Lanes;
 use super::engine::Engine;
+use super::fallback_normal;
+use super::result::{Budget, OverlapResult};
 use super::sink::{Contacts, Sink};
-use super::{Budget, OverlapResult, fallback_normal};
 use crate::error::SkinError;
 use crate::partitioning::InnerSphereTree;
 use crate::query::QueryWorkspace;

@@ -2,8 +2,8 @@
 
 use super::affine::WideAffine;
 use super::batch::{Lanes, PAIR_BATCH, PairBatch};
+use super::result::{Budget, OverlapResult};
 use super::sink::Sink;
-use super::{Budget, OverlapResult};
 use crate::partitioning::{InnerSphereTree, Node};
 use crate::query::QueryWorkspace;
 use crate::shape::{Lens, lens, lens_x4, sphere_volume};

@@ -3,6 +3,7 @@ use crate::shape::{box_buffers, lens_volume, torus_buffers, uv_sphere_buffers};
 use crate::{BuildOptions, TriMesh, build};
 use glam::Quat;
 use std::sync::OnceLock;
+use std::time::Instant;
 
 fn tree_with((v, t): (Vec<Vec3>, Vec<[u32; 3]>), options: &BuildOptions) -> InnerSphereTree {
     build(&TriMesh::new(v, t).expect("valid mesh"), options, &mut |_| {}).expect("builds").0
