@@ -19,6 +19,7 @@ pub mod flight;
 pub mod hud;
 pub mod intent;
 pub mod interp;
+pub mod museum;
 pub mod palette;
 pub mod predict;
 pub mod sound;

@@ -8,8 +8,8 @@ use glam::{Vec2, Vec3};
 use heist_shared::level::{Level, Segment, WallSet};
 use heist_shared::rules::BODY_RADIUS;
 
+use crate::museum::WALL_HEIGHT_M;
 use crate::space;
-use crate::world::WALL_HEIGHT_M;
 
 /// Farthest teleport, metres.
 pub const TELEPORT_RANGE_M: f32 = 4.0;
