@@ -195,54 +195,12 @@ fn events(
 ) {
     let now = time.elapsed_secs_f64();
     for e in std::mem::take(&mut inbox.events) {
-        let line = match &e {
-            GameEvent::CaseBroken(c) => Some(format!("Case {} shattered", c.0)),
-            GameEvent::Delivered(i) => Some(format!("Copy {} on the workbench", i.0)),
-            GameEvent::Verdict { outcome, .. } => Some(format!("Phantom's verdict: {outcome:?}")),
-            GameEvent::Alarm(n) => Some(format!("ALARM level {n}")),
-            // The client core has told Phantom it arrived.
-            GameEvent::Warning(w) => Some(format!("Phantom warns: {w:?}")),
-            GameEvent::WarningSeen(_) => None,
-            GameEvent::GuardAlert { guard, alert, .. } => {
-                let name =
-                    state.level.as_ref().and_then(|l| l.guards.get(usize::from(guard.0))).map(|g| g.name.clone());
-                Some(format!(
-                    "{} is {}",
-                    name.unwrap_or_else(|| format!("Guard {}", guard.0)),
-                    format!("{alert:?}").to_lowercase()
-                ))
-            }
-            GameEvent::Radio { guard, about, at, .. } => {
-                let level = state.level.as_ref();
-                let name = level.and_then(|l| l.guards.get(usize::from(guard.0))).map(|g| g.name.clone());
-                let room =
-                    level.and_then(|l| l.rooms.iter().find(|r| r.contains(*at, 0.0))).map(|r| r.id.replace('_', " "));
-                let what = match about {
-                    heist_shared::protocol::RadioAbout::Sighting => "intruder seen",
-                    heist_shared::protocol::RadioAbout::Evidence => "broken case found",
-                };
-                Some(format!(
-                    "RADIO {}: {what} in the {}",
-                    name.unwrap_or_else(|| format!("Guard {}", guard.0)),
-                    room.unwrap_or_else(|| "museum".into())
-                ))
-            }
-            GameEvent::Noise { .. } | GameEvent::PhaseChanged(_) | GameEvent::PickedUp(_) => None,
-            GameEvent::Joined(_)
-            | GameEvent::Left { .. }
-            | GameEvent::Resumed(_)
-            | GameEvent::GaveUp(_)
-            | GameEvent::RematchAsked(_)
-            | GameEvent::RoundStarted(_)
-            | GameEvent::EndingSoon(_)
-            | GameEvent::ServerClosing { .. } => heist_client::notice::session_notice(&e, Role::Vive),
-        };
         if let GameEvent::Noise { kind: heist_shared::protocol::NoiseKind::Glass, position, .. } = &e
             && state.body().is_some_and(|b| b.distance(*position) < heist_shared::rules::REACH * 2.0)
         {
             pulses.write(Pulse { amplitude: 1.0, seconds: 0.15, why: PulseReason::Glass });
         }
-        if let Some(line) = line {
+        if let Some(line) = hud_line(&e, state.level.as_ref()) {
             state.say(now, line);
         }
         out.write(Happened(e));
@@ -250,6 +208,44 @@ fn events(
     for r in std::mem::take(&mut inbox.refusals) {
         sent.refused();
         state.say(now, format!("The server refused: {r:?}"));
+    }
+}
+
+/// The HUD's line for a server event, if it gets one (guards and rooms named from `level`).
+pub fn hud_line(e: &GameEvent, level: Option<&heist_shared::level::Level>) -> Option<String> {
+    let guard_name = |id: u16| {
+        level.and_then(|l| l.guards.get(usize::from(id))).map_or_else(|| format!("Guard {id}"), |g| g.name.clone())
+    };
+    match e {
+        GameEvent::CaseBroken(c) => Some(format!("Case {} shattered", c.0)),
+        GameEvent::Delivered(i) => Some(format!("Copy {} on the workbench", i.0)),
+        GameEvent::Verdict { outcome, .. } => Some(format!("Phantom's verdict: {outcome:?}")),
+        GameEvent::Alarm(n) => Some(format!("ALARM level {n}")),
+        // The client core has told Phantom it arrived.
+        GameEvent::Warning(w) => Some(format!("Phantom warns: {w:?}")),
+        GameEvent::WarningSeen(_) => None,
+        GameEvent::GuardAlert { guard, alert, .. } => {
+            Some(format!("{} is {}", guard_name(guard.0), format!("{alert:?}").to_lowercase()))
+        }
+        GameEvent::Radio { guard, about, at, .. } => {
+            let room = level
+                .and_then(|l| l.rooms.iter().find(|r| r.contains(*at, 0.0)))
+                .map_or_else(|| "museum".into(), |r| r.id.replace('_', " "));
+            let what = match about {
+                heist_shared::protocol::RadioAbout::Sighting => "intruder seen",
+                heist_shared::protocol::RadioAbout::Evidence => "broken case found",
+            };
+            Some(format!("RADIO {}: {what} in the {room}", guard_name(guard.0)))
+        }
+        GameEvent::Noise { .. } | GameEvent::PhaseChanged(_) | GameEvent::PickedUp(_) => None,
+        GameEvent::Joined(_)
+        | GameEvent::Left { .. }
+        | GameEvent::Resumed(_)
+        | GameEvent::GaveUp(_)
+        | GameEvent::RematchAsked(_)
+        | GameEvent::RoundStarted(_)
+        | GameEvent::EndingSoon(_)
+        | GameEvent::ServerClosing { .. } => heist_client::notice::session_notice(e, Role::Vive),
     }
 }
 
@@ -317,5 +313,39 @@ fn quit_after_end(
         && (state.ended_s > after || heist_client::connection_over(*link, &inbox, &reconnect))
     {
         exit.write(AppExit::Success);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use heist_shared::level::Level;
+    use heist_shared::protocol::{GuardAlert, GuardId, RadioAbout};
+
+    #[test]
+    fn a_guards_alert_names_him_and_a_radio_call_names_the_room_it_is_about() {
+        let level = Level::museum();
+        let (guard, room) = (&level.guards[0], &level.rooms[1]);
+        let alert = GameEvent::GuardAlert { guard: GuardId(0), alert: GuardAlert::Chasing, position: Vec2::ZERO };
+        assert_eq!(hud_line(&alert, Some(&level)), Some(format!("{} is chasing", guard.name)));
+        let radio = GameEvent::Radio {
+            guard: GuardId(0),
+            about: RadioAbout::Evidence,
+            at: room.centre(),
+            from: Vec2::ZERO,
+            answering: Vec::new(),
+        };
+        let line = hud_line(&radio, Some(&level)).expect("a radio call is shown");
+        assert_eq!(line, format!("RADIO {}: broken case found in the {}", guard.name, room.id.replace('_', " ")));
+        assert_eq!(hud_line(&alert, None), Some("Guard 0 is chasing".into()), "before the level: by number");
+    }
+
+    #[test]
+    fn noises_and_phase_changes_are_not_written_on_the_hud() {
+        let glass =
+            GameEvent::Noise { kind: heist_shared::protocol::NoiseKind::Glass, position: Vec2::ZERO, loudness: 16.0 };
+        assert_eq!(hud_line(&glass, None), None);
+        assert_eq!(hud_line(&GameEvent::PhaseChanged(heist_shared::protocol::Phase::Heist), None), None);
+        assert_eq!(hud_line(&GameEvent::Alarm(2), None), Some("ALARM level 2".into()));
     }
 }
