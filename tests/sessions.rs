@@ -154,6 +154,25 @@ fn held(app: &mut bevy::prelude::App) -> [usize; 6] {
     ]
 }
 
+/// The most of each kind one session has, as [`held`] counts them (its items, as many as it likes).
+fn most_held() -> [usize; 6] {
+    let level = heist_shared::level::Level::museum();
+    [1, 1, 1, level.guards.len(), level.cases.len(), usize::MAX]
+}
+
+/// Looks at every client: none may hold another session's entities (more of a kind than one session has,
+/// `most`); `seen[i]` becomes true once client `i` holds its own session whole — its session, Vive, tool,
+/// every case, the guards its role gets (Vive's client, even, only those he perceives; Phantom's, odd, all
+/// of them) and, `with_items`, at least one item.
+fn check_clients(clients: &mut [bevy::prelude::App], most: [usize; 6], with_items: bool, seen: &mut [bool]) {
+    for (i, client) in clients.iter_mut().enumerate() {
+        let counts = held(client);
+        assert!(counts.iter().zip(most).all(|(n, m)| *n <= m), "client {i} holds {counts:?}: another session's?");
+        let guards_whole = i % 2 == 0 || counts[3] == most[3];
+        seen[i] |= counts[..3] == [1, 1, 1] && guards_whole && counts[4] == most[4] && (!with_items || counts[5] > 0);
+    }
+}
+
 /// A server with `n` sessions, each made by a careful Vive bot and a Phantom bot for one round of
 /// `time_limit_s` that ends `idle_end_s` after its result; `probe` adds a test's systems to every client.
 fn bot_sessions(
@@ -188,8 +207,7 @@ fn twenty_sessions_of_bot_pairs_play_whole_heists_at_once_and_no_client_sees_ano
     };
     let (mut server, mut clients) = bot_sessions(SESSIONS, 60.0, 3.0, probe);
     assert!(server.shards.len() > 1, "the sessions are spread over shards, each a replication server of its own");
-    let level = heist_shared::level::Level::museum();
-    let most = [1, 1, 1, level.guards.len(), level.cases.len(), usize::MAX];
+    let most = most_held();
     let mut all_running_at_once = false;
     let mut own_entities_seen = vec![false; clients.len()];
     let over = |server: &mut heist_server::HostedServer| all_over(server, SESSIONS);
@@ -201,16 +219,7 @@ fn twenty_sessions_of_bot_pairs_play_whole_heists_at_once_and_no_client_sees_ano
         if ticks % 30 == 0 {
             let sessions = server.sessions();
             all_running_at_once |= sessions.len() == SESSIONS && sessions.iter().all(|s| s.game.is_running());
-            for (i, client) in clients.iter_mut().enumerate() {
-                let counts = held(client);
-                assert!(
-                    counts.iter().zip(most).all(|(n, m)| *n <= m),
-                    "client {i} holds {counts:?}: another session's?"
-                );
-                // Vive's client (even) holds only the guards he perceives; Phantom's (odd) holds them all.
-                let guards_whole = i % 2 == 0 || counts[3] == most[3];
-                own_entities_seen[i] |= counts[..3] == [1, 1, 1] && guards_whole && counts[4] == most[4];
-            }
+            check_clients(&mut clients, most, false, &mut own_entities_seen);
         }
     }
     assert!(over(&mut server), "every session played its heist to a result within {ticks} ticks");
@@ -289,8 +298,7 @@ fn three_hundred_sessions_in_one_process_are_created_played_and_closed_and_no_cl
     const SESSIONS: usize = 300;
     let (mut server, mut clients) = bot_sessions(SESSIONS, 8.0, 1.0, |_| {});
     assert_eq!(server.shards.len(), SESSIONS.div_ceil(server.registry.shard_size()), "spread over shards");
-    let level = heist_shared::level::Level::museum();
-    let most = [1, 1, 1, level.guards.len(), level.cases.len(), usize::MAX];
+    let most = most_held();
     let mut own_seen = vec![false; clients.len()];
     let mut most_running = 0;
     let step = |server: &mut heist_server::HostedServer, clients: &mut Vec<bevy::prelude::App>| {
@@ -304,15 +312,7 @@ fn three_hundred_sessions_in_one_process_are_created_played_and_closed_and_no_cl
         ticks += 1;
         if ticks % 20 == 0 {
             most_running = most_running.max(server.sessions().iter().filter(|s| s.game.is_running()).count());
-            for (i, client) in clients.iter_mut().enumerate() {
-                let counts = held(client);
-                assert!(
-                    counts.iter().zip(most).all(|(n, m)| *n <= m),
-                    "client {i} holds {counts:?}: another session's?"
-                );
-                let guards_whole = i % 2 == 0 || counts[3] == most[3];
-                own_seen[i] |= counts[..3] == [1, 1, 1] && guards_whole && counts[4] == most[4] && counts[5] > 0;
-            }
+            check_clients(&mut clients, most, true, &mut own_seen);
         }
     }
     assert!(over(&mut server), "every session played its heist to a result within {ticks} ticks");

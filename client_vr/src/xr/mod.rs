@@ -529,8 +529,7 @@ fn place_view(
     if memory.turn != 0.0 {
         root.rotate_around(input.head, Quat::from_rotation_y(memory.turn));
     }
-    let XrMotion { recentre_hold_s, .. } = &mut *motion;
-    if hands::hold_to_recentre(&memory.hands, recentre_hold_s, input.dt) {
+    if hands::hold_to_recentre(&memory.hands, &mut motion.recentre_hold_s, input.dt) {
         recentre_here(&mut root);
     }
 }

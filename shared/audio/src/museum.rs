@@ -85,9 +85,7 @@ pub fn event_cue(event: &GameEvent) -> Option<MuseumCue> {
             cue(Sound::Glass, position, GLASS_HEIGHT_M, "glass")
         }
         GameEvent::Noise { kind: NoiseKind::Thud, position, .. } => cue(Sound::Thud, position, 0.0, "thud"),
-        GameEvent::Noise { kind: NoiseKind::Alarm, position, .. } => {
-            cue(Sound::Alarm, position, ALARM_HEIGHT_M, "alarm")
-        }
+        GameEvent::Noise { kind: NoiseKind::Alarm, position, .. } => Some(alarm_cue(*position)),
         GameEvent::Noise { kind: NoiseKind::Footsteps, .. } => None,
         GameEvent::GuardAlert { alert: alert @ (GuardAlert::Suspicious | GuardAlert::Chasing), position, .. } => {
             cue(Sound::Bark { chasing: *alert == GuardAlert::Chasing }, position, BARK_HEIGHT_M, "guard bark")
@@ -97,7 +95,7 @@ pub fn event_cue(event: &GameEvent) -> Option<MuseumCue> {
     }
 }
 
-/// The alarm's cue while it rings on, from `at` (the listener's client repeats it while the alarm is up).
+/// The alarm's cue from `at`: when it goes up, and as the listener's client repeats it while it is up.
 pub fn alarm_cue(at: Vec2) -> MuseumCue {
     MuseumCue { sound: Sound::Alarm, at, height_m: ALARM_HEIGHT_M, what: "alarm" }
 }
