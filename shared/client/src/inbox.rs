@@ -16,7 +16,8 @@ pub struct Inbox {
     pub briefings: Vec<Briefing>,
     /// The latest copy on the workbench not yet taken by the app (Phantom only).
     pub workbench: Option<WorkbenchCopy>,
-    /// Game events not yet taken by the app, oldest first.
+    /// Game events not yet taken by the app, oldest first: at most [`Inbox::KEPT_EVENTS`] (an app that
+    /// never takes them, a bot, loses the oldest rather than growing without end).
     pub events: Vec<GameEvent>,
     /// Every refusal received.
     pub refusals: Vec<Refusal>,
@@ -34,6 +35,17 @@ pub struct Inbox {
 }
 
 impl Inbox {
+    /// Untaken events kept at most: past twice this many, the oldest half goes.
+    pub const KEPT_EVENTS: usize = 1024;
+
+    /// Keeps `event` for the app, forgetting the oldest past [`Inbox::KEPT_EVENTS`].
+    pub fn keep_event(&mut self, event: GameEvent) {
+        if self.events.len() >= 2 * Self::KEPT_EVENTS {
+            self.events.drain(..Self::KEPT_EVENTS);
+        }
+        self.events.push(event);
+    }
+
     /// The round being played: 1 until a `RoundStarted` says otherwise.
     pub fn current_round(&self) -> u32 {
         self.round.max(1)
@@ -51,4 +63,22 @@ pub struct MessageCounts {
     pub workbench: u32,
     /// `Event`.
     pub events: u32,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_inbox_nobody_empties_keeps_the_newest_events_and_stays_bounded() {
+        let mut inbox = Inbox::default();
+        for n in 0..10_000u32 {
+            inbox.keep_event(GameEvent::RoundStarted(n));
+            assert!(inbox.events.len() <= 2 * Inbox::KEPT_EVENTS);
+        }
+        assert!(inbox.events.len() >= Inbox::KEPT_EVENTS);
+        assert_eq!(inbox.events.last(), Some(&GameEvent::RoundStarted(9_999)), "the newest is kept");
+        let oldest = 10_000 - inbox.events.len() as u32;
+        assert_eq!(inbox.events[0], GameEvent::RoundStarted(oldest), "in order, the oldest forgotten first");
+    }
 }

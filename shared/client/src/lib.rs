@@ -97,7 +97,7 @@ fn fill_inbox(
                     inbox.briefings.clear();
                     inbox.workbench = None;
                 }
-                inbox.events.push(e);
+                inbox.keep_event(e);
                 inbox.received.events += 1;
             }
         }

@@ -98,6 +98,10 @@ pub(crate) enum Command {
         /// Sessions a shard plays at most (as `serve --shard-size`).
         #[arg(long, default_value_t = heist_server::DEFAULT_SHARD_SIZE, value_parser = max_sessions)]
         shard_size: usize,
+        /// Players come and go: every this many seconds of game time each session loses a player, who
+        /// comes back with the seat's ticket 5 s later, or both leave and a new pair creates a session.
+        #[arg(long, value_parser = positive_seconds)]
+        churn: Option<f32>,
     },
     /// Join a hosted session as a bot (restarted within a minute of losing its connection, it takes its
     /// seat back through the seat cache, `$XDG_CACHE_HOME/phantom-heist/seats`).
@@ -159,7 +163,7 @@ pub(crate) fn run(command: Command) -> anyhow::Result<()> {
             }
             Ok(())
         }
-        Command::Load { sessions, seconds, json, metrics, shard_size } => {
+        Command::Load { sessions, seconds, json, metrics, shard_size, churn } => {
             let options = heist_server::load::LoadOptions {
                 sessions,
                 seconds,
@@ -167,6 +171,7 @@ pub(crate) fn run(command: Command) -> anyhow::Result<()> {
                 metrics,
                 shard_size,
                 heap: Some(counting::PROBE),
+                churn,
             };
             let report = heist_server::load::run_load(&options, |line| println!("{line}"))?;
             println!("{report}");

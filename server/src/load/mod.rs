@@ -21,6 +21,9 @@ use crate::net::registry::CreateLimits;
 use crate::net::transport::GameTransport;
 use crate::{HostedServer, ServerOptions, build_server};
 
+mod churn;
+pub use churn::{AWAY_S, ChurnCounts, MAX_LEAD_S};
+
 /// How a load run goes.
 #[derive(Clone, Debug)]
 pub struct LoadOptions {
@@ -36,6 +39,9 @@ pub struct LoadOptions {
     pub shard_size: usize,
     /// What tells the server's own heap apart from the bots' (the binary's counting allocator).
     pub heap: Option<HeapProbe>,
+    /// Players come and go: every this many seconds of game time each session loses a player who comes
+    /// back with the seat's ticket, or both leave and a new pair creates a session ([`churn`]).
+    pub churn: Option<f32>,
 }
 
 /// The net heap bytes allocated while a thread is flagged as doing the server's work: an allocator's
@@ -78,6 +84,8 @@ pub struct LoadReport {
     pub client_datagrams_per_s_down: f64,
     /// Players admitted when the measurement began (2 per session when all are in).
     pub players: usize,
+    /// Players admitted when it ended (with churn, fewer by those away or being replaced then).
+    pub players_at_end: usize,
     /// Rounds begun during the measurement (the bots ask for another after each result).
     pub rematches: u32,
     /// The process's resident size, MB, by seconds of game time into the measurement (every
@@ -86,14 +94,16 @@ pub struct LoadReport {
     /// The server's own heap (net bytes allocated during its updates since it started ticking), MB,
     /// sampled as `resident_mb`; empty without a [`HeapProbe`].
     pub server_heap_mb: Vec<(f64, f64)>,
+    /// What the churn did (with [`LoadOptions::churn`]).
+    pub churn: Option<ChurnCounts>,
 }
 
 impl std::fmt::Display for LoadReport {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         writeln!(
             f,
-            "{} sessions over {} shards, {} players, {} ticks measured ({} rematches)",
-            self.sessions, self.shards, self.players, self.ticks, self.rematches
+            "{} sessions over {} shards, {} players ({} at the end), {} ticks measured ({} rematches)",
+            self.sessions, self.shards, self.players, self.players_at_end, self.ticks, self.rematches
         )?;
         writeln!(
             f,
@@ -118,6 +128,14 @@ impl std::fmt::Display for LoadReport {
         if !self.server_heap_mb.is_empty() {
             let heap: Vec<String> = self.server_heap_mb.iter().map(|(s, mb)| format!("{s:.0} s {mb:.2}")).collect();
             write!(f, "\nserver heap MB by game time: {}", heap.join(", "))?;
+        }
+        if let Some(c) = &self.churn {
+            write!(
+                f,
+                "\nchurn: {} clients dropped, {} seats taken back ({} refused; the server counted {}), {} pairs left, \
+                 {} sessions created in their place ({} tries while full)",
+                c.drops, c.resumes, c.resumes_refused, c.server_resumes, c.leaves, c.created, c.create_retries
+            )?;
         }
         Ok(())
     }
@@ -156,16 +174,28 @@ pub fn create_bot_pair_at(
 ) -> anyhow::Result<[App; 2]> {
     let timeout = Duration::from_secs(5);
     let (code, token) = heist_client::create_session(endpoint, Role::Vive, timeout)?;
-    let vive = crate::demo::client_with_token(token, |app| {
-        app.add_plugins(ViveBotPlugin { style }).insert_resource(Rounds(rounds));
-        probe(app);
-    })?;
+    let vive = bot_app(token, Role::Vive, style, rounds, &probe)?;
     let token = heist_client::request_token(endpoint, &code, Role::Phantom, timeout)?;
-    let phantom = crate::demo::client_with_token(token, |app| {
-        app.add_plugins(PhantomBotPlugin::default()).insert_resource(Rounds(rounds));
-        probe(app);
-    })?;
+    let phantom = bot_app(token, Role::Phantom, style, rounds, &probe)?;
     Ok([vive, phantom])
+}
+
+/// A bot client of `role` connecting with `token`, playing `rounds` rounds; `probe` adds a test's systems.
+fn bot_app(
+    token: heist_client::ConnectToken,
+    role: Role,
+    style: ViveStyle,
+    rounds: u32,
+    probe: impl Fn(&mut App),
+) -> anyhow::Result<App> {
+    crate::demo::client_with_token(token, |app| {
+        match role {
+            Role::Vive => app.add_plugins(ViveBotPlugin { style }),
+            Role::Phantom => app.add_plugins(PhantomBotPlugin::default()),
+        };
+        app.insert_resource(Rounds(rounds));
+        probe(app);
+    })
 }
 
 /// CPU time of the calling thread.
@@ -213,6 +243,26 @@ fn tick(server: &mut HostedServer, heap: Option<HeapProbe>) -> (Duration, Durati
     (thread_cpu() - cpu, wall.elapsed())
 }
 
+/// Rounds begun after a session's first, counted by looking at every session's round now and then (often
+/// enough that none closes unseen after a rematch: a session closes a minute after its last result).
+#[derive(Default)]
+struct Rematches {
+    /// Each session's round when last looked at.
+    seen: std::collections::HashMap<u64, u32>,
+    rematches: u32,
+}
+
+impl Rematches {
+    fn count(&mut self, server: &mut HostedServer) {
+        let now: std::collections::HashMap<u64, u32> = server.sessions().iter().map(|s| (s.id, s.game.round)).collect();
+        for (id, round) in &now {
+            let was = self.seen.get(id).copied().unwrap_or(1);
+            self.rematches += round.saturating_sub(was);
+        }
+        self.seen = now;
+    }
+}
+
 /// Players admitted by every shard.
 fn admitted(server: &mut HostedServer) -> usize {
     server.shards.iter_mut().map(|s| admission_count(s.app.world_mut())).sum()
@@ -241,6 +291,11 @@ pub fn run_load(options: &LoadOptions, mut progress: impl FnMut(&str)) -> anyhow
         crate::net::MAX_SESSIONS
     );
     anyhow::ensure!(options.seconds.is_finite() && options.seconds > 0.0, "--seconds must be above zero");
+    anyhow::ensure!(
+        options.churn.is_none_or(|s| s.is_finite() && f64::from(s) > AWAY_S + 1.0),
+        "--churn must be more than {} seconds (a dropped client stays away {AWAY_S} s)",
+        AWAY_S + 1.0
+    );
     let mut server =
         build_server(ServerOptions { shard_size: options.shard_size, ..load_server_options(options.sessions) })?;
     let fleet = crate::fleet::FleetOptions { metrics: options.metrics, agones: None };
@@ -251,50 +306,77 @@ pub fn run_load(options: &LoadOptions, mut progress: impl FnMut(&str)) -> anyhow
         progress(&format!("health and metrics on http://{}/healthz and /metrics", http.addr));
     }
     let endpoint = server.tokens.as_ref().context("the server runs without a token endpoint")?.addr;
+    let (built, mut setup_ticks) = (std::time::Instant::now(), 0u64);
     let shards = server.shards.len();
     progress(&format!("{} sessions over {shards} shards", options.sessions));
-    let mut clients: Vec<App> = Vec::with_capacity(options.sessions * 2);
+    let mut pairs: Vec<churn::Pair> = Vec::with_capacity(options.sessions);
+    let update_all =
+        |pairs: &mut Vec<churn::Pair>| pairs.iter_mut().flat_map(churn::Pair::clients).for_each(App::update);
     for n in 0..options.sessions {
-        clients.extend(
-            create_bot_pair_at(endpoint, options.style, u32::MAX, |_| {})
-                .with_context(|| format!("bot pair {}", n + 1))?,
-        );
+        let apps = create_bot_pair_at(endpoint, options.style, u32::MAX, |_| {})
+            .with_context(|| format!("bot pair {}", n + 1))?;
+        pairs.push(churn::Pair::new(apps));
         // Let the server take each session and its players in before the next.
         for _ in 0..2 {
             tick(&mut server, options.heap);
-            clients.iter_mut().for_each(App::update);
+            update_all(&mut pairs);
+            setup_ticks += 1;
         }
     }
-    progress(&format!("{} sessions created; waiting for {} players", options.sessions, clients.len()));
-    let want = clients.len();
+    let want = options.sessions * 2;
+    progress(&format!("{} sessions created; waiting for {want} players", options.sessions));
     for _ in 0..(20.0 * TICK_HZ) as u64 {
         if admitted(&mut server) >= want {
             break;
         }
         tick(&mut server, options.heap);
-        clients.iter_mut().for_each(App::update);
+        update_all(&mut pairs);
+        setup_ticks += 1;
     }
     let players = admitted(&mut server);
     progress(&format!("{players} of {want} players in; measuring {} s of play", options.seconds));
-    let rounds = |s: &mut HostedServer| s.sessions().iter().map(|s| s.game.round).sum::<u32>();
-    let (before, rounds_before) = (traffic(&mut server), rounds(&mut server));
+    let before = traffic(&mut server);
+    let mut rounds = Rematches::default();
+    rounds.count(&mut server);
+    rounds.rematches = 0;
     let ticks = (f64::from(options.seconds) * TICK_HZ).ceil() as u64;
     let sample_every = (RESIDENT_SAMPLE_S * TICK_HZ).round() as u64;
     let heap_mb = || options.heap.map(|h| (h.bytes)() as f64 / 1e6);
     let mut resident = vec![(0.0, resident_mb())];
     let mut server_heap: Vec<(f64, f64)> = heap_mb().map(|mb| (0.0, mb)).into_iter().collect();
     let (mut tick_us, mut wall_us) = (Vec::with_capacity(ticks as usize), Vec::with_capacity(ticks as usize));
+    let mut churn = options.churn.map(|s| churn::Churn {
+        period: ((f64::from(s) * TICK_HZ).round() as u64).max(1),
+        endpoint,
+        style: options.style,
+        counts: ChurnCounts::default(),
+    });
     for n in 1..=ticks {
         let (cpu, wall) = tick(&mut server, options.heap);
         tick_us.push(cpu.as_secs_f64() * 1e6);
         wall_us.push(wall.as_secs_f64() * 1e6);
-        clients.iter_mut().for_each(App::update);
+        update_all(&mut pairs);
+        if n.is_multiple_of(TICK_HZ as u64) {
+            rounds.count(&mut server);
+        }
+        if let Some(churn) = churn.as_mut() {
+            let lead = (setup_ticks + n) as f64 / TICK_HZ - built.elapsed().as_secs_f64();
+            if lead > MAX_LEAD_S {
+                std::thread::sleep(Duration::from_secs_f64(lead - MAX_LEAD_S));
+            }
+            let count = pairs.len();
+            for (i, pair) in pairs.iter_mut().enumerate() {
+                churn.step(pair, i, count, n);
+            }
+        }
         if n % sample_every == 0 {
             resident.push((n as f64 / TICK_HZ, resident_mb()));
             server_heap.extend(heap_mb().map(|mb| (n as f64 / TICK_HZ, mb)));
         }
     }
-    let (after, rounds_after) = (traffic(&mut server), rounds(&mut server));
+    rounds.count(&mut server);
+    let after = traffic(&mut server);
+    let players_at_end = admitted(&mut server);
     services.shut_down();
     let seconds = ticks as f64 / TICK_HZ;
     let per_client = (players.max(1) as f64) * seconds;
@@ -314,9 +396,11 @@ pub fn run_load(options: &LoadOptions, mut progress: impl FnMut(&str)) -> anyhow
         client_datagrams_per_s_up: (after.datagrams_received - before.datagrams_received) as f64 / per_client,
         client_datagrams_per_s_down: (after.datagrams_sent - before.datagrams_sent) as f64 / per_client,
         players,
-        rematches: rounds_after.saturating_sub(rounds_before),
+        players_at_end,
+        rematches: rounds.rematches,
         resident_mb: resident,
         server_heap_mb: server_heap,
+        churn: churn.map(|c| ChurnCounts { server_resumes: server.fleet.metrics.resumes.get(), ..c.counts }),
     })
 }
 
@@ -334,5 +418,32 @@ mod tests {
         assert_eq!(quantile(&mut v, 0.5), 51.0);
         assert_eq!(quantile(&mut v, 0.99), 99.0);
         assert_eq!(quantile(&mut [], 0.5), 0.0);
+    }
+
+    /// Two sessions, an event every 8 s of game time each: both pairs lose Vive, then Phantom (each comes
+    /// back 5 s later with its seat ticket), then leave; their sessions close once abandoned and new pairs
+    /// create sessions in their place.
+    #[test]
+    fn a_load_with_churn_drops_resumes_and_replaces_its_players() {
+        let options = LoadOptions {
+            sessions: 2,
+            seconds: 60.0,
+            style: ViveStyle::Careful,
+            metrics: None,
+            shard_size: crate::DEFAULT_SHARD_SIZE,
+            heap: None,
+            churn: Some(8.0),
+        };
+        let report = run_load(&options, |_| {}).expect("the load runs");
+        assert_eq!(report.players, 4, "every player was in before the churn began");
+        assert!(report.players_at_end >= 2, "the replacements are playing: {report:?}");
+        let c = report.churn.expect("the churn's counts");
+        assert!(c.drops >= 4, "each pair lost Vive and Phantom once: {c:?}");
+        assert_eq!(c.resumes_refused, 0, "every kept seat was given back: {c:?}");
+        // (A pair may be away when the run ends.)
+        assert!(c.resumes >= 4 && c.resumes + 2 >= c.drops, "the dropped came back: {c:?}");
+        assert_eq!(c.server_resumes, u64::from(c.resumes), "the server admitted each as a resume: {c:?}");
+        assert_eq!(c.leaves, 2, "both pairs left: {c:?}");
+        assert!(c.created >= 1, "a new pair created a session once the server had room: {c:?}");
     }
 }
