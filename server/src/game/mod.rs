@@ -236,6 +236,8 @@ pub struct Game {
     radio: radio::Radio,
     /// The alarm level and hot rooms the guards' patrols were last laid out for.
     patrols_for: Option<(u8, Vec<usize>)>,
+    /// Where each tick lists the hot rooms to compare with `patrols_for` (no allocation a tick).
+    hot_scratch: Vec<usize>,
 }
 
 fn slot(role: Role) -> usize {
@@ -653,6 +655,13 @@ impl Game {
 
     /// The rooms that still hold a copy of a target not yet secured, in an intact case.
     pub fn hot_rooms(&self) -> Vec<usize> {
+        let mut rooms = Vec::new();
+        self.hot_rooms_into(&mut rooms);
+        rooms
+    }
+
+    /// [`Game::hot_rooms`] into `rooms`.
+    fn hot_rooms_into(&self, rooms: &mut Vec<usize>) {
         let cases = self.items.iter().filter_map(|it| match (it.place, &it.truth) {
             (ItemPlace::InCase(c), Some(truth)) if !self.targets[truth.target].secured => {
                 let case = self.cases.get(usize::from(c.0))?;
@@ -660,21 +669,24 @@ impl Game {
             }
             _ => None,
         });
-        heist_shared::level::patrol::hot_rooms(&self.nav, cases)
+        heist_shared::level::patrol::hot_rooms_into(&self.nav, cases, rooms);
     }
 
     /// Lays the guards' patrols out for the alarm level and the rooms that hold targets, when either
     /// changed ([`heist_shared::level::patrol::alert_route`]).
     fn lay_out_patrols(&mut self) {
-        let now = (self.alarm, self.hot_rooms());
-        if self.patrols_for.as_ref() == Some(&now) {
+        let mut hot = std::mem::take(&mut self.hot_scratch);
+        self.hot_rooms_into(&mut hot);
+        if self.patrols_for.as_ref().is_some_and(|(alarm, rooms)| *alarm == self.alarm && *rooms == hot) {
+            self.hot_scratch = hot;
             return;
         }
         for i in 0..self.guards.len() {
-            let route = heist_shared::level::patrol::alert_route(&self.level, &self.nav, i, now.0, &now.1);
+            let route = heist_shared::level::patrol::alert_route(&self.level, &self.nav, i, self.alarm, &hot);
             self.guards[i].set_route(route);
         }
-        self.patrols_for = Some(now);
+        let before = self.patrols_for.replace((self.alarm, hot));
+        self.hot_scratch = before.map(|(_, rooms)| rooms).unwrap_or_default();
     }
 
     /// The case with `id`, if it exists.

@@ -86,6 +86,7 @@ impl Game {
             rng,
             radio: Default::default(),
             patrols_for: None,
+            hot_scratch: Vec::new(),
             caught_by: None,
             level,
             seed: options.seed,

@@ -43,10 +43,17 @@ pub fn alert_route(level: &Level, nav: &NavGraph, guard: usize, alarm: u8, hot: 
 /// copy of a target not yet secured), each once, in room order. The server passes its cases, the Vive
 /// bot the replicated ones, so both lay the alarm's routes out alike.
 pub fn hot_rooms(nav: &NavGraph, cases: impl IntoIterator<Item = Vec2>) -> Vec<usize> {
-    let mut rooms: Vec<usize> = cases.into_iter().filter_map(|at| nav.room_at(at)).collect();
+    let mut rooms = Vec::new();
+    hot_rooms_into(nav, cases, &mut rooms);
+    rooms
+}
+
+/// [`hot_rooms`] into `rooms` (cleared first), so a caller asking every tick reuses one buffer.
+pub fn hot_rooms_into(nav: &NavGraph, cases: impl IntoIterator<Item = Vec2>, rooms: &mut Vec<usize>) {
+    rooms.clear();
+    rooms.extend(cases.into_iter().filter_map(|at| nav.room_at(at)));
     rooms.sort_unstable();
     rooms.dedup();
-    rooms
 }
 
 /// The spots to search around `at`, nearest first: `at` itself, then the centres of the rooms next to
