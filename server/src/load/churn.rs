@@ -11,7 +11,7 @@ use bevy::prelude::*;
 use heist_bots::ViveStyle;
 use heist_shared::protocol::{Role, SeatTicket, TICK_HZ};
 
-use super::{bot_app, create_bot_pair_at};
+use super::pairs::{bot_app, create_bot_pair_at};
 
 /// Game seconds a churning run may run ahead of the wall clock. Connect tokens are minted by the wall
 /// clock, but a stepped server's netcode ages them by game time: a run more than the tokens' life (5

@@ -11,8 +11,8 @@ use std::time::Duration;
 
 use anyhow::Context as _;
 use bevy::prelude::*;
-use heist_bots::{PhantomBotPlugin, Rounds, ViveBotPlugin, ViveStyle};
-use heist_shared::protocol::{Role, TICK_HZ};
+use heist_bots::ViveStyle;
+use heist_shared::protocol::TICK_HZ;
 use heist_transport::IntakeLimits;
 use heist_transport::limit::Rate;
 
@@ -22,7 +22,9 @@ use crate::net::transport::GameTransport;
 use crate::{HostedServer, ServerOptions, build_server};
 
 mod churn;
+mod pairs;
 pub use churn::{AWAY_S, ChurnCounts, MAX_LEAD_S};
+pub use pairs::{create_bot_pair, create_bot_pair_at};
 
 /// How a load run goes.
 #[derive(Clone, Debug)]
@@ -151,51 +153,6 @@ pub fn load_server_options(sessions: usize) -> ServerOptions {
     options.token_limits.creates = CreateLimits { each: plenty, all: plenty };
     options.intake_limits = IntakeLimits { requests_per_address: plenty, requests_total: plenty, ..Default::default() };
     options
-}
-
-/// A bot pair in a session it created: Vive creates it, Phantom joins with its code; `probe` adds a
-/// test's systems to both apps.
-pub fn create_bot_pair(
-    server: &HostedServer,
-    style: ViveStyle,
-    rounds: u32,
-    probe: impl Fn(&mut App),
-) -> anyhow::Result<[App; 2]> {
-    let endpoint = server.tokens.as_ref().context("the server runs without a token endpoint")?.addr;
-    create_bot_pair_at(endpoint, style, rounds, probe)
-}
-
-/// [`create_bot_pair`] through the token endpoint at `endpoint`.
-pub fn create_bot_pair_at(
-    endpoint: std::net::SocketAddr,
-    style: ViveStyle,
-    rounds: u32,
-    probe: impl Fn(&mut App),
-) -> anyhow::Result<[App; 2]> {
-    let timeout = Duration::from_secs(5);
-    let (code, token) = heist_client::create_session(endpoint, Role::Vive, timeout)?;
-    let vive = bot_app(token, Role::Vive, style, rounds, &probe)?;
-    let token = heist_client::request_token(endpoint, &code, Role::Phantom, timeout)?;
-    let phantom = bot_app(token, Role::Phantom, style, rounds, &probe)?;
-    Ok([vive, phantom])
-}
-
-/// A bot client of `role` connecting with `token`, playing `rounds` rounds; `probe` adds a test's systems.
-fn bot_app(
-    token: heist_client::ConnectToken,
-    role: Role,
-    style: ViveStyle,
-    rounds: u32,
-    probe: impl Fn(&mut App),
-) -> anyhow::Result<App> {
-    crate::demo::client_with_token(token, |app| {
-        match role {
-            Role::Vive => app.add_plugins(ViveBotPlugin { style }),
-            Role::Phantom => app.add_plugins(PhantomBotPlugin::default()),
-        };
-        app.insert_resource(Rounds(rounds));
-        probe(app);
-    })
 }
 
 /// CPU time of the calling thread.
