@@ -11,7 +11,7 @@ use bevy::prelude::*;
 use heist_bots::ViveStyle;
 use heist_shared::protocol::{Role, SeatTicket, TICK_HZ};
 
-use super::pairs::{bot_app, create_bot_pair_at};
+use super::pairs::{create_bot_pair_at, resumed_bot};
 
 /// Game seconds a churning run may run ahead of the wall clock. Connect tokens are minted by the wall
 /// clock, but a stepped server's netcode ages them by game time: a run more than the tokens' life (5
@@ -154,11 +154,7 @@ impl Churn {
     /// A new client takes the seat of `role` back with its ticket; refused, the pair leaves.
     fn come_back(&mut self, pair: &mut Pair, role: usize, ticket: &SeatTicket, tick: u64) -> Step {
         let as_role = if role == 0 { Role::Vive } else { Role::Phantom };
-        let timeout = std::time::Duration::from_secs(5);
-        let app = heist_client::request_resume_token(self.endpoint, as_role, ticket, timeout)
-            .map_err(anyhow::Error::from)
-            .and_then(|token| bot_app(token, as_role, self.style, u32::MAX, |_| {}));
-        match app {
+        match resumed_bot(self.endpoint, as_role, ticket, self.style) {
             Ok(app) => {
                 pair.apps[role] = Some(app);
                 self.counts.resumes += 1;

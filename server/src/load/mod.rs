@@ -200,8 +200,9 @@ fn tick(server: &mut HostedServer, heap: Option<HeapProbe>) -> (Duration, Durati
     (thread_cpu() - cpu, wall.elapsed())
 }
 
-/// Rounds begun after a session's first, counted by looking at every session's round now and then (often
-/// enough that none closes unseen after a rematch: a session closes a minute after its last result).
+/// Rounds begun after a session's first, counted by looking at every session's round once a second of
+/// game time: often enough that no session closes between a rematch and the next look (a round under way
+/// outlives its players by the heist's abandon grace, 20 s, or a lobby's idle time).
 #[derive(Default)]
 struct Rematches {
     /// Each session's round when last looked at.
