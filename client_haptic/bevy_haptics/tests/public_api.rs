@@ -194,7 +194,7 @@ enum PairSeen {
 struct PairLog(Arc<Mutex<Vec<PairSeen>>>);
 
 /// Two boxes and a watcher between them (no tool near them): apart nothing is heard; moved half into
-/// each other by their `Transform`s, the watcher hears them meet (with their overlap); moved apart, part;
+/// each other by their `Transform`s, the watcher hears them meet (with some overlap); moved apart, part;
 /// together again, then one despawned: part once more.
 #[test]
 fn a_watcher_between_two_colliders_hears_them_meet_and_part_where_the_game_moves_them() {
@@ -247,8 +247,12 @@ fn a_watcher_between_two_colliders_hears_them_meet_and_part_where_the_game_moves
     app.world_mut().despawn(a);
     run_until(&mut app, 4);
     let seen = log.0.lock().unwrap().clone();
+    // A Transform's move reaches the threads as a pose track: b slides from where it was to where it is
+    // over 20 ms, so they meet on the way and the event may come while b is only partly in (the overlap
+    // when the game thread heard of it). Some overlap, never more than the whole 4e-6 m³ (with the sphere
+    // trees' slack); the rig's own test checks the settled overlap of a pose set at once.
     let PairSeen::Started(_, _, volume) = seen[0] else { panic!("{seen:?}") };
-    assert!((2e-6..8e-6).contains(&volume), "overlap {volume} m³");
+    assert!(volume > 0.0 && volume < 8e-6, "overlap {volume} m³");
     let expected = [PairSeen::Started(a, b, volume), PairSeen::Ended(a, b)];
     assert_eq!(seen[..2], expected, "watcher {watcher}: a {a}, b {b}");
     assert!(matches!(seen[2], PairSeen::Started(x, y, _) if (x, y) == (a, b)), "{seen:?}");
