@@ -132,9 +132,11 @@ impl UdpAttacker {
         self.socket.send_to(bytes, self.server).expect("loopback send");
     }
 
-    /// Seals `payload` with the session key (once connected) and sends it.
-    pub fn send_sealed(&mut self, payload: &[u8]) {
-        if let Ok((to, bytes)) = self.netcode.generate_payload_packet(payload) {
+    /// Seals `packet`, alone in a bundle (heist_transport::bundle), with the session key (once connected)
+    /// and sends it.
+    pub fn send_sealed(&mut self, packet: &[u8]) {
+        let bundle = heist_transport::bundle::single(packet);
+        if let Ok((to, bytes)) = self.netcode.generate_payload_packet(&bundle) {
             let _ = self.socket.send_to(bytes, to);
         }
     }

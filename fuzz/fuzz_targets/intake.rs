@@ -1,8 +1,8 @@
 //! The server's whole intake under arbitrary traffic: datagrams from an unknown, a pending and a connected
-//! address, and renet packets sealed with the connected client's key (the only way random bytes get past
-//! netcode's encryption to renet), then every message renet delivers through the server's `ClientMsg`
-//! decoder (and what arrives on the voice channel through the `ClientVoice` decoder). The channels are
-//! the game's own, from its registered protocol.
+//! address, and renet packets and bundles of them sealed with the connected client's key (the only way
+//! random bytes get past netcode's encryption to renet), then every message renet delivers through the
+//! server's `ClientMsg` decoder (and what arrives on the voice channel through the `ClientVoice`
+//! decoder). The channels are the game's own, from its registered protocol.
 //!
 //! `cargo fuzz run intake` (see README, "Fuzzing").
 #![no_main]
@@ -29,8 +29,10 @@ enum Op {
     Pending(Vec<u8>),
     /// A datagram from the connected client's address.
     Connected(Vec<u8>),
-    /// A renet packet sealed with the connected client's session key.
+    /// A renet packet, alone in a bundle, sealed with the connected client's session key.
     Sealed(Vec<u8>),
+    /// Any payload (a bundle of renet packets, well-formed or not) sealed with that key.
+    SealedBundle(Vec<u8>),
     /// A server frame: renet's clock, keep-alives, disconnections, sends.
     Frame,
 }
@@ -81,6 +83,10 @@ fuzz_target!(|ops: Vec<Op>| {
             Op::Connected(d) => server.deliver(CONNECTED, &d),
             Op::Sealed(p) => {
                 let d = connected.seal(&p);
+                server.deliver(CONNECTED, &d)
+            }
+            Op::SealedBundle(b) => {
+                let d = connected.seal_bundle(&b);
                 server.deliver(CONNECTED, &d)
             }
             Op::Frame => {

@@ -1,5 +1,6 @@
 //! The client's side of the UDP transport: only datagrams from the server's address with a header netcode
-//! can parse reach netcode, and every decrypted payload passes a [`SliceGuard`] before renet.
+//! can parse reach netcode, and every renet packet of a decrypted payload (a bundle: [`crate::bundle`])
+//! passes a [`SliceGuard`] before renet.
 //!
 //! Like [`crate::server::ServerIntake`], [`ClientIntake`] owns no socket.
 
@@ -9,6 +10,7 @@ use std::time::Duration;
 use renet::RenetClient;
 use renetcode::{ClientAuthentication, DisconnectReason, NetcodeClient, NetcodeError};
 
+use crate::bundle::Bundler;
 use crate::datagram::DatagramRefusal;
 use crate::datagram::{Direction, check_datagram};
 use crate::error::TransportError;
@@ -24,6 +26,7 @@ pub struct ClientIntake {
     netcode: NetcodeClient,
     slices: SliceGuard,
     refused: u64,
+    bundler: Bundler,
 }
 
 impl ClientIntake {
@@ -33,6 +36,7 @@ impl ClientIntake {
             netcode: NetcodeClient::new(now, authentication)?,
             slices: SliceGuard::new(CLIENT_MAX_SLICES),
             refused: 0,
+            bundler: Bundler::new(),
         })
     }
 
@@ -88,11 +92,17 @@ impl ClientIntake {
             return Err(Refused::Datagram(r));
         }
         let Some(payload) = self.netcode.process_packet(datagram) else { return Ok(()) };
-        if let Err(r) = self.slices.check(payload) {
+        let packets = crate::bundle::unbundle(payload).map_err(|r| {
             self.refused += 1;
-            return Err(Refused::Payload(r));
+            Refused::Payload(r)
+        })?;
+        for packet in packets {
+            if let Err(r) = self.slices.check(packet) {
+                self.refused += 1;
+                return Err(Refused::Payload(r));
+            }
+            renet.process_packet(packet);
         }
-        renet.process_packet(payload);
         Ok(())
     }
 
@@ -103,16 +113,17 @@ impl ClientIntake {
         }
     }
 
-    /// Sends renet's packets.
+    /// Sends renet's packets, bundled: one datagram for all that fit.
     pub fn send_packets(&mut self, renet: &mut RenetClient, send: &mut Send<'_>) -> Result<(), TransportError> {
         if let Some(reason) = self.netcode.disconnect_reason() {
             return Err(TransportError::Netcode(NetcodeError::Disconnected(reason)));
         }
-        for packet in renet.get_packets_to_send() {
-            let (addr, bytes) = self.netcode.generate_payload_packet(&packet)?;
+        let Self { netcode, bundler, .. } = self;
+        bundler.pack(renet.get_packets_to_send(), |bundle| {
+            let (addr, bytes) = netcode.generate_payload_packet(bundle)?;
             send(addr, bytes);
-        }
-        Ok(())
+            Ok::<_, TransportError>(())
+        })
     }
 
     /// Tells the server we leave.

@@ -3,7 +3,7 @@
 
 use thiserror::Error;
 
-/// Why a decrypted renet packet never reached renet.
+/// Why a decrypted payload, or a renet packet in it, never reached renet.
 #[derive(Clone, Copy, Debug, Error, PartialEq, Eq)]
 pub enum PayloadRefusal {
     /// The packet ended inside a field.
@@ -38,9 +38,12 @@ pub enum PayloadRefusal {
     /// A slice of a message older than the ones this side still tracks.
     #[error("slice of an old message {0}")]
     StaleSlice(u64),
-    /// Over this connection's datagram rate.
-    #[error("datagrams over the connection's rate limit")]
+    /// Over this connection's packet rate.
+    #[error("packets over the connection's rate limit")]
     RateLimited,
+    /// A payload that is not a whole bundle of renet packets ([`crate::bundle`]); none of it reaches renet.
+    #[error("bad bundle: {0}")]
+    BadBundle(&'static str),
 }
 
 /// Why a transport stopped.

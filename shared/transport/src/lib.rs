@@ -2,12 +2,14 @@
 //! single byte of them: it runs netcode (renetcode) and renet as bevy_renet's netcode transport does, but
 //! checks every datagram's header before netcode parses it ([`datagram`]), every decrypted renet packet
 //! before renet parses it ([`payload`]), and limits the rate of both ([`limit`]). renetcode 2.0.0 and
-//! renet 2.0.1 panic on packets these checks refuse (docs/decisions.md has the four reports).
+//! renet 2.0.1 panic on packets these checks refuse (docs/decisions.md has the four reports). A frame's
+//! renet packets travel together: one datagram carries all that fit ([`bundle`]).
 //!
 //! No Bevy and no socket of their own: [`ServerIntake`] and [`ClientIntake`] take datagrams and a send
 //! function, so the game (through [`socket`]), the tests and the fuzz target drive the same code.
 #![warn(missing_docs)]
 
+pub mod bundle;
 pub mod client;
 pub mod datagram;
 mod error;

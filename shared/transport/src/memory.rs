@@ -188,9 +188,16 @@ impl RawClient {
         }
     }
 
-    /// `payload` as a payload datagram sealed with this client's key (empty when not connected).
-    pub fn seal(&mut self, payload: &[u8]) -> Vec<u8> {
-        self.netcode.generate_payload_packet(payload).map(|(_, bytes)| bytes.to_vec()).unwrap_or_default()
+    /// `packet` as a payload datagram (a bundle of that packet alone) sealed with this client's key
+    /// (empty when not connected).
+    pub fn seal(&mut self, packet: &[u8]) -> Vec<u8> {
+        self.seal_bundle(&crate::bundle::single(packet))
+    }
+
+    /// `bundle` as it is, sealed with this client's key: a payload that need not be a well-formed bundle
+    /// (empty when not connected).
+    pub fn seal_bundle(&mut self, bundle: &[u8]) -> Vec<u8> {
+        self.netcode.generate_payload_packet(bundle).map(|(_, bytes)| bytes.to_vec()).unwrap_or_default()
     }
 }
 

@@ -1,5 +1,5 @@
 //! The server's side of the UDP transport: every datagram is checked, rate-limited and only then handed to
-//! netcode; every decrypted payload is checked before renet sees it.
+//! netcode; every decrypted payload is unbundled and each of its packets checked before renet sees it.
 //!
 //! [`ServerIntake`] owns no socket: [`ServerIntake::receive`] takes one datagram and the caller's send
 //! function, so tests and the fuzz target drive it in memory exactly as the game's socket loop does.
@@ -11,6 +11,7 @@ use std::time::Duration;
 use renet::RenetServer;
 use renetcode::{NETCODE_USER_DATA_BYTES, NetcodeServer, ServerConfig, ServerResult};
 
+use crate::bundle::Bundler;
 use crate::datagram::DatagramRefusal;
 use crate::datagram::{Direction, PacketKind, check_datagram};
 use crate::error::PayloadRefusal;
@@ -25,8 +26,9 @@ pub struct IntakeLimits {
     pub requests_per_address: Rate,
     /// Connection requests from all addresses together; default 500/s, 500 at once.
     pub requests_total: Rate,
-    /// Authenticated datagrams per connected client; default 1000/s, 1000 at once (a player sends ~120/s).
-    pub datagrams_per_client: Rate,
+    /// renet packets per connected client, whatever datagrams carry them ([`crate::bundle`]); default
+    /// 1000/s, 1000 at once (a player sends ~150/s).
+    pub packets_per_client: Rate,
     /// Largest client message in slices of 1200 bytes; default 32 (the largest a client sends is ~5 KB).
     pub max_slices: u64,
     /// Refused payloads a client may send (leaking one a second) before it is disconnected; default 20.
@@ -47,7 +49,7 @@ impl Default for IntakeLimits {
         Self {
             requests_per_address: Rate::new(10.0, 10.0),
             requests_total: Rate::new(500.0, 500.0),
-            datagrams_per_client: Rate::new(1000.0, 1000.0),
+            packets_per_client: Rate::new(1000.0, 1000.0),
             max_slices: 32,
             refused_payloads_limit: 20.0,
             tracked_addresses: 4096,
@@ -100,7 +102,7 @@ pub struct IntakeStats {
 struct Connection {
     addr: SocketAddr,
     slices: SliceGuard,
-    datagrams: Bucket,
+    packets: Bucket,
     /// Refused payloads it may still send; empty means disconnect.
     refusals: Bucket,
     expelled: bool,
@@ -137,6 +139,7 @@ pub struct ServerIntake {
     requests: KeyedLimiter<IpAddr>,
     peers: Peers,
     log: RefusalLog,
+    bundler: Bundler,
 }
 
 /// Where the intake sends datagrams: (destination, bytes).
@@ -156,6 +159,7 @@ impl ServerIntake {
                 departures: std::collections::VecDeque::with_capacity(DEPARTURES_KEPT),
             },
             log: RefusalLog::new("heist_transport::server", "UDP intake"),
+            bundler: Bundler::new(),
         }
     }
 
@@ -241,21 +245,19 @@ impl ServerIntake {
         }
     }
 
-    /// Sends renet's packets for every connected client.
+    /// Sends renet's packets for every connected client, bundled: one datagram for all that fit.
     pub fn send_packets(&mut self, renet: &mut RenetServer, send: &mut Send<'_>) {
+        let Self { netcode, peers, bundler, .. } = self;
         for id in renet.clients_id() {
             let Ok(packets) = renet.get_packets_to_send(id) else { continue };
-            for packet in packets {
-                match self.netcode.generate_payload_packet(id, &packet) {
-                    Ok((addr, bytes)) => {
-                        self.peers.stats.bytes_out += bytes.len() as u64;
-                        send(addr, bytes);
-                    }
-                    Err(e) => {
-                        log::error!("UDP intake: cannot encrypt a packet for client {id}: {e}");
-                        break;
-                    }
-                }
+            let sealed = bundler.pack(&packets, |bundle| {
+                let (addr, bytes) = netcode.generate_payload_packet(id, bundle)?;
+                peers.stats.bytes_out += bytes.len() as u64;
+                send(addr, bytes);
+                Ok::<_, renetcode::NetcodeError>(())
+            });
+            if let Err(e) = sealed {
+                log::error!("UDP intake: cannot encrypt a packet for client {id}: {e}");
             }
         }
     }
@@ -277,6 +279,11 @@ impl ServerIntake {
         self.netcode.client_addr(client_id)
     }
 
+    /// Clients netcode holds a slot for (every slot is walked each frame, taken or not).
+    pub fn max_clients(&self) -> usize {
+        self.netcode.max_clients()
+    }
+
     /// How `client_id` went, when it was one of the last 64 to go other than by falling silent: `None` for
     /// a connection that timed out (or one this intake never saw go).
     pub fn departure(&self, client_id: u64) -> Option<Departure> {
@@ -294,18 +301,18 @@ impl Connection {
         Self {
             addr,
             slices: SliceGuard::new(limits.max_slices),
-            datagrams: Bucket::full(limits.datagrams_per_client, now_s),
+            packets: Bucket::full(limits.packets_per_client, now_s),
             refusals: Bucket::full(limits.refusal_rate(), now_s),
             expelled: false,
         }
     }
 
-    /// Checks one decrypted payload: the connection's datagram rate, then its slices.
-    fn check(&mut self, payload: &[u8], limits: &IntakeLimits, now_s: f64) -> Result<(), PayloadRefusal> {
-        if !self.datagrams.take(limits.datagrams_per_client, now_s) {
+    /// Checks one renet packet of a decrypted payload: the connection's packet rate, then its slices.
+    fn check(&mut self, packet: &[u8], limits: &IntakeLimits, now_s: f64) -> Result<(), PayloadRefusal> {
+        if !self.packets.take(limits.packets_per_client, now_s) {
             return Err(PayloadRefusal::RateLimited);
         }
-        self.slices.check(payload)
+        self.slices.check(packet)
     }
 }
 
@@ -334,11 +341,17 @@ impl Peers {
             ServerResult::PacketToSend { addr, payload } => sent(addr, payload),
             ServerResult::Payload { client_id, payload } => {
                 let connection = self.connections.get_mut(&client_id)?;
-                if let Err(r) = connection.check(payload, &self.limits, self.now_s) {
-                    return Some((client_id, r));
+                let packets = match crate::bundle::unbundle(payload) {
+                    Ok(packets) => packets,
+                    Err(r) => return Some((client_id, r)),
+                };
+                for packet in packets {
+                    if let Err(r) = connection.check(packet, &self.limits, self.now_s) {
+                        return Some((client_id, r));
+                    }
+                    // Only fails for an unknown client, which netcode just vouched for.
+                    let _ = renet.process_packet_from(packet, client_id);
                 }
-                // Only fails for an unknown client, which netcode just vouched for.
-                let _ = renet.process_packet_from(payload, client_id);
             }
             ServerResult::ClientConnected { client_id, addr, payload, .. } => {
                 log::info!("UDP intake: client {client_id} connected from {addr}");

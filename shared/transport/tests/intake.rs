@@ -216,6 +216,45 @@ fn a_client_sending_refused_payloads_is_disconnected() {
     assert_eq!(server.intake.stats().expelled, 1);
 }
 
+/// A frame's messages on every channel, and renet's acks, travel in one datagram each way; a payload that
+/// is not a whole bundle never reaches renet, counts as a refused payload, and the player plays on.
+#[test]
+fn a_frame_is_one_datagram_each_way_and_a_bad_bundle_reaches_nothing() {
+    let mut server = MemoryServer::new();
+    let mut player = server.client(addr(1, 1000), 1);
+    run(&mut server, &mut [&mut player], 10);
+    assert!(player.renet.is_connected());
+    // Both sides have something on all three of renet's default channels, and acks to give.
+    let channels =
+        [DefaultChannel::ReliableOrdered, DefaultChannel::ReliableUnordered, DefaultChannel::Unreliable].map(u8::from);
+    for channel in channels {
+        server.renet.send_message(1, channel, vec![1; 100]);
+        player.renet.send_message(channel, vec![2; 100]);
+    }
+    server.frame();
+    assert_eq!(server.sent.len(), 1, "the server's frame: one datagram");
+    let (_, down) = server.sent.pop().unwrap();
+    player.frame(vec![down]);
+    assert_eq!(player.sent.len(), 1, "the player's frame: one datagram");
+    assert_eq!(server.deliver(player.addr, &player.sent.pop().unwrap()), Ok(()));
+    for channel in channels {
+        assert_eq!(server.renet.receive_message(1, channel).as_deref(), Some(&[2; 100][..]), "channel {channel}");
+        assert_eq!(player.renet.receive_message(channel).as_deref(), Some(&[1; 100][..]), "channel {channel}");
+    }
+
+    let mut attacker = RawClient::connected(&mut server, addr(3, 3000), 3);
+    let whole = heist_transport::bundle::single(&[0x03, 0, 0]);
+    for (bundle, why) in [(&whole[..whole.len() - 1], "longer than"), (&[0, 0, 7][..], "empty packet")] {
+        let refused = server.deliver(attacker.addr, &attacker.seal_bundle(bundle));
+        assert!(
+            matches!(refused, Err(Refused::Payload(PayloadRefusal::BadBundle(w))) if w.contains(why)),
+            "{refused:?}"
+        );
+    }
+    assert_eq!(server.intake.stats().refused_payloads, 2);
+    assert!(plays(&mut server, &mut player, 1), "the player still plays");
+}
+
 /// What an attacker does to the server in one step.
 #[derive(Clone, Debug)]
 enum Attack {

@@ -30,8 +30,9 @@ pub use voice::{ClientVoice, PartnerVoice, VoiceFrame};
 use bevy::prelude::*;
 use bevy_replicon::prelude::*;
 
-/// Netcode protocol id: bumps whenever the wire format changes.
-pub const PROTOCOL_ID: u64 = 0x5048_4549_5354_0002;
+/// Netcode protocol id: bumps whenever the wire format changes (3: renet's packets of a frame travel
+/// bundled, heist_transport::bundle).
+pub const PROTOCOL_ID: u64 = 0x5048_4549_5354_0003;
 
 /// Server simulation rate (FixedUpdate), Hz.
 pub const TICK_HZ: f64 = 60.0;
