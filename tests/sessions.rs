@@ -319,6 +319,12 @@ fn three_hundred_sessions_in_one_process_are_created_played_and_closed_and_no_cl
     assert_eq!(most_running, SESSIONS, "the heists ran at the same time");
     let unseen: Vec<usize> = (0..clients.len()).filter(|i| !own_seen[*i]).collect();
     assert!(unseen.is_empty(), "clients {unseen:?} never held their own session whole");
+    // Each shard's netcode has slots for its own sessions' players (each twice, and 16 more), not for
+    // the server's 600.
+    for shard in &server.shards {
+        let transport = shard.app.world().resource::<heist_server::net::transport::GameTransport>();
+        assert_eq!(transport.max_clients(), 4 * 8 + 16, "a shard's netcode slots");
+    }
 
     // Over, every session closes and frees what it held.
     let mut ticks = 0;

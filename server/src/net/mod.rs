@@ -109,8 +109,11 @@ fn start_transport(
     };
     let config = ServerConfig {
         current_time: SystemTime::now().duration_since(UNIX_EPOCH).unwrap_or_default(),
-        // Two players a session, and room for a few more, so they can be told why they are refused.
-        max_clients: (settings.registry.max() * 2 + 16).min(MAX_CLIENTS),
+        // This shard's sessions' players, each twice (a player who dropped comes back on a new connection
+        // while the old one times out), and 16 more (clients told why they are refused). Not the whole
+        // server's: netcode keeps a slot of 2 kB a client and walks every slot each tick to list its
+        // clients, so slots sized for the server made every shard's tick O(sessions).
+        max_clients: shard_slots(settings.registry.shard_size()),
         protocol_id: PROTOCOL_ID,
         public_addresses: vec![settings.advertise.unwrap_or(addr)],
         authentication,
@@ -122,6 +125,11 @@ fn start_transport(
         }
         Err(e) => error!("cannot start the game transport on {addr}: {e}"),
     }
+}
+
+/// The netcode slots of a shard playing at most `shard_size` sessions.
+pub fn shard_slots(shard_size: usize) -> usize {
+    (shard_size * 4 + 16).min(MAX_CLIENTS)
 }
 
 /// Netcode's most clients on one server.

@@ -73,6 +73,11 @@ impl GameTransport {
         self.intake.departure(client_id)
     }
 
+    /// Clients the netcode server holds a slot for.
+    pub fn max_clients(&self) -> usize {
+        self.intake.max_clients()
+    }
+
     /// Bytes through the socket so far.
     pub fn traffic(&self) -> Traffic {
         self.bytes
