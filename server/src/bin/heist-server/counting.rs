@@ -1,11 +1,14 @@
-//! The binary's allocator (a build with the `bots` feature, for `load`): the system's, counting the net bytes allocated while a thread is flagged as
-//! doing the server's work, so `load` can tell the server's heap from its bots' in one process.
+//! The binary's allocator in a build with the `bots` feature (for `load`): mimalloc, as in every build
+//! (`main.rs`), counting the net bytes allocated while a thread is flagged as doing the server's work, so
+//! `load` can tell the server's heap from its bots' in one process.
 
-use std::alloc::{GlobalAlloc, Layout, System};
+use std::alloc::{GlobalAlloc, Layout};
+
+use mimalloc::MiMalloc;
 use std::cell::Cell;
 use std::sync::atomic::{AtomicI64, Ordering};
 
-/// The system allocator, counting flagged work.
+/// mimalloc, counting flagged work.
 struct Counting;
 
 static SERVER_BYTES: AtomicI64 = AtomicI64::new(0);
@@ -21,31 +24,31 @@ fn count(delta: i64) {
     }
 }
 
-// SAFETY: every call goes to the system allocator unchanged; counting touches only an atomic and a
+// SAFETY: every call goes to mimalloc unchanged; counting touches only an atomic and a
 // const thread-local.
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
         count(layout.size() as i64);
         // SAFETY: the caller's layout, as GlobalAlloc requires.
-        unsafe { System.alloc(layout) }
+        unsafe { MiMalloc.alloc(layout) }
     }
 
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
         count(-(layout.size() as i64));
-        // SAFETY: `ptr` came from this allocator (the system's) with `layout`.
-        unsafe { System.dealloc(ptr, layout) }
+        // SAFETY: `ptr` came from this allocator (mimalloc) with `layout`.
+        unsafe { MiMalloc.dealloc(ptr, layout) }
     }
 
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
         count(layout.size() as i64);
         // SAFETY: as `alloc`.
-        unsafe { System.alloc_zeroed(layout) }
+        unsafe { MiMalloc.alloc_zeroed(layout) }
     }
 
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
         count(new_size as i64 - layout.size() as i64);
         // SAFETY: as `dealloc` and `alloc`.
-        unsafe { System.realloc(ptr, layout, new_size) }
+        unsafe { MiMalloc.realloc(ptr, layout, new_size) }
     }
 }
 
