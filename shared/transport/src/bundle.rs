@@ -27,13 +27,12 @@ const LENGTH_BYTES: usize = 2;
 #[derive(Debug, Default)]
 pub struct Bundler {
     buffer: Vec<u8>,
-    packets: usize,
 }
 
 impl Bundler {
     /// A bundler with room for the largest bundle.
     pub fn new() -> Self {
-        Self { buffer: Vec::with_capacity(MAX_BUNDLE_BYTES), packets: 0 }
+        Self { buffer: Vec::with_capacity(MAX_BUNDLE_BYTES) }
     }
 
     /// Puts `packets` into as few bundles as fit, in order, and hands each to `seal`; stops at `seal`'s
@@ -45,22 +44,20 @@ impl Bundler {
         mut seal: impl FnMut(&[u8]) -> Result<(), E>,
     ) -> Result<(), E> {
         self.buffer.clear();
-        self.packets = 0;
+        let mut held = 0;
         for packet in packets {
             let packet = packet.as_ref();
-            let full = self.buffer.len() + LENGTH_BYTES + packet.len() > MAX_BUNDLE_BYTES
-                || self.packets == MAX_PACKETS_PER_BUNDLE;
-            if full && self.packets > 0 {
+            let full =
+                self.buffer.len() + LENGTH_BYTES + packet.len() > MAX_BUNDLE_BYTES || held == MAX_PACKETS_PER_BUNDLE;
+            if full && held > 0 {
                 seal(&self.buffer)?;
                 self.buffer.clear();
-                self.packets = 0;
+                held = 0;
             }
-            let length = u16::try_from(packet.len()).unwrap_or(u16::MAX);
-            self.buffer.extend_from_slice(&length.to_le_bytes());
-            self.buffer.extend_from_slice(&packet[..usize::from(length)]);
-            self.packets += 1;
+            push_frame(&mut self.buffer, packet);
+            held += 1;
         }
-        if self.packets > 0 {
+        if held > 0 {
             seal(&self.buffer)?;
         }
         Ok(())
@@ -70,10 +67,24 @@ impl Bundler {
 /// `packet` alone in a bundle (tests, and a peer that sends one packet at a time).
 pub fn single(packet: &[u8]) -> Vec<u8> {
     let mut bundle = Vec::with_capacity(LENGTH_BYTES + packet.len());
+    push_frame(&mut bundle, packet);
+    bundle
+}
+
+/// Appends `packet` after its length (cut at 65,535 bytes, which no bundle reaches).
+fn push_frame(bundle: &mut Vec<u8>, packet: &[u8]) {
     let length = u16::try_from(packet.len()).unwrap_or(u16::MAX);
     bundle.extend_from_slice(&length.to_le_bytes());
     bundle.extend_from_slice(&packet[..usize::from(length)]);
-    bundle
+}
+
+/// The first frame of `rest`: its packet and what follows, or why it is not whole.
+fn split_frame(rest: &[u8]) -> Result<(&[u8], &[u8]), &'static str> {
+    let (length, after) = rest.split_first_chunk::<LENGTH_BYTES>().ok_or("a packet's length cut short")?;
+    match usize::from(u16::from_le_bytes(*length)) {
+        0 => Err("an empty packet"),
+        length => after.split_at_checked(length).ok_or("a packet longer than what is left of the bundle"),
+    }
 }
 
 /// The renet packets in `bundle`, in order, once the whole bundle is checked: every frame whole and not
@@ -82,21 +93,11 @@ pub fn unbundle(bundle: &[u8]) -> Result<Packets<'_>, PayloadRefusal> {
     let mut rest = bundle;
     let mut count = 0;
     while !rest.is_empty() {
-        let Some((length, after)) = rest.split_first_chunk::<LENGTH_BYTES>() else {
-            return Err(PayloadRefusal::BadBundle("a packet's length cut short"));
-        };
-        let length = usize::from(u16::from_le_bytes(*length));
-        if length == 0 {
-            return Err(PayloadRefusal::BadBundle("an empty packet"));
-        }
-        if length > after.len() {
-            return Err(PayloadRefusal::BadBundle("a packet longer than what is left of the bundle"));
-        }
+        (_, rest) = split_frame(rest).map_err(PayloadRefusal::BadBundle)?;
         count += 1;
         if count > MAX_PACKETS_PER_BUNDLE {
             return Err(PayloadRefusal::BadBundle("more packets than a bundle may hold"));
         }
-        rest = &after[length..];
     }
     if count == 0 {
         return Err(PayloadRefusal::BadBundle("no packet"));
@@ -114,8 +115,7 @@ impl<'a> Iterator for Packets<'a> {
     type Item = &'a [u8];
 
     fn next(&mut self) -> Option<&'a [u8]> {
-        let (length, after) = self.rest.split_first_chunk::<LENGTH_BYTES>()?;
-        let (packet, rest) = after.split_at_checked(usize::from(u16::from_le_bytes(*length)))?;
+        let (packet, rest) = split_frame(self.rest).ok()?;
         self.rest = rest;
         Some(packet)
     }

@@ -92,18 +92,17 @@ impl ClientIntake {
             return Err(Refused::Datagram(r));
         }
         let Some(payload) = self.netcode.process_packet(datagram) else { return Ok(()) };
-        let packets = crate::bundle::unbundle(payload).map_err(|r| {
+        let delivered = crate::bundle::unbundle(payload).and_then(|packets| {
+            for packet in packets {
+                self.slices.check(packet)?;
+                renet.process_packet(packet);
+            }
+            Ok(())
+        });
+        delivered.map_err(|r| {
             self.refused += 1;
             Refused::Payload(r)
-        })?;
-        for packet in packets {
-            if let Err(r) = self.slices.check(packet) {
-                self.refused += 1;
-                return Err(Refused::Payload(r));
-            }
-            renet.process_packet(packet);
-        }
-        Ok(())
+        })
     }
 
     /// Ends a frame: advances netcode by `dt` and sends its keep-alive or handshake packet.

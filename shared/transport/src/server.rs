@@ -341,16 +341,16 @@ impl Peers {
             ServerResult::PacketToSend { addr, payload } => sent(addr, payload),
             ServerResult::Payload { client_id, payload } => {
                 let connection = self.connections.get_mut(&client_id)?;
-                let packets = match crate::bundle::unbundle(payload) {
-                    Ok(packets) => packets,
-                    Err(r) => return Some((client_id, r)),
-                };
-                for packet in packets {
-                    if let Err(r) = connection.check(packet, &self.limits, self.now_s) {
-                        return Some((client_id, r));
+                let delivered = crate::bundle::unbundle(payload).and_then(|packets| {
+                    for packet in packets {
+                        connection.check(packet, &self.limits, self.now_s)?;
+                        // Only fails for an unknown client, which netcode just vouched for.
+                        let _ = renet.process_packet_from(packet, client_id);
                     }
-                    // Only fails for an unknown client, which netcode just vouched for.
-                    let _ = renet.process_packet_from(packet, client_id);
+                    Ok(())
+                });
+                if let Err(r) = delivered {
+                    return Some((client_id, r));
                 }
             }
             ServerResult::ClientConnected { client_id, addr, payload, .. } => {

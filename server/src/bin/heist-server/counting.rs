@@ -3,10 +3,10 @@
 //! `load` can tell the server's heap from its bots' in one process.
 
 use std::alloc::{GlobalAlloc, Layout};
-
-use mimalloc::MiMalloc;
 use std::cell::Cell;
 use std::sync::atomic::{AtomicI64, Ordering};
+
+use mimalloc::MiMalloc;
 
 /// mimalloc, counting flagged work.
 struct Counting;
