@@ -102,6 +102,13 @@ pub(crate) enum Command {
         /// comes back with the seat's ticket 5 s later, or both leave and a new pair creates a session.
         #[arg(long, value_parser = positive_seconds)]
         churn: Option<f32>,
+        /// Before every measured tick write this many MB (1024 if no figure is given; more than the
+        /// machine's last-level cache), so that runs of any size measure the server from the same cold
+        /// cache: without it a big run's bots evict the server's data between ticks and a small run's
+        /// do not.
+        #[arg(long, num_args = 0..=1, default_missing_value = "1024", value_name = "MB",
+              value_parser = clap::value_parser!(u32).range(1..=65_536))]
+        cold_cache: Option<u32>,
     },
     /// Join a hosted session as a bot (restarted within a minute of losing its connection, it takes its
     /// seat back through the seat cache, `$XDG_CACHE_HOME/phantom-heist/seats`).
@@ -163,7 +170,7 @@ pub(crate) fn run(command: Command) -> anyhow::Result<()> {
             }
             Ok(())
         }
-        Command::Load { sessions, seconds, json, metrics, shard_size, churn } => {
+        Command::Load { sessions, seconds, json, metrics, shard_size, churn, cold_cache } => {
             let options = heist_server::load::LoadOptions {
                 sessions,
                 seconds,
@@ -172,6 +179,7 @@ pub(crate) fn run(command: Command) -> anyhow::Result<()> {
                 shard_size,
                 heap: Some(counting::PROBE),
                 churn,
+                cold_cache_mb: cold_cache,
             };
             let report = heist_server::load::run_load(&options, |line| println!("{line}"))?;
             println!("{report}");
