@@ -324,6 +324,10 @@ fn three_hundred_sessions_in_one_process_are_created_played_and_closed_and_no_cl
     for shard in &server.shards {
         let transport = shard.app.world().resource::<heist_server::net::transport::GameTransport>();
         assert_eq!(transport.max_clients(), 4 * 8 + 16, "a shard's netcode slots");
+        // A shard is a server only: replicon's client side (its resources and its systems every tick)
+        // is left out although the crate is built with it.
+        let world = shard.app.world();
+        assert!(!world.contains_resource::<bevy_replicon::client::ServerUpdateTick>(), "replicon's client side");
     }
 
     // Over, every session closes and frees what it held.

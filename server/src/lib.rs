@@ -339,6 +339,21 @@ pub fn build_server(options: ServerOptions) -> anyhow::Result<HostedServer> {
     Ok(HostedServer { shards, addr, advertised, tokens, registry, codes, fleet })
 }
 
+/// Replicon's plugins without its client side: the crate is built with replicon's `client` feature (the
+/// bots and the clients' embedded host share it), but a shard is only a server, and each of its systems
+/// costs every tick (most when the caches are cold: tens of shards' apps run in turn).
+fn server_replicon() -> bevy::app::PluginGroupBuilder {
+    RepliconPlugins
+        .build()
+        .disable::<bevy_replicon::client::ClientPlugin>()
+        .disable::<bevy_replicon::client::message::ClientMessagePlugin>()
+}
+
+/// Renet's replicon backend without its client side (as [`server_replicon`]).
+fn server_renet() -> bevy::app::PluginGroupBuilder {
+    RepliconRenetPlugins.build().disable::<bevy_replicon_renet::RepliconRenetClientPlugin>()
+}
+
 /// One shard's app: replicon and renet on `socket`, the sessions `settings.shard` plays, the fleet side.
 fn shard_app(
     clock: Clock,
@@ -354,7 +369,7 @@ fn shard_app(
         app.insert_resource(TimeUpdateStrategy::ManualDuration(period));
     }
     app.insert_resource(Time::<Fixed>::from_hz(TICK_HZ))
-        .add_plugins((StatesPlugin, RepliconPlugins, RepliconRenetPlugins, ProtocolPlugin))
+        .add_plugins((StatesPlugin, server_replicon(), server_renet(), ProtocolPlugin))
         .add_plugins(SessionPlugin)
         .insert_resource(fleet.clone())
         .add_plugins(FleetPlugin)
