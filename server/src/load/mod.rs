@@ -59,12 +59,23 @@ pub struct Evictor {
 }
 
 impl Evictor {
-    /// A buffer of `mb` MB, written once so that its pages are resident before the measurement.
-    pub fn new(mb: u32) -> Self {
-        let mut evictor = Self { buffer: vec![0; (mb as usize) << 20], round: 0 };
+    /// A buffer of `mb` MB (at most [`Evictor::MAX_MB`]), written once so that its pages are resident
+    /// before the measurement; an error if it is too big or the memory cannot be had.
+    pub fn new(mb: u32) -> anyhow::Result<Self> {
+        anyhow::ensure!((1..=Self::MAX_MB).contains(&mb), "--cold-cache {mb} MB is outside 1..={} MB", Self::MAX_MB);
+        let bytes = (mb as usize) << 20;
+        let mut buffer = Vec::new();
+        buffer
+            .try_reserve_exact(bytes)
+            .map_err(|e| anyhow::anyhow!("--cold-cache {mb} MB: cannot allocate its buffer ({e})"))?;
+        buffer.resize(bytes, 0);
+        let mut evictor = Self { buffer, round: 0 };
         evictor.evict();
-        evictor
+        Ok(evictor)
     }
+
+    /// The largest buffer, MB: far more than any last-level cache, little enough to write every tick.
+    pub const MAX_MB: u32 = 4096;
 
     /// Writes every cache line of the buffer.
     pub fn evict(&mut self) {
@@ -290,6 +301,7 @@ pub fn run_load(options: &LoadOptions, mut progress: impl FnMut(&str)) -> anyhow
         "--churn must be more than {} seconds (a dropped client stays away {AWAY_S} s)",
         AWAY_S + 1.0
     );
+    let mut evictor = options.cold_cache_mb.map(Evictor::new).transpose()?;
     let mut server =
         build_server(ServerOptions { shard_size: options.shard_size, ..load_server_options(options.sessions) })?;
     let fleet = crate::fleet::FleetOptions { metrics: options.metrics, agones: None };
@@ -345,7 +357,6 @@ pub fn run_load(options: &LoadOptions, mut progress: impl FnMut(&str)) -> anyhow
         style: options.style,
         counts: ChurnCounts::default(),
     });
-    let mut evictor = options.cold_cache_mb.map(Evictor::new);
     for n in 1..=ticks {
         if let Some(evictor) = evictor.as_mut() {
             evictor.evict();
@@ -421,7 +432,8 @@ mod tests {
 
     #[test]
     fn an_evictor_writes_every_cache_line_of_its_buffer_each_time() {
-        let mut evictor = Evictor::new(1);
+        let mut evictor = Evictor::new(1).expect("1 MB");
+        assert!(Evictor::new(0).is_err() && Evictor::new(Evictor::MAX_MB + 1).is_err(), "sizes out of range");
         assert_eq!(evictor.buffer.len(), 1 << 20);
         for round in [2u8, 3] {
             evictor.evict();
