@@ -59,7 +59,7 @@ pub struct Evictor {
 }
 
 impl Evictor {
-    /// A buffer of `mb` MB (at most [`Evictor::MAX_MB`]), written once so that its pages are resident
+    /// A buffer of `mb` MB (at most [`Evictor::MAX_MB`]), zeroed here so that its pages are resident
     /// before the measurement; an error if it is too big or the memory cannot be had.
     pub fn new(mb: u32) -> anyhow::Result<Self> {
         anyhow::ensure!((1..=Self::MAX_MB).contains(&mb), "--cold-cache {mb} MB is outside 1..={} MB", Self::MAX_MB);
@@ -69,9 +69,7 @@ impl Evictor {
             .try_reserve_exact(bytes)
             .map_err(|e| anyhow::anyhow!("--cold-cache {mb} MB: cannot allocate its buffer ({e})"))?;
         buffer.resize(bytes, 0);
-        let mut evictor = Self { buffer, round: 0 };
-        evictor.evict();
-        Ok(evictor)
+        Ok(Self { buffer, round: 0 })
     }
 
     /// The largest buffer, MB: far more than any last-level cache, little enough to write every tick.
@@ -435,7 +433,8 @@ mod tests {
         let mut evictor = Evictor::new(1).expect("1 MB");
         assert!(Evictor::new(0).is_err() && Evictor::new(Evictor::MAX_MB + 1).is_err(), "sizes out of range");
         assert_eq!(evictor.buffer.len(), 1 << 20);
-        for round in [2u8, 3] {
+        assert!(evictor.buffer.iter().all(|&b| b == 0), "zeroed, every page touched");
+        for round in [1u8, 2] {
             evictor.evict();
             let lines: Vec<u8> = evictor.buffer.iter().step_by(64).copied().collect();
             assert_eq!(lines.len(), (1 << 20) / 64);

@@ -107,7 +107,7 @@ pub(crate) enum Command {
         /// cache: without it a big run's bots evict the server's data between ticks and a small run's
         /// do not.
         #[arg(long, num_args = 0..=1, default_missing_value = "1024", value_name = "MB",
-              value_parser = clap::value_parser!(u32).range(1..=4096))]
+              value_parser = clap::value_parser!(u32).range(1..=i64::from(heist_server::load::Evictor::MAX_MB)))]
         cold_cache: Option<u32>,
     },
     /// Join a hosted session as a bot (restarted within a minute of losing its connection, it takes its
