@@ -21,9 +21,10 @@ pub use partitioning::{InnerSphereTree, Node};
 pub use pipeline::{CollisionConfig, CollisionHandle, CollisionThread, ContactReader, ObjectId, PoseWriter, WatcherId};
 pub use query::{
     Budget, CoherenceStats, CoherentOverlap, OverlapResult, ProbeHit, QueryWorkspace, Separation, overlap,
-    overlap_budgeted, overlap_field, overlap_field_budgeted, overlap_field_volume, overlap_volume, probe, separation,
+    overlap_budgeted, overlap_field, overlap_field_budgeted, overlap_field_volume, overlap_shell,
+    overlap_shell_budgeted, overlap_volume, probe, separation,
 };
-pub use shape::{SignedDistanceGrid, Sphere, TriMesh};
+pub use shape::{SignedDistanceGrid, Sphere, SurfaceShell, TriMesh};
 
 /// Types shared with the other haptic crates, re-exported for convenience.
 pub use haptic_common::{Contact, ContactSet, MAX_CONTACTS, Pose};

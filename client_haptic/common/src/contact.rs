@@ -95,6 +95,12 @@ impl ContactSet {
         &self.contacts[..self.len]
     }
 
+    /// The contacts held, to change in place (e.g. to scale their volumes).
+    #[inline]
+    pub fn as_mut_slice(&mut self) -> &mut [Contact] {
+        &mut self.contacts[..self.len]
+    }
+
     /// Number of contacts held.
     #[inline]
     pub fn len(&self) -> usize {

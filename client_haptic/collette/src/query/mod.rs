@@ -1,5 +1,5 @@
 //! Queries between trees (overlap volume, time-budgeted overlap, separation distance), between a tree
-//! and a signed distance grid (overlap volume), and probes.
+//! or a surface shell and a signed distance grid (overlap volume), and probes.
 //!
 //! You need this module to detect collisions. Every query takes the two objects' world poses (the
 //! relative pose `pos12` maps object 2's frame into object 1's), a caller-owned [`QueryWorkspace`]
@@ -10,12 +10,14 @@ pub mod distance;
 pub mod field;
 pub mod overlap;
 pub mod probe;
+pub mod shell;
 mod workspace;
 
 pub use distance::{Separation, separation};
 pub use field::{overlap_field, overlap_field_budgeted, overlap_field_volume};
 pub use overlap::{Budget, CoherenceStats, CoherentOverlap, OverlapResult, overlap, overlap_budgeted, overlap_volume};
 pub use probe::{ProbeHit, probe, spheres_near};
+pub use shell::{overlap_shell, overlap_shell_budgeted};
 pub use workspace::QueryWorkspace;
 
 pub use haptic_common::{Contact, ContactSet, Pose};

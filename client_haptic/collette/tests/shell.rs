@@ -1,0 +1,132 @@
+//! The tool's surface against an object's distance grid (`overlap_shell`): exact on flat faces.
+
+use collette::shape::{box_buffers, uv_sphere_buffers};
+use collette::{ContactSet, Pose, QueryWorkspace, SignedDistanceGrid, SurfaceShell, TriMesh};
+use glam::{Quat, Vec3};
+use std::f32::consts::PI;
+
+fn mesh((v, t): (Vec<Vec3>, Vec<[u32; 3]>)) -> TriMesh {
+    TriMesh::new(v, t).expect("mesh")
+}
+
+/// The force (Σ volume × normal) and the moment of the push (Σ point × volume × normal) of `set`.
+fn push(set: &ContactSet) -> (Vec3, Vec3) {
+    set.as_slice()
+        .iter()
+        .fold((Vec3::ZERO, Vec3::ZERO), |(f, m), c| (f + c.normal * c.volume, m + c.point.cross(c.normal * c.volume)))
+}
+
+/// A 10 cm slab, its top face at y = 0, and its grid.
+fn slab() -> (SignedDistanceGrid, Pose) {
+    let half = Vec3::new(0.05, 0.01, 0.05);
+    let grid = SignedDistanceGrid::new(&mesh(box_buffers(half)), 64).expect("grid");
+    (grid, Pose::from_translation(Vec3::new(0.0, -half.y, 0.0)))
+}
+
+#[test]
+fn a_cube_corner_pressed_into_a_face_measures_the_exact_tetrahedron() {
+    let (grid, slab_pose) = slab();
+    let h = 0.01;
+    let shell = SurfaceShell::new(&mesh(box_buffers(Vec3::splat(h))), 0.001).expect("shell");
+    let down = Quat::from_rotation_arc(Vec3::splat(-1.0).normalize(), -Vec3::Y);
+    let (mut ws, mut set) = (QueryWorkspace::new(), ContactSet::new());
+    for (depth, spin) in [(1e-4, 0.3), (5e-4, 1.0), (2e-3, 2.0), (6e-3, 4.0)] {
+        let corner = Vec3::new(0.004, -depth, -0.007);
+        let pose = Pose::new(corner + Vec3::Y * (h * 3f32.sqrt()), Quat::from_rotation_y(spin) * down);
+        let result = collette::overlap_shell(&shell, &pose, &grid, &slab_pose, &mut ws, &mut set);
+        let exact = 3f32.sqrt() / 2.0 * depth.powi(3);
+        let centroid = corner + Vec3::Y * (0.75 * depth);
+        assert!((result.total_volume / exact - 1.0).abs() < 1e-3, "{depth}: {} against {exact}", result.total_volume);
+        let (force, moment) = push(&set);
+        assert!((force.length() / exact - 1.0).abs() < 1e-3, "{depth}: push {force}");
+        assert!(force.normalize().angle_between(Vec3::Y).to_degrees() < 0.05, "{depth}: push {force}");
+        // The push acts through the overlap's centroid: its moment is centroid × force.
+        let off = (moment - centroid.cross(force)).length() / force.length();
+        assert!(off < 1e-5, "{depth}: the push acts {off} m off the centroid");
+    }
+}
+
+#[test]
+fn a_cylinder_lying_on_a_face_pushes_through_its_segment() {
+    let (grid, slab_pose) = slab();
+    let (r, half_len, sides) = (0.015f32, 0.03f32, 96u32);
+    let mut v = vec![Vec3::new(0.0, 0.0, -half_len), Vec3::new(0.0, 0.0, half_len)];
+    for i in 0..sides {
+        let a = i as f32 / sides as f32 * 2.0 * PI;
+        v.push(Vec3::new(r * a.cos(), r * a.sin(), -half_len));
+        v.push(Vec3::new(r * a.cos(), r * a.sin(), half_len));
+    }
+    let mut t = Vec::new();
+    for i in 0..sides {
+        let (b0, t0) = (2 + 2 * i, 3 + 2 * i);
+        let (b1, t1) = (2 + 2 * ((i + 1) % sides), 3 + 2 * ((i + 1) % sides));
+        t.extend([[0, b1, b0], [1, t0, t1], [b0, b1, t1], [b0, t1, t0]]);
+    }
+    let shell = SurfaceShell::new(&mesh((v, t)), 0.0005).expect("shell");
+    let (mut ws, mut set) = (QueryWorkspace::new(), ContactSet::new());
+    let depth = 0.002;
+    let c = Vec3::new(0.003, r - depth, 0.002);
+    let pose = Pose::new(c, Quat::from_rotation_y(0.7));
+    let result = collette::overlap_shell(&shell, &pose, &grid, &slab_pose, &mut ws, &mut set);
+    let (force, moment) = push(&set);
+    // The push acts on the vertical line through the axis's middle.
+    let arm = force.cross(moment) / force.length_squared();
+    assert!(!set.truncated && set.len() < 200, "{} contacts", set.len());
+    assert!(result.total_volume > 0.0 && (force.length() / result.total_volume - 1.0).abs() < 1e-3);
+    assert!(Vec3::new(arm.x - c.x, 0.0, arm.z - c.z).length() < 1e-4, "arm {arm}");
+}
+
+#[test]
+fn a_finely_split_sphere_pressed_into_a_face_measures_its_cap() {
+    let (grid, slab_pose) = slab();
+    let r = 0.01;
+    let shell = SurfaceShell::new(&mesh(uv_sphere_buffers(r, 96, 192)), 0.0005).expect("shell");
+    let (mut ws, mut set) = (QueryWorkspace::new(), ContactSet::new());
+    for depth in [2e-4, 1e-3, 4e-3] {
+        let c = Vec3::new(-0.002, r - depth, 0.005);
+        let result = collette::overlap_shell(
+            &shell,
+            &Pose::new(c, Quat::from_rotation_x(0.4)),
+            &grid,
+            &slab_pose,
+            &mut ws,
+            &mut set,
+        );
+        // The polygon's cap lies a little inside the sphere's (its facets sag by up to 3 µm).
+        let cap = PI * depth * depth * (3.0 * r - depth) / 3.0;
+        assert!((result.total_volume / cap - 1.0).abs() < 0.03, "{depth}: {} against {cap}", result.total_volume);
+        let (force, moment) = push(&set);
+        assert!(force.normalize().angle_between(Vec3::Y).to_degrees() < 0.05, "{depth}: {force}");
+        // A sphere's push passes through its centre's vertical.
+        let arm = force.cross(moment) / force.length_squared();
+        assert!(Vec3::new(arm.x - c.x, 0.0, arm.z - c.z).length() < 1e-5, "{depth}: arm {arm}");
+    }
+}
+
+#[test]
+fn a_shell_outside_the_object_measures_nothing_and_a_budget_stops_it() {
+    let (grid, slab_pose) = slab();
+    let shell = SurfaceShell::new(&mesh(box_buffers(Vec3::splat(0.01))), 0.001).expect("shell");
+    let (mut ws, mut set) = (QueryWorkspace::new(), ContactSet::new());
+    let above = Pose::from_translation(Vec3::new(0.0, 0.015, 0.0));
+    let result = collette::overlap_shell(&shell, &above, &grid, &slab_pose, &mut ws, &mut set);
+    assert_eq!((result.total_volume, set.len(), result.leaf_pairs), (0.0, 0, 0));
+    assert!(
+        result.node_pairs < 250,
+        "culled well above the leaves (of about 1,200 nodes): {} nodes",
+        result.node_pairs
+    );
+    let into = Pose::from_translation(Vec3::new(0.0, 0.008, 0.0));
+    let whole = collette::overlap_shell(&shell, &into, &grid, &slab_pose, &mut ws, &mut set);
+    assert!(whole.complete && (whole.total_volume / (0.02 * 0.02 * 0.002) - 1.0).abs() < 1e-3, "{whole:?}");
+    let cut = collette::overlap_shell_budgeted(
+        &shell,
+        &into,
+        &grid,
+        &slab_pose,
+        collette::Budget::NodePairs(20),
+        &mut ws,
+        &mut set,
+    );
+    assert!(!cut.complete && set.truncated && cut.node_pairs == 20, "{cut:?}");
+}
