@@ -118,6 +118,11 @@ impl Parts {
         safety.validate()?;
         let full = || RigError::QueueFull("collision");
         let tool_pose = collision.add_object(tool.tree, Pose::IDENTITY).ok_or_else(full)?;
+        if let Some(shell) = tool.shell
+            && !collision.set_shell(tool_pose.id(), Some(shell))
+        {
+            return Err(full());
+        }
         let proxy = config.rendering == Rendering::Proxy;
         // The tool against every object, in one buffer.
         let scene_input = match proxy {

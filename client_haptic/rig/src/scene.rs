@@ -266,7 +266,11 @@ impl Scene {
         if self.forces.slots() == 0 {
             return Err(RigError::QueueFull("haptic"));
         }
-        if !self.collision.set_tree(self.tool, tool.tree) {
+        // The tree and the shell (or none: an old tool's would be wrong) together.
+        if self.collision.free_commands() < 2 {
+            return Err(RigError::QueueFull("collision"));
+        }
+        if !self.collision.set_tree(self.tool, tool.tree) || !self.collision.set_shell(self.tool, tool.shell) {
             return Err(RigError::QueueFull("collision"));
         }
         let command = ForceCommand::SetTool { center_of_mass: tool.center_of_mass, material: tool.material };

@@ -29,7 +29,8 @@ fn a_steady_state_proxy_tick_neither_allocates_nor_frees() {
 #[test]
 fn a_steady_state_tick_pushing_an_object_neither_allocates_nor_frees() {
     // The slab is a 1 kg body the tool pushes: its haptic body moves, its pose goes to the collision
-    // stage and its impulses to the game's ring every tick.
+    // stage and its impulses to the game's ring every tick; the tool has its surface shell and the slab
+    // its grid, so the collision stage measures the tool's surface (`overlap_shell`).
     steady_state_ticks_do_not_allocate(presets::touch(), Rendering::Coupled, true);
     steady_state_ticks_do_not_allocate(presets::touch(), Rendering::Proxy, true);
 }
@@ -39,7 +40,13 @@ fn steady_state_ticks_do_not_allocate(specs: haptico::DeviceSpecs, rendering: Re
         SimConfig::new(specs),
         TargetPath::line(Vec3::new(0.0, 0.01, 0.0), Vec3::new(0.003, -0.003, 0.002), 2.0),
     );
-    let tool = ToolSpec::new(utils::ball_tool(), Material::default());
+    let mut tool = ToolSpec::new(utils::ball_tool(), Material::default());
+    if pushed {
+        // With the slab's grid below, the tool's surface is measured against it (`overlap_shell`).
+        let (v, t) = collette::shape::uv_sphere_buffers(0.005, 16, 24);
+        let mesh = collette::TriMesh::new(v, t).expect("ball");
+        tool = tool.with_shell(std::sync::Arc::new(collette::SurfaceShell::new(&mesh, 0.0005).expect("shell")));
+    }
     let config = RigConfig { rendering, ..RigConfig::default() };
     let mut rig = Lockstep::new(device, tool, &config, 1, None).expect("rig");
     let slab = ObjectSpec {

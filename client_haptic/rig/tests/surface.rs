@@ -3,7 +3,8 @@
 mod utils;
 
 use collette::shape::box_buffers;
-use collette::{SignedDistanceGrid, TriMesh};
+use collette::shape::uv_sphere_buffers;
+use collette::{SignedDistanceGrid, SurfaceShell, TriMesh};
 use glam::Vec3;
 use haptic_rig::lockstep::Lockstep;
 use haptic_rig::{RigConfig, RigError, ToolSpec};
@@ -65,4 +66,47 @@ fn an_object_not_watched_has_no_surface_to_set() {
     let mut rig = Lockstep::new(device, tool, &RigConfig::default(), 1, None).expect("rig");
     let error = rig.set_surface(7, None).expect_err("no object 7");
     assert!(matches!(error, RigError::UnknownObject(7)) && error.to_string().contains('7'), "{error}");
+}
+
+/// The ball tool (with its surface shell from `shell_from` to `shell_until`) held 2 mm into the slab,
+/// measured by the slab's surface grid; the force at each tick.
+fn press_with_shell(shell_from: u64, shell_until: u64) -> Vec<Vec3> {
+    let (v, t) = box_buffers(Vec3::new(0.05, 0.01, 0.05));
+    let grid = Arc::new(SignedDistanceGrid::new(&TriMesh::new(v, t).expect("box"), 60).expect("grid"));
+    let (v, t) = uv_sphere_buffers(0.005, 16, 24);
+    let shell = Arc::new(SurfaceShell::new(&TriMesh::new(v, t).expect("ball"), 0.0005).expect("shell"));
+    let device = SimDevice::new(
+        SimConfig::new(presets::touch()),
+        TargetPath::line(Vec3::new(0.0, 0.003, 0.0), Vec3::new(0.0, 0.003, 0.0), 1.0),
+    );
+    let spheres = ToolSpec::new(utils::ball_tool(), forcecomp::Material::default());
+    let mut rig = Lockstep::new(device, spheres.clone(), &RigConfig::default(), 1, None).expect("rig");
+    rig.add_object(utils::slab_object(1)).expect("object");
+    rig.set_surface(1, Some(grid)).expect("surface set");
+    (0..500)
+        .map(|i| {
+            if i == shell_from {
+                rig.set_tool(spheres.clone().with_shell(shell.clone())).expect("tool with its shell");
+            }
+            if i == shell_until {
+                rig.set_tool(spheres.clone()).expect("tool without");
+            }
+            rig.tick(i * 1000).force
+        })
+        .collect()
+}
+
+#[test]
+fn a_tool_with_its_surface_shell_is_measured_by_its_surface_until_it_is_replaced_by_one_without() {
+    let spheres = press_with_shell(u64::MAX, u64::MAX);
+    let shell = press_with_shell(0, u64::MAX);
+    let both = press_with_shell(0, 250);
+    let f = shell[499];
+    assert!(f.y > 0.0 && spheres[499].y > 0.0, "pushed up: {f} / {}", spheres[499]);
+    // The shell's columns all stand on the flat face: straight up.
+    assert!(f.x.abs().max(f.z.abs()) < 1e-3 * f.y, "straight up from the face: {f}");
+    assert_ne!(f, spheres[499], "the surface measures another volume than the spheres");
+    assert_eq!(&both[..250], &shell[..250], "the same as with the shell while it is set");
+    let back = both[499];
+    assert!((back - spheres[499]).length() <= 0.05 * spheres[499].length(), "the spheres' again: {back}");
 }

@@ -13,7 +13,7 @@ use super::world::{
 };
 use crate::bounding_volume::Aabb;
 use crate::partitioning::InnerSphereTree;
-use crate::shape::SignedDistanceGrid;
+use crate::shape::{SignedDistanceGrid, SurfaceShell};
 use haptic_common::{ContactSet, Delegator, OnCollision, Pose};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -305,6 +305,15 @@ impl CollisionHandle {
     pub fn set_surface(&mut self, id: ObjectId, surface: Option<Arc<SignedDistanceGrid>>) -> bool {
         self.collect_retired();
         self.commands.push(Command::SetSurface(id, surface)).is_ok()
+    }
+
+    /// Gives object `id` its surface shell, split from the mesh its tree was built from (`None` takes it
+    /// away): from the next step, pairs watching it as A against a B with a surface grid measure A's
+    /// surface against B's (`overlap_shell_budgeted`: exact on flat faces at any depth, see
+    /// docs/collette.md). False when the command ring is full.
+    pub fn set_shell(&mut self, id: ObjectId, shell: Option<Arc<SurfaceShell>>) -> bool {
+        self.collect_retired();
+        self.commands.push(Command::SetShell(id, shell)).is_ok()
     }
 
     /// Removes an object (its watchers then publish empty sets). False when the command ring is full.

@@ -7,8 +7,10 @@ use super::scene::{PairSummary, SceneContacts};
 use super::track::PoseTrack;
 use crate::bounding_volume::Aabb;
 use crate::partitioning::InnerSphereTree;
-use crate::query::{Budget, QueryWorkspace, overlap_budgeted, overlap_field_budgeted, spheres_near};
-use crate::shape::SignedDistanceGrid;
+use crate::query::{
+    Budget, QueryWorkspace, overlap_budgeted, overlap_field_budgeted, overlap_shell_budgeted, spheres_near,
+};
+use crate::shape::{SignedDistanceGrid, SurfaceShell};
 use glam::Vec3;
 use haptic_common::{ContactSet, Delegator, OnCollision, Pose};
 use std::sync::Arc;
@@ -209,6 +211,9 @@ pub enum Command {
     /// Gives the object in slot `id` a distance grid of its surface (`None`: takes it away): pairs that
     /// watch it as B then measure A's spheres against its surface (`overlap_field_budgeted`).
     SetSurface(ObjectId, Option<Arc<SignedDistanceGrid>>),
+    /// Gives the object in slot `id` its surface shell (`None`: takes it away): pairs that watch it as A
+    /// against a B with a surface grid then measure A's surface against B's (`overlap_shell_budgeted`).
+    SetShell(ObjectId, Option<Arc<SurfaceShell>>),
     /// Empties slot `id`.
     RemoveObject(ObjectId),
     /// Watches the pair (A, B) in slot `id` (for a scene output: A against every other object),
@@ -230,6 +235,8 @@ pub enum Retired {
     Tree(Arc<InnerSphereTree>),
     /// A replaced or taken surface grid.
     Surface(Arc<SignedDistanceGrid>),
+    /// A replaced or taken surface shell (or a removed object's).
+    Shell(Arc<SurfaceShell>),
     /// A removed watcher.
     Watcher(WatcherOutput),
 }
@@ -253,6 +260,7 @@ struct ObjectSlot {
     tree: Arc<InnerSphereTree>,
     pose: triple_buffer::Output<ObjectPose>,
     surface: Option<Arc<SignedDistanceGrid>>,
+    shell: Option<Arc<SurfaceShell>>,
     /// The pose this step uses (read from `pose` at the step's time).
     now: TimedPose,
     /// A sphere holding the object in its own frame (see [`ObjectSlot::local_sphere`]), and where the
@@ -267,6 +275,7 @@ impl ObjectSlot {
             tree,
             pose,
             surface: None,
+            shell: None,
             now: TimedPose::default(),
             local: (Vec3::ZERO, 0.0),
             world: (Vec3::ZERO, 0.0),
@@ -276,11 +285,13 @@ impl ObjectSlot {
     }
 
     /// A sphere holding the object in its frame: its tree's root bound, or with a surface grid the
-    /// grid's box (the mesh's surface lies a little outside the inner spheres).
+    /// grid's box, or with a shell its surface's bound (the mesh's surface lies a little outside the
+    /// inner spheres).
     fn local_sphere(&self) -> (Vec3, f32) {
-        match &self.surface {
-            Some(grid) => (grid.bounds().center(), grid.bounds().extents().length() * 0.5),
-            None => (self.tree.root().bound.center, self.tree.root().bound.radius),
+        match (&self.surface, &self.shell) {
+            (Some(grid), _) => (grid.bounds().center(), grid.bounds().extents().length() * 0.5),
+            (None, Some(shell)) => shell.bound(),
+            (None, None) => (self.tree.root().bound.center, self.tree.root().bound.radius),
         }
     }
 
@@ -297,6 +308,14 @@ impl ObjectSlot {
             }
         }
         self.world = (self.now.pose.transform_point(self.local.0), self.local.1);
+    }
+
+    /// Hands everything the slot holds to `retire`.
+    fn retire(self, retire: &mut dyn FnMut(Retired)) {
+        if let Some(shell) = self.shell {
+            retire(Retired::Shell(shell));
+        }
+        retire(Retired::Object(self.tree, self.pose, self.surface));
     }
 
     /// The world sphere holding the object on this step.
@@ -380,7 +399,7 @@ impl CollisionWorld {
             Command::AddObject(id, tree, pose) => {
                 if let Some(slot) = self.objects.get_mut(id.0 as usize) {
                     if let Some(old) = slot.replace(ObjectSlot::new(tree, pose)) {
-                        retire(Retired::Object(old.tree, old.pose, old.surface));
+                        old.retire(retire);
                     }
                 } else {
                     retire(Retired::Object(tree, pose, None));
@@ -406,9 +425,22 @@ impl CollisionWorld {
                     }
                 }
             },
+            Command::SetShell(id, shell) => match self.objects.get_mut(id.0 as usize).and_then(Option::as_mut) {
+                Some(slot) => {
+                    if let Some(old) = std::mem::replace(&mut slot.shell, shell) {
+                        retire(Retired::Shell(old));
+                    }
+                    slot.local = slot.local_sphere();
+                }
+                None => {
+                    if let Some(shell) = shell {
+                        retire(Retired::Shell(shell));
+                    }
+                }
+            },
             Command::RemoveObject(id) => {
                 if let Some(old) = self.objects.get_mut(id.0 as usize).and_then(Option::take) {
-                    retire(Retired::Object(old.tree, old.pose, old.surface));
+                    old.retire(retire);
                 }
             }
             Command::AddWatcher(id, a, b, out) => {
@@ -633,13 +665,14 @@ fn scene_candidates(
     }
 }
 
-/// A's spheres against B's tree, or against B's surface grid when it has one, into `set`; false when
-/// the budget cut the query short.
+/// A's spheres against B's tree, or against B's surface grid when it has one (A's surface when A has
+/// a shell), into `set`; false when the budget cut the query short.
 fn measure(a: &ObjectSlot, b: &ObjectSlot, budget: Budget, ws: &mut QueryWorkspace, set: &mut ContactSet) -> bool {
     let (pa, pb) = (&a.now.pose, &b.now.pose);
-    let result = match b.surface.as_deref() {
-        Some(grid) => overlap_field_budgeted(&a.tree, pa, &b.tree, grid, pb, budget, ws, set),
-        None => overlap_budgeted(&a.tree, pa, &b.tree, pb, budget, ws, set),
+    let result = match (b.surface.as_deref(), a.shell.as_deref()) {
+        (Some(grid), Some(shell)) => overlap_shell_budgeted(shell, pa, grid, pb, budget, ws, set),
+        (Some(grid), None) => overlap_field_budgeted(&a.tree, pa, &b.tree, grid, pb, budget, ws, set),
+        (None, _) => overlap_budgeted(&a.tree, pa, &b.tree, pb, budget, ws, set),
     };
     result.complete
 }
