@@ -6,7 +6,8 @@
 //! Volumetric rendering (Eq. 1 and 2 with ε_c = 1, no damping or friction: the force is the overlap
 //! volume along the contact normals) is judged against the penalty the exact overlap gives: the exact
 //! volume along the exact normal, its torque about a handle point off the tool from the exact overlap's
-//! centroid. Two trees (the tool's against the object's) and the tree against the object's surface grid.
+//! centroid. Two trees (the tool's against the object's), the tree against the object's surface grid, and
+//! the tool's surface (its shell) against the grid.
 //! The 3-DOF proxy is judged by where it holds the tip: its contact point against the exact closest
 //! point of the surface, held on the object's packing or on its surface grid. Scenes: a sphere, a box's edge, a box's corner and a cylinder on its side
 //! pressed into a slab, a sphere into a sphere; the proxy's tip into the slab, the sphere and the box
@@ -21,7 +22,7 @@ use std::sync::Arc;
 
 use clap::Parser;
 use collette::shape::{box_buffers, uv_sphere_buffers};
-use collette::{BuildOptions, ContactSet, InnerSphereTree, QueryWorkspace, SignedDistanceGrid, TriMesh};
+use collette::{BuildOptions, ContactSet, InnerSphereTree, QueryWorkspace, SignedDistanceGrid, SurfaceShell, TriMesh};
 use forcecomp::{Ball, BodyMotion, GodObject, Material, ProxyConfig};
 use glam::{Quat, Vec3};
 use haptic_common::Pose;
@@ -46,6 +47,9 @@ struct Args {
     /// Monte Carlo points per mesh pose, in the box the overlap can occupy.
     #[arg(long, default_value_t = 1_000_000)]
     samples: usize,
+    /// Longest edge of the tools' surface shells, mm.
+    #[arg(long, default_value_t = 0.5)]
+    shell_edge_mm: f32,
     /// Seed of the poses.
     #[arg(long, default_value_t = 1)]
     seed: u32,
@@ -65,20 +69,22 @@ fn main() -> std::process::ExitCode {
     }
 }
 
-/// A shape's mesh, tree and surface grid.
+/// A shape's tree, surface grid and (a tool's) surface shell.
 struct Shape {
     tree: Arc<InnerSphereTree>,
     grid: SignedDistanceGrid,
+    shell: Option<SurfaceShell>,
 }
 
-fn shape(buffers: (Vec<Vec3>, Vec<[u32; 3]>), args: &Args) -> anyhow::Result<Shape> {
-    shape_of(&TriMesh::new(buffers.0, buffers.1)?, args)
+fn shape(buffers: (Vec<Vec3>, Vec<[u32; 3]>), tool: bool, args: &Args) -> anyhow::Result<Shape> {
+    shape_of(&TriMesh::new(buffers.0, buffers.1)?, tool, args)
 }
 
-fn shape_of(mesh: &TriMesh, args: &Args) -> anyhow::Result<Shape> {
+fn shape_of(mesh: &TriMesh, tool: bool, args: &Args) -> anyhow::Result<Shape> {
     let (tree, _) = collette::build(mesh, &BuildOptions::spheres(args.spheres), &mut |_| {})?;
     let grid = SignedDistanceGrid::new(mesh, args.grid)?;
-    Ok(Shape { tree: Arc::new(tree), grid })
+    let shell = tool.then(|| SurfaceShell::new(mesh, args.shell_edge_mm * 1e-3)).transpose()?;
+    Ok(Shape { tree: Arc::new(tree), grid, shell })
 }
 
 /// A closed cylinder along z: radius `r`, half length `h`, `n` sides.
@@ -205,6 +211,8 @@ struct Errors {
     magnitude_pct: Vec<f32>,
     torque_deg: Vec<f32>,
     contact_mm: Vec<f32>,
+    /// How long each volumetric query took, µs.
+    query_us: Vec<f32>,
 }
 
 impl Errors {
@@ -219,6 +227,7 @@ impl Errors {
             magnitude_pct: pick(&self.magnitude_pct),
             torque_deg: pick(&self.torque_deg),
             contact_mm: Vec::new(),
+            query_us: pick(&self.query_us),
         }
     }
 
@@ -228,6 +237,7 @@ impl Errors {
         self.magnitude_pct.extend(other.magnitude_pct);
         self.torque_deg.extend(other.torque_deg);
         self.contact_mm.extend(other.contact_mm);
+        self.query_us.extend(other.query_us);
     }
 }
 
@@ -264,19 +274,51 @@ fn volumetric(
     poses: usize,
     dice: &mut Dice,
     place: impl Fn(f32, &mut Dice) -> (Pose, Exact),
-) -> (Errors, Errors) {
-    let (mut trees, mut grid) = (Errors::default(), Errors::default());
+) -> [Errors; 3] {
+    let mut errors: [Errors; 3] = Default::default();
     let (mut ws, mut set) = (QueryWorkspace::new(), ContactSet::new());
     for _ in 0..poses {
         let depth = dice.depth();
         let (pose, exact) = place(depth, dice);
-        collette::overlap(&tool.tree, &pose, &object.tree, object_pose, &mut ws, &mut set);
-        judge(&set, &pose, &exact, depth, &mut trees);
-        collette::overlap_field(&tool.tree, &pose, &object.tree, &object.grid, object_pose, &mut ws, &mut set);
-        judge(&set, &pose, &exact, depth, &mut grid);
+        measure_all(tool, object, &pose, object_pose, &mut ws, &mut set, |set, i, us| {
+            judge(set, &pose, &exact, depth, &mut errors[i]);
+            errors[i].query_us.push(us);
+        });
     }
-    (trees, grid)
+    errors
 }
+
+/// The volumetric renderings, in the order of [`VOLUMETRIC`]: each measured into `set`, then handed to
+/// `judge` with its index and how long the query took (µs).
+fn measure_all(
+    tool: &Shape,
+    object: &Shape,
+    pose: &Pose,
+    object_pose: &Pose,
+    ws: &mut QueryWorkspace,
+    set: &mut ContactSet,
+    mut judge: impl FnMut(&ContactSet, usize, f32),
+) {
+    let us = |started: std::time::Instant| started.elapsed().as_secs_f32() * 1e6;
+    let started = std::time::Instant::now();
+    collette::overlap(&tool.tree, pose, &object.tree, object_pose, ws, set);
+    judge(set, 0, us(started));
+    let started = std::time::Instant::now();
+    collette::overlap_field(&tool.tree, pose, &object.tree, &object.grid, object_pose, ws, set);
+    judge(set, 1, us(started));
+    if let Some(shell) = &tool.shell {
+        let started = std::time::Instant::now();
+        collette::overlap_shell(shell, pose, &object.grid, object_pose, ws, set);
+        judge(set, 2, us(started));
+    }
+}
+
+/// The volumetric renderings: the table's name, the summary's name and the JSON's.
+const VOLUMETRIC: [(&str, &str, &str); 3] = [
+    ("volumetric, two trees", "two trees", "volumetric_trees"),
+    ("volumetric, tree against grid", "tree against grid", "volumetric_grid"),
+    ("volumetric, surface against grid", "surface against grid", "volumetric_surface"),
+];
 
 /// The 3-DOF proxy's tip (radius 4 mm, as the rig's default) pressed from `outside` to `inside`, held
 /// on the object's packing or (`on_grid`) its surface grid; its contact point (the proxy less its
@@ -325,11 +367,11 @@ fn run(args: Args) -> anyhow::Result<()> {
     anyhow::ensure!(args.poses > 0, "--poses must be at least 1");
     anyhow::ensure!(args.samples >= 1000, "--samples must be at least 1000");
     let started = std::time::Instant::now();
-    let sphere = shape(uv_sphere_buffers(SPHERE_R, 48, 96), &args)?;
-    let ball = shape(uv_sphere_buffers(BALL_R, 48, 96), &args)?;
-    let cube = shape(box_buffers(Vec3::splat(CUBE_HALF)), &args)?;
-    let cylinder = shape(cylinder_buffers(CYL_R, CYL_HALF, 96), &args)?;
-    let slab = shape(box_buffers(SLAB_HALF), &args)?;
+    let sphere = shape(uv_sphere_buffers(SPHERE_R, 192, 384), true, &args)?;
+    let ball = shape(uv_sphere_buffers(BALL_R, 192, 384), false, &args)?;
+    let cube = shape(box_buffers(Vec3::splat(CUBE_HALF)), true, &args)?;
+    let cylinder = shape(cylinder_buffers(CYL_R, CYL_HALF, 384), true, &args)?;
+    let slab = shape(box_buffers(SLAB_HALF), false, &args)?;
     eprintln!("fidelity: trees and grids built in {:.1} s", started.elapsed().as_secs_f32());
     let slab_pose = Pose::from_translation(Vec3::new(0.0, -SLAB_HALF.y, 0.0));
     let mut dice = Dice(ChaCha8Rng::seed_from_u64(args.seed as u64));
@@ -344,9 +386,9 @@ fn run(args: Args) -> anyhow::Result<()> {
         ("box corner on plane", &cube, &slab, slab_pose),
         ("cylinder on its side", &cylinder, &slab, slab_pose),
     ];
-    let (mut all_trees, mut all_grid) = (Errors::default(), Errors::default());
+    let mut all: [Errors; 3] = Default::default();
     for (i, (name, tool, object, object_pose)) in scenes.into_iter().enumerate() {
-        let (trees, grid) = volumetric(tool, object, &object_pose, args.poses, &mut dice, |d, dice| match i {
+        let errors = volumetric(tool, object, &object_pose, args.poses, &mut dice, |d, dice| match i {
             0 => {
                 let c = spot(dice) + Vec3::Y * (SPHERE_R - d);
                 (Pose::new(c, spin(dice)), sphere_on_plane(SPHERE_R, c, d))
@@ -376,10 +418,10 @@ fn run(args: Args) -> anyhow::Result<()> {
                 (Pose::new(c, spin(dice)), cylinder_on_plane(CYL_R, 2.0 * CYL_HALF, c, d))
             }
         });
-        table.push((name.to_string(), "volumetric, two trees", quantiles(&trees)));
-        table.push((name.to_string(), "volumetric, tree against grid", quantiles(&grid)));
-        all_trees.add(trees);
-        all_grid.add(grid);
+        for ((rendering, _, _), (errors, all)) in VOLUMETRIC.iter().zip(errors.into_iter().zip(&mut all)) {
+            table.push((name.to_string(), *rendering, quantiles(&errors)));
+            all.add(errors);
+        }
     }
 
     // Mesh pairs against the Monte Carlo reference: depths 1–10 mm (shallower overlaps of a pointed
@@ -392,20 +434,20 @@ fn run(args: Args) -> anyhow::Result<()> {
     let closed = |(v, t): (Vec<Vec3>, Vec<[u32; 3]>)| TriMesh::new(v, t);
     let torus_mesh = closed(collette::shape::torus_buffers(0.03, 0.01, 96, 48))?;
     let ring_mesh = closed(collette::shape::torus_buffers(0.01, 0.004, 64, 32))?;
-    let mut mesh_shape = |mesh: TriMesh, voxels: usize| -> anyhow::Result<meshes::MeshShape> {
-        let shape = shape_of(&mesh, &args)?;
+    let mut mesh_shape = |mesh: TriMesh, voxels: usize, tool: bool| -> anyhow::Result<meshes::MeshShape> {
+        let shape = shape_of(&mesh, tool, &args)?;
         Ok(meshes::MeshShape::new(mesh, shape, voxels, surface_samples, &mut mesh_dice))
     };
-    let gem = mesh_shape(gem_mesh, 128)?;
-    let ring = mesh_shape(ring_mesh, 128)?;
-    let bunny = mesh_shape(bunny_mesh, 256)?;
-    let torus = mesh_shape(torus_mesh, 256)?;
+    let gem = mesh_shape(gem_mesh, 128, true)?;
+    let ring = mesh_shape(ring_mesh, 128, true)?;
+    let bunny = mesh_shape(bunny_mesh, 256, false)?;
+    let torus = mesh_shape(torus_mesh, 256, false)?;
     eprintln!("fidelity: mesh scenes built in {:.1} s", mesh_started.elapsed().as_secs_f32());
     let mesh_scenes: [(&str, &meshes::MeshShape, &meshes::MeshShape); 3] =
         [("gem on bunny", &gem, &bunny), ("gem on torus", &gem, &torus), ("ring on bunny", &ring, &bunny)];
     let mut skipped = 0;
     for (name, tool, object) in mesh_scenes {
-        let (mut trees, mut grid) = (Errors::default(), Errors::default());
+        let mut errors: [Errors; 3] = Default::default();
         let (mut ws, mut set) = (QueryWorkspace::new(), ContactSet::new());
         let mut kept = 0;
         while kept < args.mesh_poses && kept + skipped < 20 * args.mesh_poses {
@@ -420,25 +462,16 @@ fn run(args: Args) -> anyhow::Result<()> {
                 skipped += 1;
                 continue;
             };
-            let here = Pose::IDENTITY;
-            collette::overlap(&tool.shape.tree, &pose, &object.shape.tree, &here, &mut ws, &mut set);
-            judge(&set, &pose, &exact, depth, &mut trees);
-            collette::overlap_field(
-                &tool.shape.tree,
-                &pose,
-                &object.shape.tree,
-                &object.shape.grid,
-                &here,
-                &mut ws,
-                &mut set,
-            );
-            judge(&set, &pose, &exact, depth, &mut grid);
+            measure_all(&tool.shape, &object.shape, &pose, &Pose::IDENTITY, &mut ws, &mut set, |set, i, us| {
+                judge(set, &pose, &exact, depth, &mut errors[i]);
+                errors[i].query_us.push(us);
+            });
             kept += 1;
         }
-        table.push((name.to_string(), "volumetric, two trees", quantiles(&trees)));
-        table.push((name.to_string(), "volumetric, tree against grid", quantiles(&grid)));
-        all_trees.add(trees);
-        all_grid.add(grid);
+        for ((rendering, _, _), (errors, all)) in VOLUMETRIC.iter().zip(errors.into_iter().zip(&mut all)) {
+            table.push((name.to_string(), *rendering, quantiles(&errors)));
+            all.add(errors);
+        }
     }
     eprintln!(
         "fidelity: mesh scenes judged in {:.1} s ({skipped} poses skipped: no overlap, one out of reach, or the \
@@ -493,13 +526,14 @@ fn run(args: Args) -> anyhow::Result<()> {
     }
     println!();
     println!(
-        "| rendering, all volumetric scenes | depth | direction p50 / p99 | magnitude p50 / p99 | torque direction p50 / p99 |"
+        "| rendering, all volumetric scenes | depth | direction p50 / p99 | magnitude p50 / p99 | torque direction p50 / p99 | query p50 / p99 |"
     );
-    println!("| --- | --- | --- | --- | --- |");
-    for (rendering, e) in [("two trees", &all_trees), ("tree against grid", &all_grid)] {
+    println!("| --- | --- | --- | --- | --- | --- |");
+    for ((_, rendering, _), e) in VOLUMETRIC.iter().zip(&all) {
         for (band, low, high) in [("0.1–1 mm", 0.0, 0.001), ("1–5 mm", 0.001, 0.005), ("5–10 mm", 0.005, 1.0)] {
             let q = quantiles(&e.band(low, high));
-            println!("| {rendering} | {band} | {} | {} | {} |", q[0], q[1], q[2]);
+            let time = quantiles_of(&e.band(low, high).query_us, "µs", 1);
+            println!("| {rendering} | {band} | {} | {} | {} | {time} |", q[0], q[1], q[2]);
         }
     }
     println!(
@@ -513,12 +547,8 @@ fn run(args: Args) -> anyhow::Result<()> {
         started.elapsed().as_secs_f32()
     );
     if args.json {
-        for (rendering, e) in [
-            ("volumetric_trees", &all_trees),
-            ("volumetric_grid", &all_grid),
-            ("proxy", &proxy_errors),
-            ("proxy_grid", &proxy_grid_errors),
-        ] {
+        let volumetric = VOLUMETRIC.iter().zip(&all).map(|((_, _, json), e)| (*json, e));
+        for (rendering, e) in volumetric.chain([("proxy", &proxy_errors), ("proxy_grid", &proxy_grid_errors)]) {
             let volumetric = rendering.starts_with("volumetric");
             let line = serde_json::json!({
                 "rendering": rendering,
@@ -527,6 +557,7 @@ fn run(args: Args) -> anyhow::Result<()> {
                 "magnitude_p99_pct": volumetric.then(|| quantile(&e.magnitude_pct, 0.99)),
                 "torque_direction_p99_deg": volumetric.then(|| quantile(&e.torque_deg, 0.99)),
                 "contact_p99_mm": (!volumetric).then(|| quantile(&e.contact_mm, 0.99)),
+                "query_p50_us": volumetric.then(|| quantile(&e.query_us, 0.5)),
             });
             println!("{line}");
         }
@@ -534,16 +565,19 @@ fn run(args: Args) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// One cell: p50 / p99 of `v` ("–" when empty).
+fn quantiles_of(v: &[f32], unit: &str, digits: usize) -> String {
+    if v.is_empty() {
+        "–".to_string()
+    } else {
+        format!("{:.digits$} / {:.digits$} {unit}", quantile(v, 0.5), quantile(v, 0.99))
+    }
+}
+
 /// The table's cells for one rendering of one scene: p50 / p99 of each error ("–" where it does not
 /// apply).
 fn quantiles(e: &Errors) -> [String; 4] {
-    let cell = |v: &[f32], unit: &str, digits: usize| {
-        if v.is_empty() {
-            "–".to_string()
-        } else {
-            format!("{:.digits$} / {:.digits$} {unit}", quantile(v, 0.5), quantile(v, 0.99))
-        }
-    };
+    let cell = quantiles_of;
     [
         cell(&e.direction_deg, "°", 2),
         cell(&e.magnitude_pct, "%", 1),

@@ -197,7 +197,7 @@ mod tests {
         let mesh = TriMesh::new(buffers.0, buffers.1).expect("mesh");
         let (tree, _) = collette::build(&mesh, &collette::BuildOptions::spheres(100), &mut |_| {}).expect("tree");
         let grid = collette::SignedDistanceGrid::new(&mesh, 16).expect("grid");
-        let shape = Shape { tree: std::sync::Arc::new(tree), grid };
+        let shape = Shape { tree: std::sync::Arc::new(tree), grid, shell: None };
         MeshShape::new(mesh, shape, 32, 100_000, dice)
     }
 
