@@ -67,7 +67,7 @@ pub fn add_haptics(app: &mut App, settings: &HapticsSettings) -> Result<(), Clie
             pushes: setup.config.pushes,
         }),
     );
-    let gem = SphereTree { tree: setup.tool.tree.clone(), surface: None };
+    let gem = SphereTree { tree: setup.tool.tree.clone(), surface: None, shell: None };
     let gem = app.world_mut().resource_mut::<Assets<SphereTree>>().add(gem);
     app.world_mut().spawn((Name::new("stylus gemstone"), HapticTool::new(gem), ForceComponent::rigid_tool()));
     app.insert_resource(Bench::new(&setup, settings))

@@ -371,8 +371,12 @@ pub(crate) fn sync_tool(
     if watched.tool == Some(key) {
         return;
     }
-    let tree = tree.map_or_else(|| SphereTree::ball(tool.tip_radius_m).tree, |(_, t)| t.tree.clone());
-    let spec = ToolSpec::new(tree, key.material.map_or_else(rigid_tool, |m| m.material()));
+    let (tree, shell) = tree
+        .map_or_else(|| (SphereTree::ball(tool.tip_radius_m).tree, None), |(_, t)| (t.tree.clone(), t.shell.clone()));
+    let mut spec = ToolSpec::new(tree, key.material.map_or_else(rigid_tool, |m| m.material()));
+    if let Some(shell) = shell {
+        spec = spec.with_shell(shell);
+    }
     match runtime.rig(|rig| rig.set_tool(spec)) {
         Some(Err(e)) => warn!("the tool's tree waits: {e}"),
         _ => watched.tool = Some(key),

@@ -16,6 +16,11 @@ use glam::Vec3;
 pub struct SurfaceShell {
     /// Corners of the triangles, counter-clockwise seen from outside, in the leaves' order.
     triangles: Vec<[Vec3; 3]>,
+    /// Each triangle's corners as indices into its leaf's corners (`leaf_corners`), so a query reads the
+    /// object's distance once at a corner its leaf's triangles share.
+    corner_of: Vec<[u8; 3]>,
+    /// The distinct corners of each leaf's triangles, leaf after leaf.
+    leaf_corners: Vec<Vec3>,
     nodes: Vec<ShellNode>,
     max_edge: f32,
 }
@@ -29,6 +34,9 @@ pub(crate) struct ShellNode {
     pub(crate) first: u32,
     /// Triangles of a leaf; 0 for an inner node.
     pub(crate) count: u32,
+    /// A leaf's distinct corners: `corners .. corners + corner_count` in `leaf_corners`.
+    pub(crate) corners: u32,
+    pub(crate) corner_count: u32,
 }
 
 impl SurfaceShell {
@@ -36,6 +44,8 @@ impl SurfaceShell {
     pub const MAX_TRIANGLES: usize = 4_000_000;
     /// Most triangles in one leaf of the tree.
     const LEAF: usize = 8;
+    /// Most distinct corners a leaf can have.
+    pub(crate) const LEAF_CORNERS: usize = 3 * Self::LEAF;
 
     /// Splits `mesh`'s triangles (each at the middle of its longest edge, again and again) until no
     /// edge is longer than `max_edge` (m; about the touched objects' grid voxel: 1 mm for a 10 cm
@@ -92,7 +102,7 @@ impl SurfaceShell {
             return Err(BuildError::InvalidOption("the mesh has no triangle with an area to make a shell of".into()));
         }
         let mut nodes = Vec::with_capacity(2 * triangles.len() / Self::LEAF + 2);
-        nodes.push(ShellNode { center: Vec3::ZERO, radius: 0.0, first: 0, count: 0 });
+        nodes.push(ShellNode { center: Vec3::ZERO, radius: 0.0, first: 0, count: 0, corners: 0, corner_count: 0 });
         let mut pending = vec![(0usize, 0usize, triangles.len())];
         while let Some((node, start, end)) = pending.pop() {
             let part = &mut triangles[start..end];
@@ -101,7 +111,14 @@ impl SurfaceShell {
             let center = (low + high) * 0.5;
             let radius = part.iter().flatten().map(|p| p.distance(center)).fold(0.0f32, f32::max);
             if part.len() <= Self::LEAF {
-                nodes[node] = ShellNode { center, radius, first: start as u32, count: part.len() as u32 };
+                nodes[node] = ShellNode {
+                    center,
+                    radius,
+                    first: start as u32,
+                    count: part.len() as u32,
+                    corners: 0,
+                    corner_count: 0,
+                };
                 continue;
             }
             // Halve along the longest side of the centroids' box.
@@ -121,13 +138,31 @@ impl SurfaceShell {
             let half = part.len() / 2;
             part.select_nth_unstable_by(half, |p, q| centroid(p)[axis].total_cmp(&centroid(q)[axis]));
             let first = nodes.len();
-            nodes.push(ShellNode { center: Vec3::ZERO, radius: 0.0, first: 0, count: 0 });
-            nodes.push(ShellNode { center: Vec3::ZERO, radius: 0.0, first: 0, count: 0 });
-            nodes[node] = ShellNode { center, radius, first: first as u32, count: 0 };
+            nodes.push(ShellNode { center: Vec3::ZERO, radius: 0.0, first: 0, count: 0, corners: 0, corner_count: 0 });
+            nodes.push(ShellNode { center: Vec3::ZERO, radius: 0.0, first: 0, count: 0, corners: 0, corner_count: 0 });
+            nodes[node] = ShellNode { center, radius, first: first as u32, count: 0, corners: 0, corner_count: 0 };
             pending.push((first, start, start + half));
             pending.push((first + 1, start + half, end));
         }
-        Ok(Self { triangles, nodes, max_edge })
+        // Each leaf's distinct corners (a split edge's middle is the same float from either side).
+        let (mut corner_of, mut leaf_corners) = (vec![[0u8; 3]; triangles.len()], Vec::new());
+        for node in nodes.iter_mut().filter(|n| n.count > 0) {
+            let start = leaf_corners.len();
+            for t in node.first as usize..(node.first + node.count) as usize {
+                for (k, corner) in triangles[t].iter().enumerate() {
+                    let local = match leaf_corners[start..].iter().position(|c| c == corner) {
+                        Some(i) => i,
+                        None => {
+                            leaf_corners.push(*corner);
+                            leaf_corners.len() - 1 - start
+                        }
+                    };
+                    corner_of[t][k] = local as u8;
+                }
+            }
+            (node.corners, node.corner_count) = (start as u32, (leaf_corners.len() - start) as u32);
+        }
+        Ok(Self { triangles, corner_of, leaf_corners, nodes, max_edge })
     }
 
     /// The triangles after splitting, counter-clockwise seen from outside.
@@ -152,11 +187,19 @@ impl SurfaceShell {
 
     /// Heap bytes held.
     pub fn memory_bytes(&self) -> usize {
-        self.triangles.len() * std::mem::size_of::<[Vec3; 3]>() + self.nodes.len() * std::mem::size_of::<ShellNode>()
+        self.triangles.len() * (std::mem::size_of::<[Vec3; 3]>() + 3)
+            + self.leaf_corners.len() * std::mem::size_of::<Vec3>()
+            + self.nodes.len() * std::mem::size_of::<ShellNode>()
     }
 
     pub(crate) fn nodes(&self) -> &[ShellNode] {
         &self.nodes
+    }
+
+    /// Leaf `node`'s distinct corners, and its triangles' corners as indices into them.
+    pub(crate) fn leaf(&self, node: &ShellNode) -> (&[Vec3], &[[u8; 3]]) {
+        let corners = &self.leaf_corners[node.corners as usize..(node.corners + node.corner_count) as usize];
+        (corners, &self.corner_of[node.first as usize..(node.first + node.count) as usize])
     }
 }
 
@@ -190,7 +233,9 @@ mod tests {
                 stack.push((node.first as usize + 1, path));
                 continue;
             }
-            for i in node.first..node.first + node.count {
+            let (corners, corner_of) = shell.leaf(&node);
+            for (i, local) in (node.first..node.first + node.count).zip(corner_of) {
+                assert_eq!(local.map(|k| corners[k as usize]), shell.triangles()[i as usize], "a leaf's corners");
                 seen[i as usize] += 1;
                 for &a in &path {
                     let bound = shell.nodes()[a];

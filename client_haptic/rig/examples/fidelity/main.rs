@@ -367,8 +367,8 @@ fn run(args: Args) -> anyhow::Result<()> {
     anyhow::ensure!(args.poses > 0, "--poses must be at least 1");
     anyhow::ensure!(args.samples >= 1000, "--samples must be at least 1000");
     let started = std::time::Instant::now();
-    let sphere = shape(uv_sphere_buffers(SPHERE_R, 192, 384), true, &args)?;
-    let ball = shape(uv_sphere_buffers(BALL_R, 192, 384), false, &args)?;
+    let sphere = shape(uv_sphere_buffers(SPHERE_R, 384, 768), true, &args)?;
+    let ball = shape(uv_sphere_buffers(BALL_R, 384, 768), false, &args)?;
     let cube = shape(box_buffers(Vec3::splat(CUBE_HALF)), true, &args)?;
     let cylinder = shape(cylinder_buffers(CYL_R, CYL_HALF, 384), true, &args)?;
     let slab = shape(box_buffers(SLAB_HALF), false, &args)?;
