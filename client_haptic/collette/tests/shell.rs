@@ -130,3 +130,66 @@ fn a_shell_outside_the_object_measures_nothing_and_a_budget_stops_it() {
     );
     assert!(!cut.complete && set.truncated && cut.node_pairs == 20, "{cut:?}");
 }
+
+#[test]
+fn two_surfaces_measure_a_corner_and_a_sphere_through_a_thin_plate_exactly() {
+    // A cube's corner into a slab: the tetrahedron, through its centroid, straight up.
+    let (grid, slab_pose) = slab();
+    let slab_shell = SurfaceShell::new(&mesh(box_buffers(Vec3::new(0.05, 0.01, 0.05))), 0.0005).expect("slab shell");
+    let h = 0.01;
+    let cube = mesh(box_buffers(Vec3::splat(h)));
+    let (cube_shell, cube_grid) =
+        (SurfaceShell::new(&cube, 0.001).expect("shell"), SignedDistanceGrid::new(&cube, 128).expect("grid"));
+    let down = Quat::from_rotation_arc(Vec3::splat(-1.0).normalize(), -Vec3::Y);
+    let (mut ws, mut set) = (QueryWorkspace::new(), ContactSet::new());
+    // 0.1 mm: thinner than the cube's grid can draw (the columns'); 3 mm: the boundary's.
+    for depth in [1e-4, 3e-3] {
+        let corner = Vec3::new(0.004, -depth, -0.007);
+        let pose = Pose::new(corner + Vec3::Y * (h * 3f32.sqrt()), Quat::from_rotation_y(0.5) * down);
+        let result = collette::overlap_surfaces(
+            &cube_shell,
+            &cube_grid,
+            &pose,
+            &slab_shell,
+            &grid,
+            &slab_pose,
+            &mut ws,
+            &mut set,
+        );
+        let exact = 3f32.sqrt() / 2.0 * depth.powi(3);
+        assert!((result.total_volume / exact - 1.0).abs() < 0.01, "{depth}: {} against {exact}", result.total_volume);
+        let c = set.as_slice()[0];
+        assert!(set.len() == 1 && c.normal.angle_between(Vec3::Y).to_degrees() < 0.5, "{depth}: {c:?}");
+        assert!(c.point.distance(corner + Vec3::Y * (0.75 * depth)) < 0.02 * depth.max(2.5e-3), "{depth}: {c:?}");
+    }
+
+    // A 1 cm ball pushed 6 mm through a 4 mm plate: its part inside the plate is a slice between two
+    // planes, which the ball's columns (to the nearer face) get wrong, and the boundary does not.
+    let plate = mesh(box_buffers(Vec3::new(0.03, 0.002, 0.03)));
+    let (plate_shell, plate_grid) =
+        (SurfaceShell::new(&plate, 0.001).expect("shell"), SignedDistanceGrid::new(&plate, 128).expect("grid"));
+    let r = 0.005;
+    let ball = mesh(uv_sphere_buffers(r, 96, 192));
+    let (ball_shell, ball_grid) =
+        (SurfaceShell::new(&ball, 0.0005).expect("shell"), SignedDistanceGrid::new(&ball, 64).expect("grid"));
+    // The ball's centre 1 mm above the plate's middle: its bottom 4 mm under the top face, 2 mm past the
+    // bottom face.
+    let centre = Vec3::new(0.0, 0.001, 0.0);
+    let cap = |h: f32| PI * h * h * (3.0 * r - h) / 3.0;
+    // The slice from 3 mm under the centre to 1 mm over it: the cap under the top face less the cap under the bottom face.
+    let slice = cap(r + 0.001) - cap(r - 0.003);
+    let at = Pose::from_translation(centre);
+    let result = collette::overlap_surfaces(
+        &ball_shell,
+        &ball_grid,
+        &at,
+        &plate_shell,
+        &plate_grid,
+        &Pose::IDENTITY,
+        &mut ws,
+        &mut set,
+    );
+    assert!((result.total_volume / slice - 1.0).abs() < 0.01, "{} against {slice}", result.total_volume);
+    let columns = collette::overlap_shell(&ball_shell, &at, &plate_grid, &Pose::IDENTITY, &mut ws, &mut set);
+    assert!((columns.total_volume / slice - 1.0).abs() > 0.05, "the columns miss it: {}", columns.total_volume);
+}

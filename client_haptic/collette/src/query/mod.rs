@@ -11,6 +11,7 @@ pub mod field;
 pub mod overlap;
 pub mod probe;
 pub mod shell;
+pub mod surfaces;
 mod workspace;
 
 pub use distance::{Separation, separation};
@@ -18,6 +19,7 @@ pub use field::{overlap_field, overlap_field_budgeted, overlap_field_volume};
 pub use overlap::{Budget, CoherenceStats, CoherentOverlap, OverlapResult, overlap, overlap_budgeted, overlap_volume};
 pub use probe::{ProbeHit, probe, spheres_near};
 pub use shell::{overlap_shell, overlap_shell_budgeted};
+pub use surfaces::overlap_surfaces;
 pub use workspace::QueryWorkspace;
 
 pub use haptic_common::{Contact, ContactSet, Pose};

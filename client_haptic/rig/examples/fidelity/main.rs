@@ -6,8 +6,8 @@
 //! Volumetric rendering (Eq. 1 and 2 with ε_c = 1, no damping or friction: the force is the overlap
 //! volume along the contact normals) is judged against the penalty the exact overlap gives: the exact
 //! volume along the exact normal, its torque about a handle point off the tool from the exact overlap's
-//! centroid. Two trees (the tool's against the object's), the tree against the object's surface grid, and
-//! the tool's surface (its shell) against the grid.
+//! centroid. Two trees (the tool's against the object's), the tree against the object's surface grid,
+//! the tool's surface (its shell) against the grid, and both surfaces each against the other's grid.
 //! The 3-DOF proxy is judged by where it holds the tip: its contact point against the exact closest
 //! point of the surface, held on the object's packing or on its surface grid. Scenes: a sphere, a box's edge, a box's corner and a cylinder on its side
 //! pressed into a slab, a sphere into a sphere; the proxy's tip into the slab, the sphere and the box
@@ -69,21 +69,22 @@ fn main() -> std::process::ExitCode {
     }
 }
 
-/// A shape's tree, surface grid and (a tool's) surface shell.
+/// A shape's tree, surface grid and surface shell.
 struct Shape {
     tree: Arc<InnerSphereTree>,
     grid: SignedDistanceGrid,
     shell: Option<SurfaceShell>,
 }
 
-fn shape(buffers: (Vec<Vec3>, Vec<[u32; 3]>), tool: bool, args: &Args) -> anyhow::Result<Shape> {
-    shape_of(&TriMesh::new(buffers.0, buffers.1)?, tool, args)
+fn shape(buffers: (Vec<Vec3>, Vec<[u32; 3]>), args: &Args) -> anyhow::Result<Shape> {
+    shape_of(&TriMesh::new(buffers.0, buffers.1)?, args)
 }
 
-fn shape_of(mesh: &TriMesh, tool: bool, args: &Args) -> anyhow::Result<Shape> {
+fn shape_of(mesh: &TriMesh, args: &Args) -> anyhow::Result<Shape> {
     let (tree, _) = collette::build(mesh, &BuildOptions::spheres(args.spheres), &mut |_| {})?;
     let grid = SignedDistanceGrid::new(mesh, args.grid)?;
-    let shell = tool.then(|| SurfaceShell::new(mesh, args.shell_edge_mm * 1e-3)).transpose()?;
+    // Every shape has its shell: the tool's for the surface rendering, both for the two surfaces.
+    let shell = Some(SurfaceShell::new(mesh, args.shell_edge_mm * 1e-3)?);
     Ok(Shape { tree: Arc::new(tree), grid, shell })
 }
 
@@ -274,8 +275,8 @@ fn volumetric(
     poses: usize,
     dice: &mut Dice,
     place: impl Fn(f32, &mut Dice) -> (Pose, Exact),
-) -> [Errors; 3] {
-    let mut errors: [Errors; 3] = Default::default();
+) -> [Errors; 4] {
+    let mut errors: [Errors; 4] = Default::default();
     let (mut ws, mut set) = (QueryWorkspace::new(), ContactSet::new());
     for _ in 0..poses {
         let depth = dice.depth();
@@ -311,13 +312,19 @@ fn measure_all(
         collette::overlap_shell(shell, pose, &object.grid, object_pose, ws, set);
         judge(set, 2, us(started));
     }
+    if let (Some(a), Some(b)) = (&tool.shell, &object.shell) {
+        let started = std::time::Instant::now();
+        collette::overlap_surfaces(a, &tool.grid, pose, b, &object.grid, object_pose, ws, set);
+        judge(set, 3, us(started));
+    }
 }
 
 /// The volumetric renderings: the table's name, the summary's name and the JSON's.
-const VOLUMETRIC: [(&str, &str, &str); 3] = [
+const VOLUMETRIC: [(&str, &str, &str); 4] = [
     ("volumetric, two trees", "two trees", "volumetric_trees"),
     ("volumetric, tree against grid", "tree against grid", "volumetric_grid"),
     ("volumetric, surface against grid", "surface against grid", "volumetric_surface"),
+    ("volumetric, two surfaces", "two surfaces", "volumetric_surfaces"),
 ];
 
 /// The 3-DOF proxy's tip (radius 4 mm, as the rig's default) pressed from `outside` to `inside`, held
@@ -367,11 +374,11 @@ fn run(args: Args) -> anyhow::Result<()> {
     anyhow::ensure!(args.poses > 0, "--poses must be at least 1");
     anyhow::ensure!(args.samples >= 1000, "--samples must be at least 1000");
     let started = std::time::Instant::now();
-    let sphere = shape(uv_sphere_buffers(SPHERE_R, 384, 768), true, &args)?;
-    let ball = shape(uv_sphere_buffers(BALL_R, 384, 768), false, &args)?;
-    let cube = shape(box_buffers(Vec3::splat(CUBE_HALF)), true, &args)?;
-    let cylinder = shape(cylinder_buffers(CYL_R, CYL_HALF, 384), true, &args)?;
-    let slab = shape(box_buffers(SLAB_HALF), false, &args)?;
+    let sphere = shape(uv_sphere_buffers(SPHERE_R, 384, 768), &args)?;
+    let ball = shape(uv_sphere_buffers(BALL_R, 384, 768), &args)?;
+    let cube = shape(box_buffers(Vec3::splat(CUBE_HALF)), &args)?;
+    let cylinder = shape(cylinder_buffers(CYL_R, CYL_HALF, 384), &args)?;
+    let slab = shape(box_buffers(SLAB_HALF), &args)?;
     eprintln!("fidelity: trees and grids built in {:.1} s", started.elapsed().as_secs_f32());
     let slab_pose = Pose::from_translation(Vec3::new(0.0, -SLAB_HALF.y, 0.0));
     let mut dice = Dice(ChaCha8Rng::seed_from_u64(args.seed as u64));
@@ -386,7 +393,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         ("box corner on plane", &cube, &slab, slab_pose),
         ("cylinder on its side", &cylinder, &slab, slab_pose),
     ];
-    let mut all: [Errors; 3] = Default::default();
+    let mut all: [Errors; 4] = Default::default();
     for (i, (name, tool, object, object_pose)) in scenes.into_iter().enumerate() {
         let errors = volumetric(tool, object, &object_pose, args.poses, &mut dice, |d, dice| match i {
             0 => {
@@ -434,20 +441,20 @@ fn run(args: Args) -> anyhow::Result<()> {
     let closed = |(v, t): (Vec<Vec3>, Vec<[u32; 3]>)| TriMesh::new(v, t);
     let torus_mesh = closed(collette::shape::torus_buffers(0.03, 0.01, 96, 48))?;
     let ring_mesh = closed(collette::shape::torus_buffers(0.01, 0.004, 64, 32))?;
-    let mut mesh_shape = |mesh: TriMesh, voxels: usize, tool: bool| -> anyhow::Result<meshes::MeshShape> {
-        let shape = shape_of(&mesh, tool, &args)?;
+    let mut mesh_shape = |mesh: TriMesh, voxels: usize| -> anyhow::Result<meshes::MeshShape> {
+        let shape = shape_of(&mesh, &args)?;
         Ok(meshes::MeshShape::new(mesh, shape, voxels, surface_samples, &mut mesh_dice))
     };
-    let gem = mesh_shape(gem_mesh, 128, true)?;
-    let ring = mesh_shape(ring_mesh, 128, true)?;
-    let bunny = mesh_shape(bunny_mesh, 256, false)?;
-    let torus = mesh_shape(torus_mesh, 256, false)?;
+    let gem = mesh_shape(gem_mesh, 128)?;
+    let ring = mesh_shape(ring_mesh, 128)?;
+    let bunny = mesh_shape(bunny_mesh, 256)?;
+    let torus = mesh_shape(torus_mesh, 256)?;
     eprintln!("fidelity: mesh scenes built in {:.1} s", mesh_started.elapsed().as_secs_f32());
     let mesh_scenes: [(&str, &meshes::MeshShape, &meshes::MeshShape); 3] =
         [("gem on bunny", &gem, &bunny), ("gem on torus", &gem, &torus), ("ring on bunny", &ring, &bunny)];
     let mut skipped = 0;
     for (name, tool, object) in mesh_scenes {
-        let mut errors: [Errors; 3] = Default::default();
+        let mut errors: [Errors; 4] = Default::default();
         let (mut ws, mut set) = (QueryWorkspace::new(), ContactSet::new());
         let mut kept = 0;
         while kept < args.mesh_poses && kept + skipped < 20 * args.mesh_poses {
