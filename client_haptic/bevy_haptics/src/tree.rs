@@ -48,7 +48,7 @@ impl SphereTree {
     /// This tool's tree with `shell` (collette's [`SurfaceShell::new`] of the same mesh, e.g. 0.5 mm
     /// edges: milliseconds for a 1 cm gem): against a collider with a surface grid, the tool's surface
     /// is measured instead of its spheres (docs/haptics.md, *Fidelity against exact answers*; it costs
-    /// more on deep contacts: 0.35 ms for a 1 cm gem 5 mm in).
+    /// more on deep contacts: about 0.5 ms for a 1 cm gem 5 mm in).
     pub fn with_shell(mut self, shell: SurfaceShell) -> Self {
         self.shell = Some(Arc::new(shell));
         self

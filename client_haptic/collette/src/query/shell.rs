@@ -21,7 +21,6 @@ use crate::query::overlap::{Budget, OverlapResult};
 use crate::shape::{ShellNode, SignedDistanceGrid, SurfaceShell};
 use glam::Vec3;
 use haptic_common::{Contact, ContactSet, Pose};
-use std::time::Instant;
 
 /// Overlap of the tool A (its `shell` at `pose_a`) with the object B (its distance grid `b` at
 /// `pose_b`): the volume and one world-frame contact per leaf of the shell with surface inside B (at
@@ -81,15 +80,7 @@ pub fn overlap_shell_budgeted(
         *group = Group::default();
     };
     while let Some(n) = stack.pop() {
-        let spent = match budget {
-            Budget::Unlimited => false,
-            Budget::NodePairs(max) => result.node_pairs >= max,
-            Budget::Deadline(deadline) => {
-                until_clock = if until_clock == 0 { CLOCK_STRIDE } else { until_clock - 1 };
-                until_clock == CLOCK_STRIDE && Instant::now() >= deadline
-            }
-        };
-        if spent {
+        if budget.spent(result.node_pairs, &mut until_clock) {
             result.complete = false;
             stack.clear();
             break;
@@ -101,10 +92,7 @@ pub fn overlap_shell_budgeted(
             group_floor = Some(stack.len());
         }
         let f = b.distance(center);
-        // No point of the node reaches inside: the interpolated distance rises at most its steepest
-        // slope per unit moved.
-        let outside = f + SignedDistanceGrid::STEEPEST * node.radius <= 0.0
-            || (f + node.radius <= 0.0 && f + b.steepest_slope(center, node.radius) * node.radius <= 0.0);
+        let outside = outside(b, center, node.radius, f);
         if !outside && node.count == 0 {
             stack.push(node.first);
             stack.push(node.first + 1);
@@ -139,9 +127,6 @@ pub fn overlap_shell_budgeted(
 /// taken as flat, m.
 const FLAT_M: f32 = 1e-7;
 
-/// Nodes visited between two looks at the clock.
-const CLOCK_STRIDE: u32 = 16;
-
 /// A node of at most this many of the shell's longest edges in radius gathers its subtree into one
 /// contact (about a contact per 4 mm of surface for a shell of 0.5 mm edges: a whole sphere's cap at
 /// a centimetre's depth in a few hundred).
@@ -161,17 +146,7 @@ fn measure_leaf(
     result: &mut OverlapResult,
 ) {
     let mut curvature = None;
-    // The leaf's corners in B's frame with the distance and its gradient there, each read once.
-    let (corners, corner_of) = shell.leaf(&node);
-    let mut read = [(Vec3::ZERO, 0.0f32, Vec3::ZERO); SurfaceShell::LEAF_CORNERS];
-    for (slot, &corner) in read.iter_mut().zip(corners) {
-        let q = a_in_b.transform_point(corner);
-        let (d, g) = b.distance_and_gradient(q);
-        *slot = (q, d, g);
-    }
-    for local in corner_of {
-        let [r0, r1, r2] = local.map(|k| read[k as usize]);
-        let (p, phi, gradients) = ([r0.0, r1.0, r2.0], [r0.1, r1.1, r2.1], [r0.2, r1.2, r2.2]);
+    for (p, phi, gradients) in leaf_triangles(shell, &node, a_in_b, b) {
         let mut column = Column::default();
         if !inside_pieces(p, phi, gradients, |piece| column.add(piece)) {
             continue;
@@ -184,6 +159,36 @@ fn measure_leaf(
         result.leaf_pairs += 1;
         group.add(column, g, g.dot(n), curvature);
     }
+}
+
+/// Whether no point within `radius` of `center` (the grid's frame; `f` the distance there) reaches
+/// inside: the interpolated distance rises at most its steepest slope per unit moved (√3 first, the
+/// slope pyramid's bound when that is not enough).
+pub(super) fn outside(grid: &SignedDistanceGrid, center: Vec3, radius: f32, f: f32) -> bool {
+    f + SignedDistanceGrid::STEEPEST * radius <= 0.0
+        || (f + radius <= 0.0 && f + grid.steepest_slope(center, radius) * radius <= 0.0)
+}
+
+/// The triangles of leaf `node` in the grid's frame (`into_grid` maps the shell's frame there), each
+/// with the distance and its gradient at its corners: every corner the leaf's triangles share read
+/// once.
+pub(super) fn leaf_triangles<'s>(
+    shell: &'s SurfaceShell,
+    node: &ShellNode,
+    into_grid: &Pose,
+    grid: &SignedDistanceGrid,
+) -> impl Iterator<Item = ([Vec3; 3], [f32; 3], [Vec3; 3])> + 's {
+    let (corners, corner_of) = shell.leaf(node);
+    let mut read = [(Vec3::ZERO, 0.0f32, Vec3::ZERO); SurfaceShell::LEAF_CORNERS];
+    for (slot, &corner) in read.iter_mut().zip(corners) {
+        let q = into_grid.transform_point(corner);
+        let (d, g) = grid.distance_and_gradient(q);
+        *slot = (q, d, g);
+    }
+    corner_of.iter().map(move |local| {
+        let [r0, r1, r2] = local.map(|k| read[k as usize]);
+        ([r0.0, r1.0, r2.0], [r0.1, r1.1, r2.1], [r0.2, r1.2, r2.2])
+    })
 }
 
 /// Hands `piece` the parts of triangle `p` where φ > 0 (each a triangle with φ at its corners, φ ≥ 0),

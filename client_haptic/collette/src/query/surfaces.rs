@@ -15,7 +15,7 @@
 
 use crate::query::QueryWorkspace;
 use crate::query::overlap::OverlapResult;
-use crate::query::shell::inside_pieces;
+use crate::query::shell::{inside_pieces, leaf_triangles, outside};
 use crate::shape::{SignedDistanceGrid, SurfaceShell};
 use glam::{DVec3, Vec3};
 use haptic_common::{Contact, ContactSet, Pose};
@@ -143,10 +143,7 @@ fn boundary(
         result.node_pairs += 1;
         let node = nodes[n as usize];
         let center = into_grid.transform_point(node.center);
-        let f = grid.distance(center);
-        let outside = f + SignedDistanceGrid::STEEPEST * node.radius <= 0.0
-            || (f + node.radius <= 0.0 && f + grid.steepest_slope(center, node.radius) * node.radius <= 0.0);
-        if outside {
+        if outside(grid, center, node.radius, grid.distance(center)) {
             continue;
         }
         if node.count == 0 {
@@ -154,16 +151,7 @@ fn boundary(
             stack.push(node.first + 1);
             continue;
         }
-        let (corners, corner_of) = shell.leaf(&node);
-        let mut read = [(Vec3::ZERO, 0.0f32, Vec3::ZERO); SurfaceShell::LEAF_CORNERS];
-        for (slot, &corner) in read.iter_mut().zip(corners) {
-            let q = into_grid.transform_point(corner);
-            let (d, g) = grid.distance_and_gradient(q);
-            *slot = (q, d, g);
-        }
-        for local in corner_of {
-            let [r0, r1, r2] = local.map(|k| read[k as usize]);
-            let (p, phi, gradients) = ([r0.0, r1.0, r2.0], [r0.1, r1.1, r2.1], [r0.2, r1.2, r2.2]);
+        for (p, phi, gradients) in leaf_triangles(shell, &node, &into_grid, grid) {
             // The triangle's outward normal, world frame.
             let Some(normal) = grid_pose.transform_vector((p[1] - p[0]).cross(p[2] - p[0])).try_normalize() else {
                 continue;

@@ -19,7 +19,6 @@ use crate::query::overlap::{Budget, OverlapResult};
 use crate::shape::{SignedDistanceGrid, cap_moment, cap_volume, lens_volume, sphere_volume};
 use glam::Vec3;
 use haptic_common::{Contact, ContactSet, Pose};
-use std::time::Instant;
 
 /// Overlap of tree `a` at `pose_a` with the object B at `pose_b` — its tree `b` and its distance grid
 /// `b_grid`, built from the same mesh: the volume (exact up to the grid's interpolation and the caps'
@@ -77,9 +76,6 @@ pub fn overlap_field_volume(
     descend(a, pose_a, (b, b_grid), pose_b, Budget::Unlimited, ws, None)
 }
 
-/// Nodes visited between two looks at the clock.
-const CLOCK_STRIDE: u32 = 16;
-
 fn descend(
     a: &InnerSphereTree,
     pose_a: &Pose,
@@ -115,15 +111,7 @@ fn descend(
     let mut until_clock = 0;
     while let Some(n) = frontier.pop(stack) {
         let node = &nodes[n as usize];
-        let spent = match budget {
-            Budget::Unlimited => false,
-            Budget::NodePairs(max) => result.node_pairs >= max,
-            Budget::Deadline(deadline) => {
-                until_clock = if until_clock == 0 { CLOCK_STRIDE } else { until_clock - 1 };
-                until_clock == CLOCK_STRIDE && Instant::now() >= deadline
-            }
-        };
-        if spent {
+        if budget.spent(result.node_pairs, &mut until_clock) {
             // This node and every one still queued: estimated from its bound.
             result.complete = false;
             let waiting = (0..frontier.queued).map(|i| frontier.ring[(frontier.head + i) % frontier.ring.len()].0);

@@ -243,5 +243,5 @@ fn a_budget_stops_the_descent_and_estimates_the_rest_from_the_nodes_bounds() {
         &mut ws,
         &mut set,
     );
-    assert!(!late.complete && late.node_pairs <= CLOCK_STRIDE && late.total_volume > 0.0, "{late:?}");
+    assert!(!late.complete && late.node_pairs <= Budget::CLOCK_STRIDE && late.total_volume > 0.0, "{late:?}");
 }

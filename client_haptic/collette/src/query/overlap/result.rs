@@ -13,6 +13,24 @@ pub enum Budget {
     Deadline(Instant),
 }
 
+impl Budget {
+    /// Whether a single-tree query that has visited `visited` nodes must stop: the node count, or the
+    /// clock every [`Self::CLOCK_STRIDE`] calls (`until_clock` counts them down; start it at 0).
+    pub(crate) fn spent(&self, visited: u32, until_clock: &mut u32) -> bool {
+        match *self {
+            Budget::Unlimited => false,
+            Budget::NodePairs(max) => visited >= max,
+            Budget::Deadline(deadline) => {
+                *until_clock = if *until_clock == 0 { Self::CLOCK_STRIDE } else { *until_clock - 1 };
+                *until_clock == Self::CLOCK_STRIDE && Instant::now() >= deadline
+            }
+        }
+    }
+
+    /// Nodes a single-tree query visits between two looks at the clock.
+    pub(crate) const CLOCK_STRIDE: u32 = 16;
+}
+
 /// Summary of an overlap query.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct OverlapResult {
