@@ -412,32 +412,14 @@ impl CollisionWorld {
                 }
                 None => retire(Retired::Tree(tree)),
             },
-            Command::SetSurface(id, surface) => match self.objects.get_mut(id.0 as usize).and_then(Option::as_mut) {
-                Some(slot) => {
-                    if let Some(old) = std::mem::replace(&mut slot.surface, surface) {
-                        retire(Retired::Surface(old));
-                    }
-                    slot.local = slot.local_sphere();
-                }
-                None => {
-                    if let Some(surface) = surface {
-                        retire(Retired::Surface(surface));
-                    }
-                }
-            },
-            Command::SetShell(id, shell) => match self.objects.get_mut(id.0 as usize).and_then(Option::as_mut) {
-                Some(slot) => {
-                    if let Some(old) = std::mem::replace(&mut slot.shell, shell) {
-                        retire(Retired::Shell(old));
-                    }
-                    slot.local = slot.local_sphere();
-                }
-                None => {
-                    if let Some(shell) = shell {
-                        retire(Retired::Shell(shell));
-                    }
-                }
-            },
+            Command::SetSurface(id, surface) => {
+                let slot = self.objects.get_mut(id.0 as usize).and_then(Option::as_mut);
+                set_part(slot, surface, |slot| &mut slot.surface, Retired::Surface, retire);
+            }
+            Command::SetShell(id, shell) => {
+                let slot = self.objects.get_mut(id.0 as usize).and_then(Option::as_mut);
+                set_part(slot, shell, |slot| &mut slot.shell, Retired::Shell, retire);
+            }
             Command::RemoveObject(id) => {
                 if let Some(old) = self.objects.get_mut(id.0 as usize).and_then(Option::take) {
                     old.retire(retire);
@@ -662,6 +644,30 @@ fn scene_candidates(
         None => out.extend(
             (0..objects.len()).filter(|&ib| ib != ia && close(objects, None, region, ia, ib, near)).map(|ib| ib as u32),
         ),
+    }
+}
+
+/// Puts `part` (a surface grid or shell) in `slot`'s field `field`, handing the one it replaces to
+/// `retire` (or `part` itself when the slot is empty), and refits the slot's bounding sphere.
+fn set_part<T>(
+    slot: Option<&mut ObjectSlot>,
+    part: Option<Arc<T>>,
+    field: impl Fn(&mut ObjectSlot) -> &mut Option<Arc<T>>,
+    retired: impl Fn(Arc<T>) -> Retired,
+    retire: &mut dyn FnMut(Retired),
+) {
+    match slot {
+        Some(slot) => {
+            if let Some(old) = std::mem::replace(field(slot), part) {
+                retire(retired(old));
+            }
+            slot.local = slot.local_sphere();
+        }
+        None => {
+            if let Some(part) = part {
+                retire(retired(part));
+            }
+        }
     }
 }
 

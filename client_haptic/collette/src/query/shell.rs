@@ -23,8 +23,9 @@ use glam::Vec3;
 use haptic_common::{Contact, ContactSet, Pose};
 
 /// Overlap of the tool A (its `shell` at `pose_a`) with the object B (its distance grid `b` at
-/// `pose_b`): the volume and one world-frame contact per leaf of the shell with surface inside B (at
-/// the centroid of its columns, the normal out of B: the direction that pushes the tool out). The
+/// `pose_b`): the volume and one world-frame contact per group of leaves with surface inside B (a
+/// subtree about 8 of the shell's edges in radius; at the centroid of its columns, the normal out of B:
+/// the direction that pushes the tool out). The
 /// contacts' volumes are scaled so that their push (Σ volume × normal) has the overlap's volume as its
 /// magnitude, the penalty's convention.
 ///

@@ -51,34 +51,40 @@ pub fn overlap_surfaces(
     // δ changes nothing; for this one it takes δ·∮n dA / 3 off the volume and adjusts the moment.
     let closure = sums.a_area + sums.b_area;
     let delta = if sums.a_total > 0.0 { sums.a_moment / sums.a_total } else { DVec3::ZERO };
-    let volume = (sums.volume - delta.dot(closure)) / 3.0;
+    // ∮ y·n dA is the sum of the per-axis ∮ y_k n_k dA.
+    let volume = (sums.first.element_sum() - delta.dot(closure)) / 3.0;
     let moment = sums.moment * 0.5 - delta * sums.first + delta * delta * closure * 0.5;
     // The two parts' ways out agree on a closed boundary; their mean halves what either misses.
     let out_of_b = (sums.b_area - sums.a_area) * 0.5;
-    let mut boundary = None;
+    let mut closed = None;
     if volume > 0.0
         && let Some(normal) = out_of_b.as_vec3().try_normalize()
     {
-        boundary = Some((volume as f32, origin + (delta + moment / volume).as_vec3(), normal));
+        closed = Some((volume as f32, origin + (delta + moment / volume).as_vec3(), normal));
     }
     // B's part is clipped by A's grid, which cannot draw an overlap thinner than a few of its voxels (a
     // box's corner 0.1 mm in); A's columns are exact there on any face. So: the columns up to two of A's
-    // voxels deep, the boundary from six, blended smoothly between.
-    let columns = super::shell::overlap_shell(a_shell, pose_a, b_grid, pose_b, ws, out);
-    let (mut force, mut moment, mut deepest) = (Vec3::ZERO, Vec3::ZERO, 0.0f32);
-    for c in out.as_slice() {
-        force += c.normal * c.volume;
-        moment += c.point * c.volume;
-        deepest = deepest.max(c.depth);
-    }
-    let listed: f32 = out.as_slice().iter().map(|c| c.volume).sum();
-    let column = (columns.total_volume > 0.0 && listed > 0.0)
-        .then(|| force.try_normalize().map(|n| (columns.total_volume, moment / listed, n)))
-        .flatten();
-    let voxel = a_grid.voxel_size();
+    // voxels deep, the boundary from six, blended smoothly between (the columns not measured at all
+    // where they would weigh nothing). A's deepest point inside B is the one the columns would report.
+    let (deepest, voxel) = (sums.deepest, a_grid.voxel_size());
     let t = ((deepest - 2.0 * voxel) / (4.0 * voxel)).clamp(0.0, 1.0);
     let w = t * t * (3.0 - 2.0 * t);
-    let blended = match (column, boundary) {
+    let mut column = None;
+    if w < 1.0 {
+        let columns = super::shell::overlap_shell(a_shell, pose_a, b_grid, pose_b, ws, out);
+        let (mut force, mut moment, mut listed) = (Vec3::ZERO, Vec3::ZERO, 0.0f32);
+        for c in out.as_slice() {
+            force += c.normal * c.volume;
+            moment += c.point * c.volume;
+            listed += c.volume;
+        }
+        column = (columns.total_volume > 0.0 && listed > 0.0)
+            .then(|| force.try_normalize().map(|n| (columns.total_volume, moment / listed, n)))
+            .flatten();
+        // The same triangles of A were counted in the boundary's pass; its nodes were visited again.
+        result.node_pairs += columns.node_pairs;
+    }
+    let blended = match (column, closed) {
         (Some(c), Some(b)) => {
             Some((c.0 + (b.0 - c.0) * w, c.1 + (b.1 - c.1) * w, (c.2 + (b.2 - c.2) * w).normalize_or(b.2)))
         }
@@ -86,8 +92,6 @@ pub fn overlap_surfaces(
         (Some(c), None) => Some((c.0 * (1.0 - w), c.1, c.2)),
         (None, None) => None,
     };
-    result.leaf_pairs += columns.leaf_pairs;
-    result.node_pairs += columns.node_pairs;
     out.clear();
     if let Some((volume, point, normal)) = blended.filter(|b| b.0 > 0.0) {
         out.push(Contact { point, normal, volume, depth: deepest });
@@ -108,8 +112,6 @@ enum Side {
 /// between the two parts.
 #[derive(Default)]
 struct Boundary {
-    /// ∮ y·n dA.
-    volume: f64,
     /// ∮ y_k² n_k dA and ∮ y_k n_k dA, per axis.
     moment: DVec3,
     first: DVec3,
@@ -119,6 +121,8 @@ struct Boundary {
     /// ∫ n dA over A's part and over B's part.
     a_area: DVec3,
     b_area: DVec3,
+    /// The deepest point of A's part inside B, m.
+    deepest: f32,
 }
 
 /// Adds the part of `shell` (at `pose`) inside the object of `grid` (at `grid_pose`) to `sums`.
@@ -161,13 +165,13 @@ fn boundary(
                 let y = piece.map(|(x, _)| (grid_pose.transform_point(x) - origin).as_dvec3());
                 let area = 0.5 * (y[1] - y[0]).cross(y[2] - y[0]).length();
                 let sum = y[0] + y[1] + y[2];
-                sums.volume += area * normal.dot(sum / 3.0);
                 // ∫y_k² dA = A/12·(Σ y_ik² + (Σ y_ik)²).
                 let squares = y[0] * y[0] + y[1] * y[1] + y[2] * y[2] + sum * sum;
                 sums.moment += normal * squares * (area / 12.0);
                 sums.first += normal * sum * (area / 3.0);
                 match side {
                     Side::A => {
+                        sums.deepest = piece.iter().fold(sums.deepest, |d, c| d.max(c.1));
                         sums.a_area += normal * area;
                         sums.a_moment += sum * (area / 3.0);
                         sums.a_total += area;

@@ -3,7 +3,7 @@
 //!
 //! You need this module when a tool's force against an object with a surface grid should be exact on
 //! flat faces at any depth: the tool's surface, not its sphere packing, is measured against the
-//! object's distance (docs/collette.md, *Surface against grid*).
+//! object's distance (docs/collette.md, *The tool's surface against the touched object's surface*).
 
 use crate::error::BuildError;
 use crate::shape::TriMesh;
@@ -27,7 +27,7 @@ pub struct SurfaceShell {
 
 /// One node of the shell's tree: a bounding sphere of its triangles, and either its two children
 /// (`first`, `first + 1` in `nodes`) or its triangles (`first .. first + count`).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct ShellNode {
     pub(crate) center: Vec3,
     pub(crate) radius: f32,
@@ -102,7 +102,7 @@ impl SurfaceShell {
             return Err(BuildError::InvalidOption("the mesh has no triangle with an area to make a shell of".into()));
         }
         let mut nodes = Vec::with_capacity(2 * triangles.len() / Self::LEAF + 2);
-        nodes.push(ShellNode { center: Vec3::ZERO, radius: 0.0, first: 0, count: 0, corners: 0, corner_count: 0 });
+        nodes.push(ShellNode::default());
         let mut pending = vec![(0usize, 0usize, triangles.len())];
         while let Some((node, start, end)) = pending.pop() {
             let part = &mut triangles[start..end];
@@ -111,14 +111,8 @@ impl SurfaceShell {
             let center = (low + high) * 0.5;
             let radius = part.iter().flatten().map(|p| p.distance(center)).fold(0.0f32, f32::max);
             if part.len() <= Self::LEAF {
-                nodes[node] = ShellNode {
-                    center,
-                    radius,
-                    first: start as u32,
-                    count: part.len() as u32,
-                    corners: 0,
-                    corner_count: 0,
-                };
+                nodes[node] =
+                    ShellNode { center, radius, first: start as u32, count: part.len() as u32, ..ShellNode::default() };
                 continue;
             }
             // Halve along the longest side of the centroids' box.
@@ -138,9 +132,8 @@ impl SurfaceShell {
             let half = part.len() / 2;
             part.select_nth_unstable_by(half, |p, q| centroid(p)[axis].total_cmp(&centroid(q)[axis]));
             let first = nodes.len();
-            nodes.push(ShellNode { center: Vec3::ZERO, radius: 0.0, first: 0, count: 0, corners: 0, corner_count: 0 });
-            nodes.push(ShellNode { center: Vec3::ZERO, radius: 0.0, first: 0, count: 0, corners: 0, corner_count: 0 });
-            nodes[node] = ShellNode { center, radius, first: first as u32, count: 0, corners: 0, corner_count: 0 };
+            nodes.extend([ShellNode::default(); 2]);
+            nodes[node] = ShellNode { center, radius, first: first as u32, ..ShellNode::default() };
             pending.push((first, start, start + half));
             pending.push((first + 1, start + half, end));
         }

@@ -47,7 +47,7 @@ struct Args {
     /// Monte Carlo points per mesh pose, in the box the overlap can occupy.
     #[arg(long, default_value_t = 1_000_000)]
     samples: usize,
-    /// Longest edge of the tools' surface shells, mm.
+    /// Longest edge of the shapes' surface shells, mm.
     #[arg(long, default_value_t = 0.5)]
     shell_edge_mm: f32,
     /// Seed of the poses.
@@ -73,7 +73,7 @@ fn main() -> std::process::ExitCode {
 struct Shape {
     tree: Arc<InnerSphereTree>,
     grid: SignedDistanceGrid,
-    shell: Option<SurfaceShell>,
+    shell: SurfaceShell,
 }
 
 fn shape(buffers: (Vec<Vec3>, Vec<[u32; 3]>), args: &Args) -> anyhow::Result<Shape> {
@@ -84,7 +84,7 @@ fn shape_of(mesh: &TriMesh, args: &Args) -> anyhow::Result<Shape> {
     let (tree, _) = collette::build(mesh, &BuildOptions::spheres(args.spheres), &mut |_| {})?;
     let grid = SignedDistanceGrid::new(mesh, args.grid)?;
     // Every shape has its shell: the tool's for the surface rendering, both for the two surfaces.
-    let shell = Some(SurfaceShell::new(mesh, args.shell_edge_mm * 1e-3)?);
+    let shell = SurfaceShell::new(mesh, args.shell_edge_mm * 1e-3)?;
     Ok(Shape { tree: Arc::new(tree), grid, shell })
 }
 
@@ -307,16 +307,12 @@ fn measure_all(
     let started = std::time::Instant::now();
     collette::overlap_field(&tool.tree, pose, &object.tree, &object.grid, object_pose, ws, set);
     judge(set, 1, us(started));
-    if let Some(shell) = &tool.shell {
-        let started = std::time::Instant::now();
-        collette::overlap_shell(shell, pose, &object.grid, object_pose, ws, set);
-        judge(set, 2, us(started));
-    }
-    if let (Some(a), Some(b)) = (&tool.shell, &object.shell) {
-        let started = std::time::Instant::now();
-        collette::overlap_surfaces(a, &tool.grid, pose, b, &object.grid, object_pose, ws, set);
-        judge(set, 3, us(started));
-    }
+    let started = std::time::Instant::now();
+    collette::overlap_shell(&tool.shell, pose, &object.grid, object_pose, ws, set);
+    judge(set, 2, us(started));
+    let started = std::time::Instant::now();
+    collette::overlap_surfaces(&tool.shell, &tool.grid, pose, &object.shell, &object.grid, object_pose, ws, set);
+    judge(set, 3, us(started));
 }
 
 /// The volumetric renderings: the table's name, the summary's name and the JSON's.

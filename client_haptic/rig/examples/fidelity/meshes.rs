@@ -197,7 +197,8 @@ mod tests {
         let mesh = TriMesh::new(buffers.0, buffers.1).expect("mesh");
         let (tree, _) = collette::build(&mesh, &collette::BuildOptions::spheres(100), &mut |_| {}).expect("tree");
         let grid = collette::SignedDistanceGrid::new(&mesh, 16).expect("grid");
-        let shape = Shape { tree: std::sync::Arc::new(tree), grid, shell: None };
+        let shell = collette::SurfaceShell::new(&mesh, 0.005).expect("shell");
+        let shape = Shape { tree: std::sync::Arc::new(tree), grid, shell };
         MeshShape::new(mesh, shape, 32, 100_000, dice)
     }
 
