@@ -193,3 +193,49 @@ fn two_surfaces_measure_a_corner_and_a_sphere_through_a_thin_plate_exactly() {
     let columns = collette::overlap_shell(&ball_shell, &at, &plate_grid, &Pose::IDENTITY, &mut ws, &mut set);
     assert!((columns.total_volume / slice - 1.0).abs() > 0.05, "the columns miss it: {}", columns.total_volume);
 }
+
+#[test]
+fn a_ball_pressed_past_a_thin_plates_middle_is_pushed_back_the_way_it_came() {
+    // Past the middle of a 4 mm plate a column from the ball's surface runs to the plate's far face and
+    // points through it; the push follows the way out (−∫ n dA over the ball's surface inside) instead.
+    let plate = mesh(box_buffers(Vec3::new(0.03, 0.002, 0.03)));
+    let grid = SignedDistanceGrid::new(&plate, 128).expect("grid");
+    let r = 0.005;
+    let shell = SurfaceShell::new(&mesh(uv_sphere_buffers(r, 96, 192)), 0.0005).expect("shell");
+    let (mut ws, mut set) = (QueryWorkspace::new(), ContactSet::new());
+    // The ball's bottom 3 mm and 3.5 mm under the top face (inside the plate), and 4 mm (through it).
+    for (bottom, way) in [(-0.001, Vec3::Y), (-0.0015, Vec3::Y), (-0.002, Vec3::Y)] {
+        let at = Pose::new(Vec3::new(0.001, bottom + r, -0.002), Quat::from_rotation_z(0.3));
+        let result = collette::overlap_shell(&shell, &at, &grid, &Pose::IDENTITY, &mut ws, &mut set);
+        let (force, _) = push(&set);
+        let volume = result.total_volume;
+        assert!(volume > 0.0 && (force.length() / volume - 1.0).abs() < 1e-3, "{bottom}: {volume}, {force}");
+        let off = force.normalize().angle_between(way).to_degrees();
+        assert!(off < 0.5, "bottom at {bottom}: pushed {off}° off {way}");
+    }
+}
+
+#[test]
+fn a_ball_pressed_beside_a_blocks_edge_is_pushed_the_way_out() {
+    // A block filling x < 0, y < 0 near its edge; a 5 mm ball 3 mm into its top face, its centre 2 mm
+    // from the side face. The way that shrinks the overlap fastest, −∫ n dA over the ball's surface
+    // inside, is (by the divergence theorem) the area of the overlap's flat face on the top plane along
+    // +y plus that of its face on the side plane along +x: two discs less a segment, and a segment. Near
+    // the edge the columns run to the side face and push towards −x; the push follows the way out.
+    let block = mesh(box_buffers(Vec3::splat(0.02)));
+    let grid = SignedDistanceGrid::new(&block, 128).expect("grid");
+    let block_pose = Pose::from_translation(Vec3::new(-0.02, -0.02, 0.0));
+    let r = 0.005f32;
+    let shell = SurfaceShell::new(&mesh(uv_sphere_buffers(r, 192, 384)), 0.0005).expect("shell");
+    let (mut ws, mut set) = (QueryWorkspace::new(), ContactSet::new());
+    let (depth, off) = (0.003f32, 0.002f32);
+    let at = Pose::new(Vec3::new(-off, r - depth, 0.001), Quat::from_rotation_z(0.3));
+    collette::overlap_shell(&shell, &at, &grid, &block_pose, &mut ws, &mut set);
+    let (force, _) = push(&set);
+    let segment = |radius: f32, h: f32| radius * radius * (h / radius).acos() - h * (radius * radius - h * h).sqrt();
+    let a = (r * r - (r - depth).powi(2)).sqrt();
+    let b = (r * r - off * off).sqrt();
+    let way = Vec3::new(segment(b, r - depth), PI * a * a - segment(a, off), 0.0).normalize();
+    let off_way = force.normalize().angle_between(way).to_degrees();
+    assert!(off_way < 1.0, "pushed {off_way}° off the way out {way}: {force}");
+}

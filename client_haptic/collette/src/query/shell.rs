@@ -13,8 +13,12 @@
 //! through the ends' distances and slopes), the triangle clipped where φ > 0 and the column integrated
 //! exactly, its centroid too; the second term is taken per column from the distance's Laplacian and
 //! Hessian at the leaf (the column's cross-section to second order in its length: exact for a ball
-//! and a cylinder). On a flat face
-//! the volume, its centroid and its normal are exact at any depth.
+//! and a cylinder). On a flat face the volume, its centroid and its normal are exact at any depth.
+//! The push points the way out, `−∫ n dA` over the tool's surface inside (exact anywhere: beside an
+//! edge of B the columns run to the side face and lean the push over). Past the middle of a part of B
+//! thinner than the tool is deep a column runs to the far face: the volume is then too small (the
+//! overlap taken as at least the columns' push); [`overlap_surfaces`](crate::overlap_surfaces) is
+//! exact there.
 
 use crate::query::QueryWorkspace;
 use crate::query::overlap::{Budget, OverlapResult};
@@ -25,9 +29,10 @@ use haptic_common::{Contact, ContactSet, Pose};
 /// Overlap of the tool A (its `shell` at `pose_a`) with the object B (its distance grid `b` at
 /// `pose_b`): the volume and one world-frame contact per group of leaves with surface inside B (a
 /// subtree about 8 of the shell's edges in radius; at the centroid of its columns, the normal out of B:
-/// the direction that pushes the tool out). The
-/// contacts' volumes are scaled so that their push (Σ volume × normal) has the overlap's volume as its
-/// magnitude, the penalty's convention.
+/// the direction that pushes the tool out). The contacts are turned together so that their push
+/// (Σ volume × normal) points the way out that shrinks the overlap fastest (`−∫ n dA` over the tool's
+/// surface inside B, exact whatever the depth), and their volumes scaled so that it has the overlap's
+/// volume as its magnitude, the penalty's convention.
 ///
 /// In the result `leaf_pairs` counts the shell's triangles inside B and `node_pairs` the shell's nodes
 /// visited. Contacts beyond `out`'s capacity still count in the volume; `out.truncated` is then set.
@@ -61,12 +66,15 @@ pub fn overlap_shell_budgeted(
     stack.push(0);
     let mut result = OverlapResult { complete: true, ..OverlapResult::default() };
     let mut until_clock = 0u32;
-    // The contacts' push, before its scaling.
+    // The contacts' push, before its scaling, and the way out: −∫ n dA over the tool's surface inside B.
     let mut push = Vec3::ZERO;
+    let mut surface = Surface::default();
     // The node whose subtree gathers into one contact while the stack stays above `group_floor`.
     let group_radius = GROUP_EDGES * shell.max_edge();
     let (mut group, mut group_floor) = (Group::default(), None);
-    let mut emit = |group: &mut Group, result: &mut OverlapResult, push: &mut Vec3| {
+    let mut emit = |group: &mut Group, result: &mut OverlapResult, push: &mut Vec3, surface: &mut Surface| {
+        surface.area += group.surface.area;
+        surface.way_out += group.surface.way_out;
         if let Some(contact) = group.contact() {
             result.total_volume += group.volume;
             let world = Contact {
@@ -105,17 +113,27 @@ pub fn overlap_shell_budgeted(
         // A node outside any group is its own; a group ends when its subtree is done.
         if group_floor.is_none_or(|floor| stack.len() <= floor) {
             group_floor = None;
-            emit(&mut group, &mut result, &mut push);
+            emit(&mut group, &mut result, &mut push, &mut surface);
         }
     }
-    emit(&mut group, &mut result, &mut push);
-    // The push's magnitude is the overlap's volume: on a flat face it is already (every column's normal
-    // is the face's); on a curved one the columns' normals spread, and the push is scaled back up.
+    emit(&mut group, &mut result, &mut push, &mut surface);
+    // The push's direction is the way out (the columns' agrees on a face; past the middle of a part of B
+    // thinner than the tool is deep a column runs to B's far face and points the push through it) and
+    // its magnitude the overlap's volume: on a flat face it is already (every column's normal is the
+    // face's); on a curved one the columns' normals spread, and the push is scaled back up.
+    let turn = surface.way_out(pose_b).map(|way| glam::Quat::from_rotation_arc(push.normalize_or_zero(), way));
     let magnitude = push.length();
+    // Past the middle of a thin part a column measures to the far face and its signed volume falls (to
+    // nothing or below), while its push (−g·(g·n)·φ, the same whichever face g comes from) holds up:
+    // the overlap is at least the push.
+    result.total_volume = result.total_volume.max(magnitude);
     if result.total_volume > 0.0 && magnitude > 0.0 {
         let scale = result.total_volume / magnitude;
         for contact in out.as_mut_slice() {
             contact.volume *= scale;
+            if let Some(turn) = turn {
+                contact.normal = turn * contact.normal;
+            }
         }
     }
     result.total_volume = result.total_volume.max(0.0);
@@ -158,6 +176,7 @@ fn measure_leaf(
         };
         let curvature = *curvature.get_or_insert_with(|| curvature_at(b, center, f));
         result.leaf_pairs += 1;
+        group.surface.add(n, column.area);
         group.add(column, g, g.dot(n), curvature);
     }
 }
@@ -279,6 +298,7 @@ struct Column {
     depth_squared: f32,
     depth_cubed: f32,
     deepest: f32,
+    area: f32,
 }
 
 impl Column {
@@ -288,6 +308,7 @@ impl Column {
         let [(x0, d0), (x1, d1), (x2, d2)] = piece;
         self.deepest = self.deepest.max(d0).max(d1).max(d2);
         let area = 0.5 * (x1 - x0).cross(x2 - x0).length();
+        self.area += area;
         let (sum_d, sum_x) = (d0 + d1 + d2, x0 + x1 + x2);
         self.depth += area * sum_d / 3.0;
         self.moment += area / 12.0 * (x0 * d0 + x1 * d1 + x2 * d2 + sum_x * sum_d);
@@ -296,6 +317,32 @@ impl Column {
         let cross = d0 * d0 * (d1 + d2) + d1 * d1 * (d0 + d2) + d2 * d2 * (d0 + d1);
         self.depth_cubed += area / 10.0 * (d0 * d0 * d0 + d1 * d1 * d1 + d2 * d2 * d2 + cross + d0 * d1 * d2);
     }
+}
+
+/// The tool's surface inside B: its area, and `−∫ n dA` over it (B's frame), the way the tool moves to
+/// shrink the overlap fastest (on a face, the face's normal).
+#[derive(Default)]
+struct Surface {
+    area: f32,
+    way_out: Vec3,
+}
+
+impl Surface {
+    /// A triangle's part inside B: its outward normal `n` and its area.
+    fn add(&mut self, n: Vec3, area: f32) {
+        self.area += area;
+        self.way_out -= n * area;
+    }
+
+    /// The way out in the world's frame, unless the tool is nearly sunk whole (its surface inside B
+    /// almost closed: no way out stands out, and the columns' push is kept).
+    fn way_out(&self, pose_b: &Pose) -> Option<Vec3> {
+        (self.way_out.length() > Self::OPEN * self.area).then(|| pose_b.transform_vector(self.way_out).normalize())
+    }
+
+    /// The least `|∫ n dA|` per unit of area for the way out to count (a ball sunk to 1.8 of its
+    /// diameter: 0.1).
+    const OPEN: f32 = 0.1;
 }
 
 /// The columns of one group of leaves: their volume, push and moment.
@@ -309,6 +356,7 @@ struct Group {
     weighted_point: Vec3,
     weight: f32,
     deepest: f32,
+    surface: Surface,
 }
 
 impl Group {
