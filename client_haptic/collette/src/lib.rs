@@ -22,7 +22,7 @@ pub use pipeline::{CollisionConfig, CollisionHandle, CollisionThread, ContactRea
 pub use query::{
     Budget, CoherenceStats, CoherentOverlap, OverlapResult, ProbeHit, QueryWorkspace, Separation, overlap,
     overlap_budgeted, overlap_field, overlap_field_budgeted, overlap_field_volume, overlap_shell,
-    overlap_shell_budgeted, overlap_surfaces, overlap_volume, probe, separation,
+    overlap_shell_budgeted, overlap_surfaces, overlap_surfaces_budgeted, overlap_volume, probe, separation,
 };
 pub use shape::{SignedDistanceGrid, Sphere, SurfaceShell, TriMesh};
 

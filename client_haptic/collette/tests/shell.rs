@@ -239,3 +239,51 @@ fn a_ball_pressed_beside_a_blocks_edge_is_pushed_the_way_out() {
     let off_way = force.normalize().angle_between(way).to_degrees();
     assert!(off_way < 1.0, "pushed {off_way}° off the way out {way}: {force}");
 }
+
+#[test]
+fn two_surfaces_cut_short_by_their_budget_answer_with_the_columns() {
+    let plate = mesh(box_buffers(Vec3::new(0.03, 0.002, 0.03)));
+    let (plate_shell, plate_grid) =
+        (SurfaceShell::new(&plate, 0.001).expect("shell"), SignedDistanceGrid::new(&plate, 128).expect("grid"));
+    let ball = mesh(uv_sphere_buffers(0.005, 48, 96));
+    let (ball_shell, ball_grid) =
+        (SurfaceShell::new(&ball, 0.0005).expect("shell"), SignedDistanceGrid::new(&ball, 64).expect("grid"));
+    let at = Pose::from_translation(Vec3::new(0.0, 0.004, 0.0));
+    let (mut ws, mut set) = (QueryWorkspace::new(), ContactSet::new());
+    let columns = collette::overlap_shell(&ball_shell, &at, &plate_grid, &Pose::IDENTITY, &mut ws, &mut set);
+    let column_contacts = set.as_slice().to_vec();
+    let whole = collette::overlap_surfaces(
+        &ball_shell,
+        &ball_grid,
+        &at,
+        &plate_shell,
+        &plate_grid,
+        &Pose::IDENTITY,
+        &mut ws,
+        &mut set,
+    );
+    assert!(whole.complete && set.len() == 1 && whole.node_pairs > columns.node_pairs + 10, "{whole:?}");
+    let mut run = |pairs| {
+        let result = collette::overlap_surfaces_budgeted(
+            &ball_shell,
+            &ball_grid,
+            &at,
+            &plate_shell,
+            &plate_grid,
+            &Pose::IDENTITY,
+            collette::Budget::NodePairs(pairs),
+            &mut ws,
+            &mut set,
+        );
+        (result, set.as_slice().to_vec())
+    };
+    // Cut short in the boundary: the columns' contacts, whole.
+    let (cut, contacts) = run(columns.node_pairs + 10);
+    assert!(!cut.complete && cut.total_volume == columns.total_volume && contacts == column_contacts, "{cut:?}");
+    // Cut short in the columns: part of them.
+    let (cut, contacts) = run(columns.node_pairs / 2);
+    assert!(!cut.complete && contacts.len() < column_contacts.len(), "{cut:?}");
+    // Budget enough: the whole answer.
+    let (enough, _) = run(whole.node_pairs);
+    assert!(enough.complete && enough.total_volume == whole.total_volume, "{enough:?}");
+}

@@ -95,6 +95,11 @@ impl<D: Device> Lockstep<D> {
         self.scene.set_surface(id, surface)
     }
 
+    /// See [`HapticRig::set_object_shell`](crate::HapticRig::set_object_shell).
+    pub fn set_object_shell(&mut self, id: u32, shell: Option<std::sync::Arc<collette::SurfaceShell>>) -> Result<()> {
+        self.scene.set_object_shell(id, shell)
+    }
+
     /// Replaces the tool.
     pub fn set_tool(&mut self, tool: ToolSpec) -> Result<()> {
         self.scene.set_tool(tool)

@@ -123,6 +123,11 @@ impl Parts {
         {
             return Err(full());
         }
+        if let Some(grid) = tool.surface
+            && !collision.set_surface(tool_pose.id(), Some(grid))
+        {
+            return Err(full());
+        }
         let proxy = config.rendering == Rendering::Proxy;
         // The tool against every object, in one buffer.
         let scene_input = match proxy {
@@ -309,6 +314,15 @@ impl<D: Device + 'static> HapticRig<D> {
     /// tool much smaller than the object (docs/collette.md, *Volume accuracy*).
     pub fn set_surface(&self, id: u32, surface: Option<std::sync::Arc<collette::SignedDistanceGrid>>) -> Result<()> {
         self.with_scene(|s| s.set_surface(id, surface))
+    }
+
+    /// Gives object `id` its surface shell (`collette::SurfaceShell::new(&mesh, max_edge)` of the mesh
+    /// its tree was built from; `None` takes it away): with its surface grid
+    /// ([`set_surface`](Self::set_surface)) and a tool that has both ([`ToolSpec::with_surface`]), the
+    /// force is measured from both surfaces (`collette::overlap_surfaces`), right past the middle of the
+    /// object's thin parts too.
+    pub fn set_object_shell(&self, id: u32, shell: Option<std::sync::Arc<collette::SurfaceShell>>) -> Result<()> {
+        self.with_scene(|s| s.set_object_shell(id, shell))
     }
 
     /// Only checks the objects whose bounds touch `region`, scene frame (the paper's ColletteVolume;

@@ -266,11 +266,14 @@ impl Scene {
         if self.forces.slots() == 0 {
             return Err(RigError::QueueFull("haptic"));
         }
-        // The tree and the shell (or none: an old tool's would be wrong) together.
-        if self.collision.free_commands() < 2 {
+        // The tree, the shell and the grid (or none: an old tool's would be wrong) together.
+        if self.collision.free_commands() < 3 {
             return Err(RigError::QueueFull("collision"));
         }
-        if !self.collision.set_tree(self.tool, tool.tree) || !self.collision.set_shell(self.tool, tool.shell) {
+        if !self.collision.set_tree(self.tool, tool.tree)
+            || !self.collision.set_shell(self.tool, tool.shell)
+            || !self.collision.set_surface(self.tool, tool.surface)
+        {
             return Err(RigError::QueueFull("collision"));
         }
         let command = ForceCommand::SetTool { center_of_mass: tool.center_of_mass, material: tool.material };
@@ -294,6 +297,17 @@ impl Scene {
         // The 3-DOF proxy holds the tip on the grid (on the haptic thread).
         let command = ForceCommand::Surface { slot: entry.object.0, grid: surface };
         self.forces.push(command).map_err(|_| RigError::QueueFull("haptic"))
+    }
+
+    /// Gives object `id` its surface shell (`None`: takes it away).
+    pub(crate) fn set_object_shell(
+        &mut self,
+        id: u32,
+        shell: Option<std::sync::Arc<collette::SurfaceShell>>,
+    ) -> Result<()> {
+        self.free_returned();
+        let entry = self.entries.iter().find(|e| e.id == id).ok_or(RigError::UnknownObject(id))?;
+        if self.collision.set_shell(entry.object, shell) { Ok(()) } else { Err(RigError::QueueFull("collision")) }
     }
 
     /// Only checks objects whose bounds touch `region` (`None`: everywhere).

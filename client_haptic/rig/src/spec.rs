@@ -47,13 +47,16 @@ pub struct ToolSpec {
     /// the tool's surface is measured instead of its spheres (exact on flat faces at any depth, see
     /// [`ToolSpec::with_shell`]). `None`: its spheres.
     pub shell: Option<Arc<collette::SurfaceShell>>,
+    /// Its own surface grid (with a shell): against an object that has a shell and a grid too, both
+    /// surfaces are measured (see [`ToolSpec::with_surface`]). `None`: its shell's columns alone.
+    pub surface: Option<Arc<collette::SignedDistanceGrid>>,
 }
 
 impl ToolSpec {
     /// A tool whose centre of mass is the volume-weighted centre of its inner spheres.
     pub fn new(tree: Arc<collette::InnerSphereTree>, material: Material) -> Self {
         let center_of_mass = center_of_mass(&tree);
-        Self { tree, center_of_mass, material, shell: None }
+        Self { tree, center_of_mass, material, shell: None, surface: None }
     }
 
     /// The same tool with its surface shell (`SurfaceShell::new(&mesh, max_edge)` of the mesh its tree
@@ -63,6 +66,18 @@ impl ToolSpec {
     /// benchmark finds exact on flat faces and edges down to 0.1 mm (docs/haptics.md).
     pub fn with_shell(mut self, shell: Arc<collette::SurfaceShell>) -> Self {
         self.shell = Some(shell);
+        self
+    }
+
+    /// The same tool with its surface grid too (`SignedDistanceGrid::new(&mesh, resolution)` of the
+    /// same mesh; with its shell, [`ToolSpec::with_shell`]): against an object that has a shell and a
+    /// grid ([`crate::HapticRig::set_object_shell`], [`crate::HapticRig::set_surface`]) the collision
+    /// thread then measures both surfaces, the overlap's whole boundary (`collette::overlap_surfaces`),
+    /// right however deep the tool goes: past the middle of a thin part of the object the shell's
+    /// columns alone run to its far face and measure too little. It costs about three times the columns;
+    /// a step cut short by its time budget falls back on the columns.
+    pub fn with_surface(mut self, grid: Arc<collette::SignedDistanceGrid>) -> Self {
+        self.surface = Some(grid);
         self
     }
 }

@@ -110,3 +110,53 @@ fn a_tool_with_its_surface_shell_is_measured_by_its_surface_until_it_is_replaced
     let back = both[499];
     assert!((back - spheres[499]).length() <= 0.05 * spheres[499].length(), "the spheres' again: {back}");
 }
+
+/// The overlap volume (m³) and the tool's height (m) after 300 ticks of the ball tool held 4.5 mm into
+/// a 4 mm plate (past its middle), the plate with its grid and shell, the tool with its shell and, when
+/// `tool_grid`, its grid.
+fn press_through_plate(tool_grid: bool) -> (f32, f32) {
+    let (v, t) = box_buffers(Vec3::new(0.03, 0.002, 0.03));
+    let plate = TriMesh::new(v, t).expect("plate");
+    let (plate_tree, _) =
+        collette::build(&plate, &collette::BuildOptions::spheres(600), &mut |_| {}).expect("plate tree");
+    let (v, t) = uv_sphere_buffers(0.005, 48, 96);
+    let ball = TriMesh::new(v, t).expect("ball");
+    let mut tool = ToolSpec::new(utils::ball_tool(), forcecomp::Material::default())
+        .with_shell(Arc::new(SurfaceShell::new(&ball, 0.0005).expect("shell")));
+    if tool_grid {
+        tool = tool.with_surface(Arc::new(SignedDistanceGrid::new(&ball, 64).expect("ball grid")));
+    }
+    let centre = Vec3::new(0.001, 0.0025, -0.002);
+    let device = SimDevice::new(SimConfig::new(presets::touch()), TargetPath::line(centre, centre, 1.0));
+    let mut rig = Lockstep::new(device, tool, &RigConfig::default(), 1, None).expect("rig");
+    let object = haptic_rig::ObjectSpec {
+        id: 1,
+        tree: Arc::new(plate_tree),
+        pose: haptic_common::Pose::IDENTITY,
+        material: forcecomp::Material::default(),
+    };
+    rig.add_object(object).expect("plate");
+    rig.set_surface(1, Some(Arc::new(SignedDistanceGrid::new(&plate, 128).expect("plate grid")))).expect("grid");
+    rig.set_object_shell(1, Some(Arc::new(SurfaceShell::new(&plate, 0.001).expect("plate shell")))).expect("shell");
+    for i in 0..300 {
+        rig.tick(i * 1000);
+    }
+    let telemetry = rig.telemetry();
+    let contact = telemetry.objects()[0];
+    (contact.volume, telemetry.tool_pose.translation.y)
+}
+
+#[test]
+fn a_tool_with_its_shell_and_grid_measures_both_surfaces_past_the_middle_of_a_thin_plate() {
+    // The ball's cap under the plate's top face (y = 2 mm), for the ball's centre at `y`.
+    let cap = |y: f32| {
+        let (r, h) = (0.005f32, 0.002 - (y - 0.005));
+        std::f32::consts::PI * h * h * (3.0 * r - h) / 3.0
+    };
+    let (both, y) = press_through_plate(true);
+    assert!(y - 0.005 < -0.001, "the ball's bottom past the plate's middle: centre at {y}");
+    assert!((both / cap(y) - 1.0).abs() < 0.03, "both surfaces: {both} m³ against the cap's {}", cap(y));
+    // The tool's columns alone run to the plate's far face.
+    let (columns, y) = press_through_plate(false);
+    assert!((columns / cap(y) - 1.0).abs() > 0.1, "the columns alone: {columns} m³ against {}", cap(y));
+}

@@ -310,7 +310,9 @@ impl CollisionHandle {
     /// Gives object `id` its surface shell, split from the mesh its tree was built from (`None` takes it
     /// away): from the next step, pairs watching it as A against a B with a surface grid measure A's
     /// surface against B's (`overlap_shell_budgeted`: exact on flat faces at any depth, see
-    /// docs/collette.md). False when the command ring is full.
+    /// docs/collette.md); when A has a grid and B a shell too, both surfaces
+    /// (`overlap_surfaces_budgeted`: exact past the middle of B's thin parts as well). False when the
+    /// command ring is full.
     pub fn set_shell(&mut self, id: ObjectId, shell: Option<Arc<SurfaceShell>>) -> bool {
         self.collect_retired();
         self.commands.push(Command::SetShell(id, shell)).is_ok()

@@ -8,7 +8,8 @@ use super::track::PoseTrack;
 use crate::bounding_volume::Aabb;
 use crate::partitioning::InnerSphereTree;
 use crate::query::{
-    Budget, QueryWorkspace, overlap_budgeted, overlap_field_budgeted, overlap_shell_budgeted, spheres_near,
+    Budget, QueryWorkspace, overlap_budgeted, overlap_field_budgeted, overlap_shell_budgeted,
+    overlap_surfaces_budgeted, spheres_near,
 };
 use crate::shape::{SignedDistanceGrid, SurfaceShell};
 use glam::Vec3;
@@ -212,7 +213,8 @@ pub enum Command {
     /// watch it as B then measure A's spheres against its surface (`overlap_field_budgeted`).
     SetSurface(ObjectId, Option<Arc<SignedDistanceGrid>>),
     /// Gives the object in slot `id` its surface shell (`None`: takes it away): pairs that watch it as A
-    /// against a B with a surface grid then measure A's surface against B's (`overlap_shell_budgeted`).
+    /// against a B with a surface grid then measure A's surface against B's (`overlap_shell_budgeted`),
+    /// and both surfaces when A has a grid and B a shell too (`overlap_surfaces_budgeted`).
     SetShell(ObjectId, Option<Arc<SurfaceShell>>),
     /// Empties slot `id`.
     RemoveObject(ObjectId),
@@ -672,11 +674,17 @@ fn set_part<T>(
 }
 
 /// A's spheres against B's tree, or against B's surface grid when it has one (A's surface when A has
-/// a shell), into `set`; false when the budget cut the query short.
+/// a shell; both surfaces when both have a shell and a grid), into `set`; false when the budget cut the
+/// query short.
 fn measure(a: &ObjectSlot, b: &ObjectSlot, budget: Budget, ws: &mut QueryWorkspace, set: &mut ContactSet) -> bool {
     let (pa, pb) = (&a.now.pose, &b.now.pose);
     let result = match (b.surface.as_deref(), a.shell.as_deref()) {
-        (Some(grid), Some(shell)) => overlap_shell_budgeted(shell, pa, grid, pb, budget, ws, set),
+        (Some(grid), Some(shell)) => match (a.surface.as_deref(), b.shell.as_deref()) {
+            (Some(a_grid), Some(b_shell)) => {
+                overlap_surfaces_budgeted(shell, a_grid, pa, b_shell, grid, pb, budget, ws, set)
+            }
+            _ => overlap_shell_budgeted(shell, pa, grid, pb, budget, ws, set),
+        },
         (Some(grid), None) => overlap_field_budgeted(&a.tree, pa, &b.tree, grid, pb, budget, ws, set),
         (None, _) => overlap_budgeted(&a.tree, pa, &b.tree, pb, budget, ws, set),
     };

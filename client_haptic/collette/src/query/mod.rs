@@ -19,7 +19,7 @@ pub use field::{overlap_field, overlap_field_budgeted, overlap_field_volume};
 pub use overlap::{Budget, CoherenceStats, CoherentOverlap, OverlapResult, overlap, overlap_budgeted, overlap_volume};
 pub use probe::{ProbeHit, probe, spheres_near};
 pub use shell::{overlap_shell, overlap_shell_budgeted};
-pub use surfaces::overlap_surfaces;
+pub use surfaces::{overlap_surfaces, overlap_surfaces_budgeted};
 pub use workspace::QueryWorkspace;
 
 pub use haptic_common::{Contact, ContactSet, Pose};

@@ -14,7 +14,7 @@
 //! depth where A's grid cannot draw B's part (blended smoothly from two voxels deep to six).
 
 use crate::query::QueryWorkspace;
-use crate::query::overlap::OverlapResult;
+use crate::query::overlap::{Budget, OverlapResult};
 use crate::query::shell::{inside_pieces, leaf_triangles, outside};
 use crate::shape::{SignedDistanceGrid, SurfaceShell};
 use glam::{DVec3, Vec3};
@@ -37,13 +37,50 @@ pub fn overlap_surfaces(
     ws: &mut QueryWorkspace,
     out: &mut ContactSet,
 ) -> OverlapResult {
-    out.clear();
-    let mut result = OverlapResult { complete: true, ..OverlapResult::default() };
+    overlap_surfaces_budgeted(a_shell, a_grid, pose_a, b_shell, b_grid, pose_b, Budget::Unlimited, ws, out)
+}
+
+/// [`overlap_surfaces`] that stops when `budget` runs out. A's columns
+/// ([`overlap_shell`](crate::overlap_shell)) come first, then the boundary; cut short in the boundary,
+/// it answers with the columns' contacts (their push the way out, exact on faces at any depth), cut
+/// short in the columns, with the part of them it measured. Either way `complete` is false.
+#[allow(clippy::too_many_arguments)]
+pub fn overlap_surfaces_budgeted(
+    a_shell: &SurfaceShell,
+    a_grid: &SignedDistanceGrid,
+    pose_a: &Pose,
+    b_shell: &SurfaceShell,
+    b_grid: &SignedDistanceGrid,
+    pose_b: &Pose,
+    budget: Budget,
+    ws: &mut QueryWorkspace,
+    out: &mut ContactSet,
+) -> OverlapResult {
+    let columns = super::shell::overlap_shell_budgeted(a_shell, pose_a, b_grid, pose_b, budget, ws, out);
+    if !columns.complete || columns.total_volume <= 0.0 {
+        return columns;
+    }
+    let (mut force, mut moment, mut listed, mut deepest) = (Vec3::ZERO, Vec3::ZERO, 0.0f32, 0.0f32);
+    for c in out.as_slice() {
+        force += c.normal * c.volume;
+        moment += c.point * c.volume;
+        listed += c.volume;
+        deepest = deepest.max(c.depth);
+    }
+    let mut result = OverlapResult { complete: true, node_pairs: columns.node_pairs, ..OverlapResult::default() };
     // Sums in the world frame, about a point near the overlap (A's centre) to keep them small.
     let origin = pose_a.transform_point(a_shell.bound().0);
     let mut sums = Boundary::default();
-    boundary(a_shell, pose_a, b_grid, pose_b, origin, Side::A, ws, &mut sums, &mut result);
-    boundary(b_shell, pose_b, a_grid, pose_a, origin, Side::B, ws, &mut sums, &mut result);
+    let mut until_clock = 0;
+    let mut pass = |shell, pose, grid, grid_pose, side, sums: &mut Boundary, result: &mut OverlapResult| {
+        boundary(shell, pose, grid, grid_pose, origin, side, (budget, &mut until_clock), ws, sums, result)
+    };
+    if !pass(a_shell, pose_a, b_grid, pose_b, Side::A, &mut sums, &mut result)
+        || !pass(b_shell, pose_b, a_grid, pose_a, Side::B, &mut sums, &mut result)
+    {
+        // `out` still holds the columns' contacts.
+        return OverlapResult { complete: false, node_pairs: result.node_pairs, ..columns };
+    }
     // The two parts, each clipped by the other's interpolated distance, meet along nearly the same curve:
     // what the boundary misses there counts in proportion to its distance from the origin, so the sums
     // move to the middle of A's part (beside that curve for a shallow overlap, whose small volume is the
@@ -53,37 +90,24 @@ pub fn overlap_surfaces(
     let delta = if sums.a_total > 0.0 { sums.a_moment / sums.a_total } else { DVec3::ZERO };
     // ∮ y·n dA is the sum of the per-axis ∮ y_k n_k dA.
     let volume = (sums.first.element_sum() - delta.dot(closure)) / 3.0;
-    let moment = sums.moment * 0.5 - delta * sums.first + delta * delta * closure * 0.5;
+    let boundary_moment = sums.moment * 0.5 - delta * sums.first + delta * delta * closure * 0.5;
     // The two parts' ways out agree on a closed boundary; their mean halves what either misses.
     let out_of_b = (sums.b_area - sums.a_area) * 0.5;
     let mut closed = None;
     if volume > 0.0
         && let Some(normal) = out_of_b.as_vec3().try_normalize()
     {
-        closed = Some((volume as f32, origin + (delta + moment / volume).as_vec3(), normal));
+        closed = Some((volume as f32, origin + (delta + boundary_moment / volume).as_vec3(), normal));
     }
     // B's part is clipped by A's grid, which cannot draw an overlap thinner than a few of its voxels (a
     // box's corner 0.1 mm in); A's columns are exact there on any face. So: the columns up to two of A's
-    // voxels deep, the boundary from six, blended smoothly between (the columns not measured at all
-    // where they would weigh nothing). A's deepest point inside B is the one the columns would report.
-    let (deepest, voxel) = (sums.deepest, a_grid.voxel_size());
+    // voxels deep, the boundary from six, blended smoothly between. A's deepest point inside B is the
+    // one the columns report.
+    let voxel = a_grid.voxel_size();
     let t = ((deepest - 2.0 * voxel) / (4.0 * voxel)).clamp(0.0, 1.0);
     let w = t * t * (3.0 - 2.0 * t);
-    let mut column = None;
-    if w < 1.0 {
-        let columns = super::shell::overlap_shell(a_shell, pose_a, b_grid, pose_b, ws, out);
-        let (mut force, mut moment, mut listed) = (Vec3::ZERO, Vec3::ZERO, 0.0f32);
-        for c in out.as_slice() {
-            force += c.normal * c.volume;
-            moment += c.point * c.volume;
-            listed += c.volume;
-        }
-        column = (columns.total_volume > 0.0 && listed > 0.0)
-            .then(|| force.try_normalize().map(|n| (columns.total_volume, moment / listed, n)))
-            .flatten();
-        // The same triangles of A were counted in the boundary's pass; its nodes were visited again.
-        result.node_pairs += columns.node_pairs;
-    }
+    let column =
+        (listed > 0.0).then(|| force.try_normalize().map(|n| (columns.total_volume, moment / listed, n))).flatten();
     let blended = match (column, closed) {
         (Some(c), Some(b)) => {
             Some((c.0 + (b.0 - c.0) * w, c.1 + (b.1 - c.1) * w, (c.2 + (b.2 - c.2) * w).normalize_or(b.2)))
@@ -121,8 +145,6 @@ struct Boundary {
     /// ∫ n dA over A's part and over B's part.
     a_area: DVec3,
     b_area: DVec3,
-    /// The deepest point of A's part inside B, m.
-    deepest: f32,
 }
 
 /// Adds the part of `shell` (at `pose`) inside the object of `grid` (at `grid_pose`) to `sums`.
@@ -134,16 +156,20 @@ fn boundary(
     grid_pose: &Pose,
     origin: Vec3,
     side: Side,
+    (budget, until_clock): (Budget, &mut u32),
     ws: &mut QueryWorkspace,
     sums: &mut Boundary,
     result: &mut OverlapResult,
-) {
+) -> bool {
     let into_grid = grid_pose.relative_to(pose);
     let nodes = shell.nodes();
     let stack = &mut ws.nodes;
     stack.clear();
     stack.push(0);
     while let Some(n) = stack.pop() {
+        if budget.spent(result.node_pairs, until_clock) {
+            return false;
+        }
         result.node_pairs += 1;
         let node = nodes[n as usize];
         let center = into_grid.transform_point(node.center);
@@ -171,7 +197,6 @@ fn boundary(
                 sums.first += normal * sum * (area / 3.0);
                 match side {
                     Side::A => {
-                        sums.deepest = piece.iter().fold(sums.deepest, |d, c| d.max(c.1));
                         sums.a_area += normal * area;
                         sums.a_moment += sum * (area / 3.0);
                         sums.a_total += area;
@@ -184,4 +209,5 @@ fn boundary(
             }
         }
     }
+    true
 }
