@@ -371,11 +371,17 @@ pub(crate) fn sync_tool(
     if watched.tool == Some(key) {
         return;
     }
-    let (tree, shell) = tree
-        .map_or_else(|| (SphereTree::ball(tool.tip_radius_m).tree, None), |(_, t)| (t.tree.clone(), t.shell.clone()));
+    let (tree, shell, surface) = tree.map_or_else(
+        || (SphereTree::ball(tool.tip_radius_m).tree, None, None),
+        |(_, t)| (t.tree.clone(), t.shell.clone(), t.surface.clone()),
+    );
     let mut spec = ToolSpec::new(tree, key.material.map_or_else(rigid_tool, |m| m.material()));
+    // The tool's grid matters with its shell: both surfaces against a collider that has both.
     if let Some(shell) = shell {
         spec = spec.with_shell(shell);
+        if let Some(surface) = surface {
+            spec = spec.with_surface(surface);
+        }
     }
     match runtime.rig(|rig| rig.set_tool(spec)) {
         Some(Err(e)) => warn!("the tool's tree waits: {e}"),
@@ -494,13 +500,14 @@ pub(crate) fn send_colliders(
         };
         let material = force.copied().unwrap_or_default().material();
         let spec = ObjectSpec { id, tree: Arc::clone(&tree.tree), pose: pose_of(transform), material };
-        let surface = tree.surface.clone();
+        let (surface, shell) = (tree.surface.clone(), tree.shell.clone());
         let added = runtime.rig(|rig| {
             match pushable {
                 Some(p) => rig.add_pushable(spec, p.mass_kg),
                 None => rig.add_object(spec),
             }
             .and_then(|()| rig.set_surface(id, surface))
+            .and_then(|()| rig.set_object_shell(id, shell))
         });
         match added {
             Some(Err(e @ haptic_rig::RigError::BadMass { .. })) => {

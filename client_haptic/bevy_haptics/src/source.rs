@@ -24,12 +24,18 @@ pub struct SphereTreeSource {
     pub spheres: usize,
     /// Metres per unit of a mesh (default 1; a tree file is in metres).
     pub scale: f32,
+    /// Voxels of a mesh's surface grid along its longest side (default 0: none; see
+    /// [`SphereTreeSettings::surface_voxels`]).
+    pub surface_voxels: usize,
+    /// Longest edge of a mesh's surface shell, m (default 0: none; see
+    /// [`SphereTreeSettings::shell_edge_m`]).
+    pub shell_edge_m: f32,
 }
 
 impl Default for SphereTreeSource {
     fn default() -> Self {
-        let SphereTreeSettings { spheres, scale } = SphereTreeSettings::default();
-        Self { path: String::new(), spheres, scale }
+        let SphereTreeSettings { spheres, scale, surface_voxels, shell_edge_m } = SphereTreeSettings::default();
+        Self { path: String::new(), spheres, scale, surface_voxels, shell_edge_m }
     }
 }
 
@@ -43,13 +49,15 @@ pub(crate) fn load_sources(
     mut sources: Query<Source, Changed<SphereTreeSource>>,
 ) {
     for (entity, source, tool, collider) in &mut sources {
-        let (spheres, scale) = (source.spheres, source.scale);
+        let settings = SphereTreeSettings {
+            spheres: source.spheres,
+            scale: source.scale,
+            surface_voxels: source.surface_voxels,
+            shell_edge_m: source.shell_edge_m,
+        };
         let tree: Handle<SphereTree> = assets
             .load_builder()
-            .with_settings(move |s: &mut SphereTreeSettings| {
-                s.spheres = spheres;
-                s.scale = scale;
-            })
+            .with_settings(move |s: &mut SphereTreeSettings| *s = settings)
             .load(source.path.clone());
         match (tool, collider) {
             (Some(mut tool), _) => tool.tree = Some(tree),

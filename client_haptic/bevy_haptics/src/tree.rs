@@ -18,9 +18,11 @@ use serde::{Deserialize, Serialize};
 /// An Inner Sphere Tree: the spheres packed inside a closed mesh, in the mesh's frame (metres), as the
 /// collision thread measures it (the paper's sphere-tree asset); optionally with the mesh's surface as a
 /// signed distance grid, against which volumetric rendering measures the tool's spheres (the overlap
-/// within about 1 % of the true one, and no bumps of the packing under a smooth surface); and, for a
-/// tool, optionally with its surface shell, measured instead of its spheres against a collider's grid
-/// (exact on flat faces at any depth, a box's corner too).
+/// within about 1 % of the true one, and no bumps of the packing under a smooth surface); and
+/// optionally with its surface shell: a tool's is measured instead of its spheres against a collider's
+/// grid (exact on flat faces at any depth, a box's corner too), and when the tool and the collider
+/// both have a shell and a grid, both surfaces are (the overlap's whole boundary: right past the
+/// middle of a collider's thin parts too).
 #[derive(Asset, TypePath, Clone, Debug)]
 pub struct SphereTree {
     /// The tree.
@@ -28,7 +30,8 @@ pub struct SphereTree {
     /// The mesh's surface, in the same frame (`None`: the tree's spheres stand for it).
     pub surface: Option<Arc<SignedDistanceGrid>>,
     /// The mesh's surface split into small triangles, in the same frame: used when this tree is the
-    /// tool's and the collider it touches has a `surface` (`None`: the tool's spheres are measured).
+    /// tool's and the collider it touches has a `surface` (`None`: the tool's spheres are measured),
+    /// and a collider's when the tool has a shell and a `surface` too (both surfaces measured).
     pub shell: Option<Arc<SurfaceShell>>,
 }
 
@@ -45,13 +48,36 @@ impl SphereTree {
         self
     }
 
-    /// This tool's tree with `shell` (collette's [`SurfaceShell::new`] of the same mesh, e.g. 0.5 mm
-    /// edges: milliseconds for a 1 cm gem): against a collider with a surface grid, the tool's surface
-    /// is measured instead of its spheres (docs/haptics.md, *Fidelity against exact answers*; it costs
-    /// more on deep contacts: about 0.5 ms for a 1 cm gem 5 mm in).
+    /// This tree with `shell` (collette's [`SurfaceShell::new`] of the same mesh, e.g. 0.5 mm edges:
+    /// milliseconds for a 1 cm gem): a tool's surface is measured instead of its spheres against a
+    /// collider with a surface grid (docs/haptics.md, *Fidelity against exact answers*; it costs more on
+    /// deep contacts: about 0.5 ms for a 1 cm gem 5 mm in); a tool with a shell and a surface grid
+    /// against a collider with both measures both surfaces (about 0.25 ms for the gem 1 mm in, 1.2 ms
+    /// 5 mm in, where a collision step's budget falls back on the tool's surface alone).
     pub fn with_shell(mut self, shell: SurfaceShell) -> Self {
         self.shell = Some(Arc::new(shell));
         self
+    }
+
+    /// This tree with its mesh's surfaces, built from `mesh` (the one the tree was packed into, in the
+    /// same frame): a surface grid of `grid_voxels` along the mesh's longest side (0: none; see
+    /// [`with_surface`](Self::with_surface)) and a shell of edges at most `shell_edge_m` (0: none; see
+    /// [`with_shell`](Self::with_shell)). With both on the tool and on a collider, both surfaces are
+    /// measured. Takes about a second for the bunny at 128 voxels and 1 mm edges: off the game thread.
+    pub fn with_surfaces_of(
+        mut self,
+        mesh: &TriMesh,
+        grid_voxels: usize,
+        shell_edge_m: f32,
+    ) -> Result<Self, SphereTreeError> {
+        let failed = |e: collette::BuildError| SphereTreeError::Build(e.to_string());
+        if grid_voxels > 0 {
+            self = self.with_surface(SignedDistanceGrid::new(mesh, grid_voxels).map_err(failed)?);
+        }
+        if shell_edge_m > 0.0 {
+            self = self.with_shell(SurfaceShell::new(mesh, shell_edge_m).map_err(failed)?);
+        }
+        Ok(self)
     }
 
     /// One sphere of `radius_m` at the origin: a ball tip.
@@ -121,11 +147,19 @@ pub struct SphereTreeSettings {
     pub spheres: usize,
     /// The mesh's vertices are multiplied by this, to metres (default 1).
     pub scale: f32,
+    /// Voxels of its surface grid along the mesh's longest side (default 0: no grid; 100–150 for a
+    /// collider, see [`SphereTree::with_surface`]).
+    #[serde(default)]
+    pub surface_voxels: usize,
+    /// Longest edge of its surface shell, m (default 0: no shell; 0.5–1 mm, see
+    /// [`SphereTree::with_shell`]).
+    #[serde(default)]
+    pub shell_edge_m: f32,
 }
 
 impl Default for SphereTreeSettings {
     fn default() -> Self {
-        Self { spheres: 2_000, scale: 1.0 }
+        Self { spheres: 2_000, scale: 1.0, surface_voxels: 0, shell_edge_m: 0.0 }
     }
 }
 
@@ -153,7 +187,11 @@ impl AssetLoader for SphereTreeLoader {
         let mesh = TriMesh::from_obj_bytes(&bytes, context.path().path())
             .and_then(|m| m.map_vertices(|v| v * settings.scale))
             .map_err(|e| SphereTreeError::Mesh(e.to_string()))?;
-        SphereTree::build(&mesh, settings.spheres)
+        SphereTree::build(&mesh, settings.spheres)?.with_surfaces_of(
+            &mesh,
+            settings.surface_voxels,
+            settings.shell_edge_m,
+        )
     }
 
     fn extensions(&self) -> &[&str] {
