@@ -66,6 +66,15 @@ struct Args {
     /// the real intersection for a tool this much smaller than the object (docs/collette.md).
     #[arg(long)]
     surface: bool,
+    /// With `--surface`: the gemstone's surface split to edges of at most this many millimetres (its
+    /// shell), measured instead of its spheres against the bunny's grid (`collette::overlap_shell`);
+    /// 0: its spheres.
+    #[arg(long, default_value_t = 0.0)]
+    shell_edge_mm: f32,
+    /// With `--shell-edge-mm`: the gemstone's grid (64 voxels) and the bunny's shell (edges as long) too,
+    /// so that both surfaces are measured (`collette::overlap_surfaces_budgeted`).
+    #[arg(long)]
+    both_surfaces: bool,
     /// Scatter this many small objects (1.2 cm balls and boxes of 300 spheres) around the bunny, in the
     /// tool's way: a whole scene for the collision thread's broad phase (at most 255 beside the bunny).
     #[arg(long, default_value_t = 0)]
@@ -112,6 +121,12 @@ fn run() -> anyhow::Result<()> {
     let specs =
         presets::by_name(&args.device).with_context(|| format!("no device preset matches {:?}", args.device))?;
 
+    if args.shell_edge_mm != 0.0 && !(args.surface && (0.2..=10.0).contains(&args.shell_edge_mm)) {
+        anyhow::bail!("--shell-edge-mm takes 0.2 to 10 (mm) and needs --surface, not {}", args.shell_edge_mm);
+    }
+    if args.both_surfaces && args.shell_edge_mm == 0.0 {
+        anyhow::bail!("--both-surfaces needs --shell-edge-mm (and --surface)");
+    }
     let locked = args.realtime.is_some() && haptico::timing::lock_memory();
     let started = Instant::now();
     let bunny_mesh = scene::load_bunny(scene::default_bunny_path()).context("loading the bunny")?;
@@ -129,12 +144,31 @@ fn run() -> anyhow::Result<()> {
         }
         false => None,
     };
+    let edge_m = args.shell_edge_mm * 1e-3;
+    let shell_of = |mesh, what| match edge_m > 0.0 {
+        true => collette::SurfaceShell::new(mesh, edge_m).map(Arc::new).map(Some).context(what),
+        false => Ok(None),
+    };
+    let gem_shell = shell_of(&gem_mesh, "the gemstone's shell")?;
+    let (gem_grid, bunny_shell) = match args.both_surfaces {
+        true => (
+            Some(Arc::new(collette::SignedDistanceGrid::new(&gem_mesh, 64).context("the gemstone's grid")?)),
+            shell_of(&bunny_mesh, "the bunny's shell")?,
+        ),
+        false => (None, None),
+    };
     eprintln!(
-        "haptic-bench: trees built in {:.1} s ({} bunny spheres, {} tool spheres{})",
+        "haptic-bench: trees built in {:.1} s ({} bunny spheres, {} tool spheres{}{}{})",
         started.elapsed().as_secs_f64(),
         bunny.spheres().len(),
         gem.spheres().len(),
-        if surface.is_some() { ", the bunny's distance grid" } else { "" }
+        if surface.is_some() { ", the bunny's distance grid" } else { "" },
+        gem_shell
+            .as_ref()
+            .map_or(String::new(), |s| format!(", the gemstone's shell of {} triangles", s.triangles().len())),
+        bunny_shell
+            .as_ref()
+            .map_or(String::new(), |s| format!(", the bunny's of {} and the gemstone's grid", s.triangles().len())),
     );
 
     // The hand follows the scripted tool path (or a recorded trace); the device frame is the scene
@@ -188,10 +222,17 @@ fn run() -> anyhow::Result<()> {
         ..RigConfig::default()
     };
     // Stiff enough for newtons at a few millimetres, soft enough that the deep stretch really goes deep.
-    let tool = ToolSpec::new(
+    let mut tool = ToolSpec::new(
         Arc::new(gem),
         Material { stiffness_n_per_m3: 5e8, damping_ns_per_m: 4.0, friction: 0.3, texture: None },
     );
+    if let Some(shell) = gem_shell {
+        tool = tool.with_shell(shell);
+    }
+    if let Some(grid) = gem_grid {
+        tool = tool.with_surface(grid);
+    }
+    let surface = BunnySurface { grid: surface, shell: bunny_shell };
     let bunny_material = Material { stiffness_n_per_m3: 5e7, damping_ns_per_m: 4.0, friction: 0.3, texture: None };
     let bunny = ObjectSpec { id: 1, tree: Arc::new(bunny), pose: Pose::IDENTITY, material: bunny_material };
     let scattered = scatter(args.objects, &bunny_mesh, &bunny_material)?;
@@ -204,9 +245,8 @@ fn run() -> anyhow::Result<()> {
     for object in scattered {
         rig.add_object(object)?;
     }
-    if surface.is_some() {
-        rig.set_surface(id, surface)?;
-    }
+    rig.set_surface(id, surface.grid)?;
+    rig.set_object_shell(id, surface.shell)?;
 
     let mut haptic = Vec::with_capacity(ticks);
     let mut collision = Vec::with_capacity(ticks);
@@ -321,6 +361,8 @@ fn run() -> anyhow::Result<()> {
             "device": specs.name,
             "rendering": args.rendering,
             "surface": args.surface,
+            "shell_edge_mm": args.shell_edge_mm,
+            "both_surfaces": args.both_surfaces,
             "realtime": haptic_telemetry.realtime,
             "memory_locked": locked,
             "windows_below_target_haptic": low_haptic,
@@ -335,6 +377,12 @@ fn run() -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The bunny's surface grid (`--surface`) and shell (`--both-surfaces`).
+struct BunnySurface {
+    grid: Option<Arc<collette::SignedDistanceGrid>>,
+    shell: Option<Arc<collette::SurfaceShell>>,
+}
+
 /// The run on simulated time (`--lockstep`): every tick of the scripted path, or of the replayed
 /// trace at its own times; with a replay of a trace holding commands, how many ticks' forces are the
 /// recorded ones to the bit.
@@ -342,7 +390,7 @@ fn lockstep(
     args: &Args,
     device: Box<dyn Device>,
     tool: ToolSpec,
-    (bunny, surface, scattered): (ObjectSpec, Option<Arc<collette::SignedDistanceGrid>>, Vec<ObjectSpec>),
+    (bunny, surface, scattered): (ObjectSpec, BunnySurface, Vec<ObjectSpec>),
     config: &RigConfig,
     replay: Option<&Trace>,
     recording: Option<TraceWriter>,
@@ -362,9 +410,8 @@ fn lockstep(
     for object in scattered {
         rig.add_object(object)?;
     }
-    if surface.is_some() {
-        rig.set_surface(id, surface)?;
-    }
+    rig.set_surface(id, surface.grid)?;
+    rig.set_object_shell(id, surface.shell)?;
     let started = Instant::now();
     let forces: Vec<ForceTorque> = times.iter().map(|&t| rig.tick(t)).collect();
     let elapsed = started.elapsed();
@@ -400,6 +447,8 @@ fn lockstep(
             "lockstep": true,
             "rendering": args.rendering,
             "surface": args.surface,
+            "shell_edge_mm": args.shell_edge_mm,
+            "both_surfaces": args.both_surfaces,
             "ticks": forces.len(),
             "seconds_wall": elapsed.as_secs_f64(),
             "ticks_with_force": in_contact,
