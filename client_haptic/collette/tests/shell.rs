@@ -23,6 +23,30 @@ fn slab() -> (SignedDistanceGrid, Pose) {
     (grid, Pose::from_translation(Vec3::new(0.0, -half.y, 0.0)))
 }
 
+/// A mesh's shell (edges of at most `edge`) and grid (`voxels` along its longest side).
+struct Surfaced {
+    shell: SurfaceShell,
+    grid: SignedDistanceGrid,
+}
+
+fn surfaced(mesh: &TriMesh, edge: f32, voxels: usize) -> Surfaced {
+    Surfaced {
+        shell: SurfaceShell::new(mesh, edge).expect("shell"),
+        grid: SignedDistanceGrid::new(mesh, voxels).expect("grid"),
+    }
+}
+
+/// Both surfaces of `a` at `at` against `b` at `b_at`, within `budget`.
+fn both(
+    (a, at): (&Surfaced, &Pose),
+    (b, b_at): (&Surfaced, &Pose),
+    budget: collette::Budget,
+    ws: &mut QueryWorkspace,
+    set: &mut ContactSet,
+) -> collette::OverlapResult {
+    collette::overlap_surfaces_budgeted(&a.shell, &a.grid, at, &b.shell, &b.grid, b_at, budget, ws, set)
+}
+
 #[test]
 fn a_cube_corner_pressed_into_a_face_measures_the_exact_tetrahedron() {
     let (grid, slab_pose) = slab();
@@ -134,28 +158,17 @@ fn a_shell_outside_the_object_measures_nothing_and_a_budget_stops_it() {
 #[test]
 fn two_surfaces_measure_a_corner_and_a_sphere_through_a_thin_plate_exactly() {
     // A cube's corner into a slab: the tetrahedron, through its centroid, straight up.
-    let (grid, slab_pose) = slab();
-    let slab_shell = SurfaceShell::new(&mesh(box_buffers(Vec3::new(0.05, 0.01, 0.05))), 0.0005).expect("slab shell");
+    let slab_pose = Pose::from_translation(Vec3::new(0.0, -0.01, 0.0));
+    let slab = surfaced(&mesh(box_buffers(Vec3::new(0.05, 0.01, 0.05))), 0.0005, 64);
     let h = 0.01;
-    let cube = mesh(box_buffers(Vec3::splat(h)));
-    let (cube_shell, cube_grid) =
-        (SurfaceShell::new(&cube, 0.001).expect("shell"), SignedDistanceGrid::new(&cube, 128).expect("grid"));
+    let cube = surfaced(&mesh(box_buffers(Vec3::splat(h))), 0.001, 128);
     let down = Quat::from_rotation_arc(Vec3::splat(-1.0).normalize(), -Vec3::Y);
     let (mut ws, mut set) = (QueryWorkspace::new(), ContactSet::new());
     // 0.1 mm: thinner than the cube's grid can draw (the columns'); 3 mm: the boundary's.
     for depth in [1e-4, 3e-3] {
         let corner = Vec3::new(0.004, -depth, -0.007);
         let pose = Pose::new(corner + Vec3::Y * (h * 3f32.sqrt()), Quat::from_rotation_y(0.5) * down);
-        let result = collette::overlap_surfaces(
-            &cube_shell,
-            &cube_grid,
-            &pose,
-            &slab_shell,
-            &grid,
-            &slab_pose,
-            &mut ws,
-            &mut set,
-        );
+        let result = both((&cube, &pose), (&slab, &slab_pose), collette::Budget::Unlimited, &mut ws, &mut set);
         let exact = 3f32.sqrt() / 2.0 * depth.powi(3);
         assert!((result.total_volume / exact - 1.0).abs() < 0.01, "{depth}: {} against {exact}", result.total_volume);
         let c = set.as_slice()[0];
@@ -165,13 +178,9 @@ fn two_surfaces_measure_a_corner_and_a_sphere_through_a_thin_plate_exactly() {
 
     // A 1 cm ball pushed 6 mm through a 4 mm plate: its part inside the plate is a slice between two
     // planes, which the ball's columns (to the nearer face) get wrong, and the boundary does not.
-    let plate = mesh(box_buffers(Vec3::new(0.03, 0.002, 0.03)));
-    let (plate_shell, plate_grid) =
-        (SurfaceShell::new(&plate, 0.001).expect("shell"), SignedDistanceGrid::new(&plate, 128).expect("grid"));
+    let plate = surfaced(&mesh(box_buffers(Vec3::new(0.03, 0.002, 0.03))), 0.001, 128);
     let r = 0.005;
-    let ball = mesh(uv_sphere_buffers(r, 96, 192));
-    let (ball_shell, ball_grid) =
-        (SurfaceShell::new(&ball, 0.0005).expect("shell"), SignedDistanceGrid::new(&ball, 64).expect("grid"));
+    let ball = surfaced(&mesh(uv_sphere_buffers(r, 96, 192)), 0.0005, 64);
     // The ball's centre 1 mm above the plate's middle: its bottom 4 mm under the top face, 2 mm past the
     // bottom face.
     let centre = Vec3::new(0.0, 0.001, 0.0);
@@ -179,18 +188,9 @@ fn two_surfaces_measure_a_corner_and_a_sphere_through_a_thin_plate_exactly() {
     // The slice from 3 mm under the centre to 1 mm over it: the cap under the top face less the cap under the bottom face.
     let slice = cap(r + 0.001) - cap(r - 0.003);
     let at = Pose::from_translation(centre);
-    let result = collette::overlap_surfaces(
-        &ball_shell,
-        &ball_grid,
-        &at,
-        &plate_shell,
-        &plate_grid,
-        &Pose::IDENTITY,
-        &mut ws,
-        &mut set,
-    );
+    let result = both((&ball, &at), (&plate, &Pose::IDENTITY), collette::Budget::Unlimited, &mut ws, &mut set);
     assert!((result.total_volume / slice - 1.0).abs() < 0.01, "{} against {slice}", result.total_volume);
-    let columns = collette::overlap_shell(&ball_shell, &at, &plate_grid, &Pose::IDENTITY, &mut ws, &mut set);
+    let columns = collette::overlap_shell(&ball.shell, &at, &plate.grid, &Pose::IDENTITY, &mut ws, &mut set);
     assert!((columns.total_volume / slice - 1.0).abs() > 0.05, "the columns miss it: {}", columns.total_volume);
 }
 
@@ -242,39 +242,17 @@ fn a_ball_pressed_beside_a_blocks_edge_is_pushed_the_way_out() {
 
 #[test]
 fn two_surfaces_cut_short_by_their_budget_answer_with_the_columns() {
-    let plate = mesh(box_buffers(Vec3::new(0.03, 0.002, 0.03)));
-    let (plate_shell, plate_grid) =
-        (SurfaceShell::new(&plate, 0.001).expect("shell"), SignedDistanceGrid::new(&plate, 128).expect("grid"));
-    let ball = mesh(uv_sphere_buffers(0.005, 48, 96));
-    let (ball_shell, ball_grid) =
-        (SurfaceShell::new(&ball, 0.0005).expect("shell"), SignedDistanceGrid::new(&ball, 64).expect("grid"));
+    let plate = surfaced(&mesh(box_buffers(Vec3::new(0.03, 0.002, 0.03))), 0.001, 128);
+    let ball = surfaced(&mesh(uv_sphere_buffers(0.005, 48, 96)), 0.0005, 64);
     let at = Pose::from_translation(Vec3::new(0.0, 0.004, 0.0));
     let (mut ws, mut set) = (QueryWorkspace::new(), ContactSet::new());
-    let columns = collette::overlap_shell(&ball_shell, &at, &plate_grid, &Pose::IDENTITY, &mut ws, &mut set);
+    let columns = collette::overlap_shell(&ball.shell, &at, &plate.grid, &Pose::IDENTITY, &mut ws, &mut set);
     let column_contacts = set.as_slice().to_vec();
-    let whole = collette::overlap_surfaces(
-        &ball_shell,
-        &ball_grid,
-        &at,
-        &plate_shell,
-        &plate_grid,
-        &Pose::IDENTITY,
-        &mut ws,
-        &mut set,
-    );
+    let whole = both((&ball, &at), (&plate, &Pose::IDENTITY), collette::Budget::Unlimited, &mut ws, &mut set);
     assert!(whole.complete && set.len() == 1 && whole.node_pairs > columns.node_pairs + 10, "{whole:?}");
     let mut run = |pairs| {
-        let result = collette::overlap_surfaces_budgeted(
-            &ball_shell,
-            &ball_grid,
-            &at,
-            &plate_shell,
-            &plate_grid,
-            &Pose::IDENTITY,
-            collette::Budget::NodePairs(pairs),
-            &mut ws,
-            &mut set,
-        );
+        let budget = collette::Budget::NodePairs(pairs);
+        let result = both((&ball, &at), (&plate, &Pose::IDENTITY), budget, &mut ws, &mut set);
         (result, set.as_slice().to_vec())
     };
     // Cut short in the boundary: the columns' contacts, whole.
