@@ -61,8 +61,8 @@ impl SphereTree {
 
     /// This tree with its mesh's surfaces, built from `mesh` (the one the tree was packed into, in the
     /// same frame): a surface grid of `grid_voxels` along the mesh's longest side (0: none; see
-    /// [`with_surface`](Self::with_surface)) and a shell of edges at most `shell_edge_m` (0: none; see
-    /// [`with_shell`](Self::with_shell)). With both on the tool and on a collider, both surfaces are
+    /// [`with_surface`](Self::with_surface)) and a shell of edges at most `shell_edge_m` (0: none; not a
+    /// positive length: an error; see [`with_shell`](Self::with_shell)). With both on the tool and on a collider, both surfaces are
     /// measured. Takes about a second for the bunny at 128 voxels and 1 mm edges: off the game thread.
     pub fn with_surfaces_of(
         mut self,
@@ -74,7 +74,7 @@ impl SphereTree {
         if grid_voxels > 0 {
             self = self.with_surface(SignedDistanceGrid::new(mesh, grid_voxels).map_err(failed)?);
         }
-        if shell_edge_m > 0.0 {
+        if shell_edge_m != 0.0 {
             self = self.with_shell(SurfaceShell::new(mesh, shell_edge_m).map_err(failed)?);
         }
         Ok(self)

@@ -150,8 +150,7 @@ impl Scene {
         if self.pairs.len() >= MAX_PAIR_WATCHERS {
             return Err(RigError::TooManyPairs(MAX_PAIR_WATCHERS));
         }
-        let object = |id| self.entries.iter().find(|e| e.id == id).map(|e| e.object).ok_or(RigError::UnknownObject(id));
-        let (oa, ob) = (object(a)?, object(b)?);
+        let (oa, ob) = (self.object_of(a)?, self.object_of(b)?);
         let reader = self.collision.add_summary_watcher(oa, ob).ok_or(RigError::QueueFull("collision"))?;
         self.pairs.push(PairEntry { a, b, watcher: reader.id(), reader });
         Ok(())
@@ -287,15 +286,15 @@ impl Scene {
         surface: Option<std::sync::Arc<collette::SignedDistanceGrid>>,
     ) -> Result<()> {
         self.free_returned();
-        let entry = self.entries.iter().find(|e| e.id == id).ok_or(RigError::UnknownObject(id))?;
+        let object = self.object_of(id)?;
         if self.forces.slots() == 0 {
             return Err(RigError::QueueFull("haptic"));
         }
-        if !self.collision.set_surface(entry.object, surface.clone()) {
+        if !self.collision.set_surface(object, surface.clone()) {
             return Err(RigError::QueueFull("collision"));
         }
         // The 3-DOF proxy holds the tip on the grid (on the haptic thread).
-        let command = ForceCommand::Surface { slot: entry.object.0, grid: surface };
+        let command = ForceCommand::Surface { slot: object.0, grid: surface };
         self.forces.push(command).map_err(|_| RigError::QueueFull("haptic"))
     }
 
@@ -306,8 +305,13 @@ impl Scene {
         shell: Option<std::sync::Arc<collette::SurfaceShell>>,
     ) -> Result<()> {
         self.free_returned();
-        let entry = self.entries.iter().find(|e| e.id == id).ok_or(RigError::UnknownObject(id))?;
-        if self.collision.set_shell(entry.object, shell) { Ok(()) } else { Err(RigError::QueueFull("collision")) }
+        let object = self.object_of(id)?;
+        if self.collision.set_shell(object, shell) { Ok(()) } else { Err(RigError::QueueFull("collision")) }
+    }
+
+    /// The collision pipeline's slot of watched object `id`.
+    fn object_of(&self, id: u32) -> Result<ObjectId> {
+        self.entries.iter().find(|e| e.id == id).map(|e| e.object).ok_or(RigError::UnknownObject(id))
     }
 
     /// Only checks objects whose bounds touch `region` (`None`: everywhere).

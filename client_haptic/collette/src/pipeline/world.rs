@@ -678,15 +678,13 @@ fn set_part<T>(
 /// query short.
 fn measure(a: &ObjectSlot, b: &ObjectSlot, budget: Budget, ws: &mut QueryWorkspace, set: &mut ContactSet) -> bool {
     let (pa, pb) = (&a.now.pose, &b.now.pose);
-    let result = match (b.surface.as_deref(), a.shell.as_deref()) {
-        (Some(grid), Some(shell)) => match (a.surface.as_deref(), b.shell.as_deref()) {
-            (Some(a_grid), Some(b_shell)) => {
-                overlap_surfaces_budgeted(shell, a_grid, pa, b_shell, grid, pb, budget, ws, set)
-            }
-            _ => overlap_shell_budgeted(shell, pa, grid, pb, budget, ws, set),
-        },
-        (Some(grid), None) => overlap_field_budgeted(&a.tree, pa, &b.tree, grid, pb, budget, ws, set),
-        (None, _) => overlap_budgeted(&a.tree, pa, &b.tree, pb, budget, ws, set),
+    let result = match (b.surface.as_deref(), a.shell.as_deref(), a.surface.as_deref(), b.shell.as_deref()) {
+        (Some(grid), Some(shell), Some(a_grid), Some(b_shell)) => {
+            overlap_surfaces_budgeted(shell, a_grid, pa, b_shell, grid, pb, budget, ws, set)
+        }
+        (Some(grid), Some(shell), ..) => overlap_shell_budgeted(shell, pa, grid, pb, budget, ws, set),
+        (Some(grid), None, ..) => overlap_field_budgeted(&a.tree, pa, &b.tree, grid, pb, budget, ws, set),
+        (None, ..) => overlap_budgeted(&a.tree, pa, &b.tree, pb, budget, ws, set),
     };
     result.complete
 }

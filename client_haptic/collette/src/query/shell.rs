@@ -73,8 +73,7 @@ pub fn overlap_shell_budgeted(
     let group_radius = GROUP_EDGES * shell.max_edge();
     let (mut group, mut group_floor) = (Group::default(), None);
     let mut emit = |group: &mut Group, result: &mut OverlapResult, push: &mut Vec3, surface: &mut Surface| {
-        surface.area += group.surface.area;
-        surface.way_out += group.surface.way_out;
+        surface.merge(&group.surface);
         if let Some(contact) = group.contact() {
             result.total_volume += group.volume;
             let world = Contact {
@@ -121,7 +120,6 @@ pub fn overlap_shell_budgeted(
     // thinner than the tool is deep a column runs to B's far face and points the push through it) and
     // its magnitude the overlap's volume: on a flat face it is already (every column's normal is the
     // face's); on a curved one the columns' normals spread, and the push is scaled back up.
-    let turn = surface.way_out(pose_b).map(|way| glam::Quat::from_rotation_arc(push.normalize_or_zero(), way));
     let magnitude = push.length();
     // Past the middle of a thin part a column measures to the far face and its signed volume falls (to
     // nothing or below), while its push (−g·(g·n)·φ, the same whichever face g comes from) holds up:
@@ -129,6 +127,7 @@ pub fn overlap_shell_budgeted(
     result.total_volume = result.total_volume.max(magnitude);
     if result.total_volume > 0.0 && magnitude > 0.0 {
         let scale = result.total_volume / magnitude;
+        let turn = surface.way_out(pose_b).map(|way| glam::Quat::from_rotation_arc(push / magnitude, way));
         for contact in out.as_mut_slice() {
             contact.volume *= scale;
             if let Some(turn) = turn {
@@ -334,13 +333,19 @@ impl Surface {
         self.way_out -= n * area;
     }
 
+    /// Adds another part of the surface inside B.
+    fn merge(&mut self, other: &Surface) {
+        self.area += other.area;
+        self.way_out += other.way_out;
+    }
+
     /// The way out in the world's frame, unless the tool is nearly sunk whole (its surface inside B
     /// almost closed: no way out stands out, and the columns' push is kept).
     fn way_out(&self, pose_b: &Pose) -> Option<Vec3> {
         (self.way_out.length() > Self::OPEN * self.area).then(|| pose_b.transform_vector(self.way_out).normalize())
     }
 
-    /// The least `|∫ n dA|` per unit of area for the way out to count (a ball sunk to 1.8 of its
+    /// The least `|∫ n dA|` per unit of area for the way out to count (a ball sunk to 0.9 of its
     /// diameter: 0.1).
     const OPEN: f32 = 0.1;
 }
