@@ -410,7 +410,7 @@ fn load_plays_bot_pairs_in_sessions_of_their_own_and_ends_with_one_json_line_of_
         (Some(3), Some(6), Some(120))
     );
     let number = |k: &str| last[k].as_f64().unwrap_or_else(|| panic!("{k} in {last}"));
-    for k in ["session_tick_us_median", "session_tick_us_p99", "tick_ms_p99"] {
+    for k in ["session_tick_us_median", "session_tick_us_p99", "tick_ms_p99", "bots_tick_ms_median"] {
         assert!(number(k) > 0.0, "{k}: {last}");
     }
     assert!(number("session_tick_us_median") <= number("session_tick_us_p99"), "{last}");
@@ -419,6 +419,7 @@ fn load_plays_bot_pairs_in_sessions_of_their_own_and_ends_with_one_json_line_of_
         assert!((500.0..100_000.0).contains(&number(k)), "{k}: {last}");
     }
     assert!(text.contains("server CPU per session-tick"), "{text}");
+    assert!(text.contains("the bots between two server ticks"), "{text}");
 }
 
 /// `GET path` on `addr` (HTTP/1.1, one request); the status code and the body.

@@ -115,6 +115,9 @@ pub struct LoadReport {
     pub tick_ms_p99: f64,
     /// Wall time of a whole server tick (every shard's update), ms, 99th percentile.
     pub tick_wall_ms_p99: f64,
+    /// CPU time of stepping every bot client once between two server ticks, ms, median: the load
+    /// generator's own cost, which shares the server's core and last-level cache in this process.
+    pub bots_tick_ms_median: f64,
     /// Bytes a second each client sent the server (UDP payloads), averaged over the clients.
     pub client_bytes_per_s_up: f64,
     /// Bytes a second the server sent each client.
@@ -162,6 +165,7 @@ impl std::fmt::Display for LoadReport {
             "server tick: CPU median {:.3} ms, p99 {:.3} ms; wall p99 {:.3} ms",
             self.tick_ms_median, self.tick_ms_p99, self.tick_wall_ms_p99
         )?;
+        writeln!(f, "the bots between two server ticks: CPU median {:.3} ms", self.bots_tick_ms_median)?;
         writeln!(
             f,
             "per client: up {:.0} B/s in {:.0} datagrams/s, down {:.0} B/s in {:.0} datagrams/s",
@@ -349,6 +353,7 @@ pub fn run_load(options: &LoadOptions, mut progress: impl FnMut(&str)) -> anyhow
     let mut resident = vec![(0.0, resident_mb())];
     let mut server_heap: Vec<(f64, f64)> = heap_mb().map(|mb| (0.0, mb)).into_iter().collect();
     let (mut tick_us, mut wall_us) = (Vec::with_capacity(ticks as usize), Vec::with_capacity(ticks as usize));
+    let mut bots_us = Vec::with_capacity(ticks as usize);
     let mut churn = options.churn.map(|s| churn::Churn {
         period: ((f64::from(s) * TICK_HZ).round() as u64).max(1),
         endpoint,
@@ -362,7 +367,9 @@ pub fn run_load(options: &LoadOptions, mut progress: impl FnMut(&str)) -> anyhow
         let (cpu, wall) = tick(&mut server, options.heap);
         tick_us.push(cpu.as_secs_f64() * 1e6);
         wall_us.push(wall.as_secs_f64() * 1e6);
+        let bots = thread_cpu();
         update_all(&mut pairs);
+        bots_us.push((thread_cpu() - bots).as_secs_f64() * 1e6);
         if n.is_multiple_of(TICK_HZ as u64) {
             rounds.count(&mut server);
         }
@@ -398,6 +405,7 @@ pub fn run_load(options: &LoadOptions, mut progress: impl FnMut(&str)) -> anyhow
         tick_ms_median: quantile(&mut tick_us, 0.5) / 1000.0,
         tick_ms_p99: quantile(&mut tick_us, 0.99) / 1000.0,
         tick_wall_ms_p99: quantile(&mut wall_us, 0.99) / 1000.0,
+        bots_tick_ms_median: quantile(&mut bots_us, 0.5) / 1000.0,
         client_bytes_per_s_up: (after.received - before.received) as f64 / per_client,
         client_bytes_per_s_down: (after.sent - before.sent) as f64 / per_client,
         client_datagrams_per_s_up: (after.datagrams_received - before.datagrams_received) as f64 / per_client,
