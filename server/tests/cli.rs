@@ -475,9 +475,17 @@ fn health_and_metrics_scraped_while_load_runs_count_its_sessions_players_ticks_a
     assert_eq!(value(&first, "heist_draining"), 0.0);
     std::thread::sleep(Duration::from_millis(500));
     let (_, second) = http_get(&addr, "/metrics");
-    for name in ["heist_tick_seconds_count", "heist_received_bytes_total", "heist_sent_bytes_total"] {
+    for name in [
+        "heist_tick_seconds_count",
+        "heist_tick_cpu_seconds_total",
+        "heist_received_bytes_total",
+        "heist_sent_bytes_total",
+    ] {
         assert!(value(&second, name) > value(&first, name), "{name} grows while the load plays: {second}");
     }
+    // The updates' CPU time is at most their wall time (one thread runs them all).
+    let cpu = value(&second, "heist_tick_cpu_seconds_total");
+    assert!(cpu <= value(&second, "heist_tick_seconds_sum") * 1.05 + 0.01, "{second}");
     assert_eq!(http_get(&addr, "/nothing").0, 404);
 
     assert!(wait_for(&mut load, Duration::from_secs(120)).is_some_and(|s| s.success()), "the load ends");

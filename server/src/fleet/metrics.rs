@@ -5,6 +5,7 @@
 //! refusals and resumes. Nothing is collected on a scrape but the encoding.
 
 use std::sync::Arc;
+use std::sync::atomic::AtomicU64;
 
 use bevy::prelude::Resource;
 use prometheus_client::encoding::EncodeLabelSet;
@@ -44,6 +45,9 @@ pub struct Metrics {
     pub resumes: Counter,
     /// Seconds one update of the game loop took (every session's tick, the network in and out).
     pub tick_seconds: Histogram,
+    /// CPU seconds the game loop's updates took (the thread's CPU clock, every shard's update): divided by
+    /// the ticks (60 a second) and the sessions open, a session's cost per tick.
+    pub tick_cpu_seconds: Counter<f64, AtomicU64>,
     /// UDP payload bytes read from the game socket.
     pub bytes_received: Counter,
     /// UDP payload bytes sent on it.
@@ -75,6 +79,7 @@ impl Metrics {
             resumes: Counter::default(),
             // 0.25 ms to ~0.5 s: a tick is budgeted 16.7 ms.
             tick_seconds: Histogram::new(exponential_buckets(0.000_25, 2.0, 12)),
+            tick_cpu_seconds: Counter::default(),
             bytes_received: Counter::default(),
             bytes_sent: Counter::default(),
             refused: Family::default(),
@@ -88,6 +93,11 @@ impl Metrics {
         registry.register("seats_kept", "Seats kept for players whose connection dropped", m.seats_kept.clone());
         registry.register("resumes", "Seats taken back by players whose connection dropped", m.resumes.clone());
         registry.register("tick_seconds", "Time of one update of the game loop", m.tick_seconds.clone());
+        registry.register(
+            "tick_cpu_seconds",
+            "CPU time of the game loop's updates (the loop thread's clock)",
+            m.tick_cpu_seconds.clone(),
+        );
         registry.register("received_bytes", "UDP payload bytes read from the game socket", m.bytes_received.clone());
         registry.register("sent_bytes", "UDP payload bytes sent on the game socket", m.bytes_sent.clone());
         registry.register("refused", "Refused requests, by stage and reason", m.refused.clone());
@@ -131,12 +141,14 @@ mod tests {
         m.refuse("join", "wrong_code");
         m.refuse("message", "too_fast");
         m.tick_seconds.observe(0.002);
+        m.tick_cpu_seconds.inc_by(0.0015);
         let text = m.encode();
         assert_eq!(sample(&text, "heist_sessions"), Some(3.0), "{text}");
         assert_eq!(sample(&text, "heist_sessions_created_total"), Some(4.0), "{text}");
         assert_eq!(sample(&text, r#"heist_refused_total{stage="join",reason="wrong_code"}"#), Some(2.0), "{text}");
         assert_eq!(sample(&text, r#"heist_refused_total{stage="message",reason="too_fast"}"#), Some(1.0), "{text}");
         assert_eq!(sample(&text, "heist_tick_seconds_count"), Some(1.0), "{text}");
+        assert_eq!(sample(&text, "heist_tick_cpu_seconds_total"), Some(0.0015), "{text}");
         for name in ["heist_players", "heist_resumes_total", "heist_received_bytes_total", "heist_draining"] {
             assert!(sample(&text, name).is_some(), "{name} in {text}");
         }

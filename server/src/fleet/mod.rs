@@ -29,6 +29,7 @@ pub use drain::{DEFAULT_DRAIN_LIMIT, Drain};
 pub use health::{Heartbeat, STALL_AFTER};
 pub use metrics::Metrics;
 pub use plugin::FleetPlugin;
+pub(crate) use plugin::thread_cpu;
 #[cfg(feature = "fleet")]
 pub use services::{FleetOptions, FleetServices};
 

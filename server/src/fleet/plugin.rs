@@ -1,7 +1,7 @@
 //! What the game loop does for the fleet each update: stamps the heartbeat, times the update, keeps the
 //! gauges and counters, carries out a drain ([`super::drain`]), and exits when a helper thread failed.
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use bevy::prelude::*;
 
@@ -23,17 +23,32 @@ impl Plugin for FleetPlugin {
     }
 }
 
+/// When the update began: the wall clock and the thread's CPU clock.
 #[derive(Resource)]
-struct UpdateStart(Instant);
+struct UpdateStart {
+    wall: Instant,
+    cpu: Duration,
+}
 
 impl Default for UpdateStart {
     fn default() -> Self {
-        Self(Instant::now())
+        Self { wall: Instant::now(), cpu: thread_cpu() }
     }
 }
 
 fn start_update(mut start: ResMut<UpdateStart>) {
-    start.0 = Instant::now();
+    *start = UpdateStart::default();
+}
+
+/// CPU time of the calling thread (zero if the clock cannot be read).
+pub(crate) fn thread_cpu() -> Duration {
+    let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+    // SAFETY: `ts` is a valid, writable timespec; CLOCK_THREAD_CPUTIME_ID needs nothing else.
+    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    if rc != 0 {
+        return Duration::ZERO;
+    }
+    Duration::new(ts.tv_sec as u64, ts.tv_nsec as u32)
 }
 
 fn exit_on_failure(fleet: Res<Fleet>, mut exit: MessageWriter<AppExit>) {
@@ -56,7 +71,8 @@ fn end_update(
     mut seated: Local<(i64, i64)>,
 ) {
     let m = &fleet.metrics;
-    m.tick_seconds.observe(start.0.elapsed().as_secs_f64());
+    m.tick_seconds.observe(start.wall.elapsed().as_secs_f64());
+    m.tick_cpu_seconds.inc_by(thread_cpu().saturating_sub(start.cpu).as_secs_f64());
     fleet.heartbeat.beat();
     m.sessions.set(settings.registry.len() as i64);
     m.sessions_created.inc_by(added.iter().count() as u64);

@@ -16,6 +16,7 @@ use heist_shared::protocol::TICK_HZ;
 use heist_transport::IntakeLimits;
 use heist_transport::limit::Rate;
 
+use crate::fleet::thread_cpu;
 use crate::net::admission_count;
 use crate::net::registry::CreateLimits;
 use crate::net::transport::GameTransport;
@@ -202,17 +203,6 @@ pub fn load_server_options(sessions: usize) -> ServerOptions {
     options.token_limits.creates = CreateLimits { each: plenty, all: plenty };
     options.intake_limits = IntakeLimits { requests_per_address: plenty, requests_total: plenty, ..Default::default() };
     options
-}
-
-/// CPU time of the calling thread.
-fn thread_cpu() -> Duration {
-    let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
-    // SAFETY: `ts` is a valid, writable timespec; CLOCK_THREAD_CPUTIME_ID needs nothing else.
-    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
-    if rc != 0 {
-        return Duration::ZERO;
-    }
-    Duration::new(ts.tv_sec as u64, ts.tv_nsec as u32)
 }
 
 /// The `q` quantile (0..=1) of `values`, sorted in place.
