@@ -13,6 +13,7 @@ pub mod game;
 pub mod load;
 pub mod net;
 pub mod session;
+mod tick_grid;
 
 use std::net::SocketAddr;
 use std::time::Duration;
@@ -37,7 +38,7 @@ use session::{HostSession, LogEcho, Session, SessionPlugin};
 /// How the server's clock advances.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Clock {
-    /// Wall-clock time; the app runs its own loop (`App::run`).
+    /// Wall-clock time: [`HostedServer::run`] updates every shard once a tick, on the wall clock.
     RealTime,
     /// Each `app.update()` advances exactly one tick (tests, the demo).
     Stepped,
@@ -203,23 +204,26 @@ impl HostedServer {
         exits.map(|exits| exits.into_iter().find(AppExit::is_error).unwrap_or(AppExit::Success))
     }
 
-    /// Runs the game loop in real time until every shard has exited (a drain, a failure), ticking each
-    /// shard in turn twice a game tick (as Bevy's schedule runner would one app); a shard that has exited
-    /// is no longer updated.
+    /// Runs the game loop in real time until every shard has exited (a drain, a failure): each shard
+    /// updates once a game tick, in turn, on a grid of deadlines 1/60 s apart, and its clock reads the
+    /// deadline, so each update runs exactly one fixed step; a loop that falls behind updates at the
+    /// latest deadline past, and the fixed schedule runs every step it missed. A shard that has exited is
+    /// no longer updated.
     pub fn run(&mut self) -> AppExit {
-        let period = Duration::from_secs_f64(0.5 / TICK_HZ);
+        let mut grid = tick_grid::TickGrid::new(std::time::Instant::now(), TICK_HZ);
         loop {
-            let start = std::time::Instant::now();
+            let deadline = grid.next(std::time::Instant::now());
+            if let Some(rest) = deadline.checked_duration_since(std::time::Instant::now()) {
+                std::thread::sleep(rest);
+            }
             for shard in &mut self.shards {
                 if shard.app.should_exit().is_none() {
+                    shard.app.insert_resource(TimeUpdateStrategy::ManualInstant(deadline));
                     shard.app.update();
                 }
             }
             if let Some(exit) = self.should_exit() {
                 return exit;
-            }
-            if let Some(rest) = period.checked_sub(start.elapsed()) {
-                std::thread::sleep(rest);
             }
         }
     }
