@@ -43,10 +43,10 @@ pub struct Metrics {
     pub seats_kept: Gauge,
     /// Seats taken back by players who dropped.
     pub resumes: Counter,
-    /// Seconds one update of the game loop took (every session's tick, the network in and out).
+    /// Seconds one shard's update in the game loop took (its sessions' tick, the network in and out).
     pub tick_seconds: Histogram,
-    /// CPU seconds the game loop's updates took (the thread's CPU clock, every shard's update): divided by
-    /// the ticks (60 a second) and the sessions open, a session's cost per tick.
+    /// CPU seconds the game loop's updates took (the loop thread's CPU clock, every shard's update): its
+    /// rate divided by the ticks (60 a second) and the sessions open is a session's cost per tick.
     pub tick_cpu_seconds: Counter<f64, AtomicU64>,
     /// UDP payload bytes read from the game socket.
     pub bytes_received: Counter,
@@ -92,7 +92,7 @@ impl Metrics {
         registry.register("players", "Players connected and admitted now", m.players.clone());
         registry.register("seats_kept", "Seats kept for players whose connection dropped", m.seats_kept.clone());
         registry.register("resumes", "Seats taken back by players whose connection dropped", m.resumes.clone());
-        registry.register("tick_seconds", "Time of one update of the game loop", m.tick_seconds.clone());
+        registry.register("tick_seconds", "Time of one shard's update in the game loop", m.tick_seconds.clone());
         registry.register(
             "tick_cpu_seconds",
             "CPU time of the game loop's updates (the loop thread's clock)",

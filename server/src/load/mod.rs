@@ -236,7 +236,7 @@ fn tick(server: &mut HostedServer, heap: Option<HeapProbe>) -> (Duration, Durati
     if let Some(h) = heap {
         (h.flag)(false);
     }
-    (thread_cpu() - cpu, wall.elapsed())
+    (thread_cpu().saturating_sub(cpu), wall.elapsed())
 }
 
 /// Rounds begun after a session's first, counted by looking at every session's round once a second of
@@ -359,7 +359,7 @@ pub fn run_load(options: &LoadOptions, mut progress: impl FnMut(&str)) -> anyhow
         wall_us.push(wall.as_secs_f64() * 1e6);
         let bots = thread_cpu();
         update_all(&mut pairs);
-        bots_us.push((thread_cpu() - bots).as_secs_f64() * 1e6);
+        bots_us.push(thread_cpu().saturating_sub(bots).as_secs_f64() * 1e6);
         if n.is_multiple_of(TICK_HZ as u64) {
             rounds.count(&mut server);
         }
