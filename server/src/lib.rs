@@ -210,7 +210,9 @@ impl HostedServer {
     /// latest deadline past, and the fixed schedule runs every step it missed. A shard that has exited is
     /// no longer updated.
     pub fn run(&mut self) -> AppExit {
-        let mut grid = tick_grid::TickGrid::new(std::time::Instant::now(), TICK_HZ);
+        // Every shard steps at the same fixed rate (`shard_app`): the grid is that step.
+        let step = self.shards[0].app.world().resource::<Time<Fixed>>().timestep();
+        let mut grid = tick_grid::TickGrid::new(std::time::Instant::now(), step);
         loop {
             let deadline = grid.next(std::time::Instant::now());
             if let Some(rest) = deadline.checked_duration_since(std::time::Instant::now()) {

@@ -7,16 +7,16 @@ use std::time::{Duration, Instant};
 #[derive(Debug)]
 pub(crate) struct TickGrid {
     start: Instant,
-    /// One fixed step, in nanoseconds (the same rounding as `Time::<Fixed>::from_hz`).
+    /// One fixed step, in nanoseconds.
     period_ns: u64,
     tick: u64,
 }
 
 impl TickGrid {
-    /// A grid from `start`, one deadline every `1 / hz` seconds.
-    pub(crate) fn new(start: Instant, hz: f64) -> Self {
-        let period_ns = Duration::from_secs_f64(1.0 / hz).as_nanos().max(1) as u64;
-        Self { start, period_ns, tick: 0 }
+    /// A grid from `start`, one deadline every `period`: the shards' fixed step (`Time::<Fixed>::timestep`),
+    /// to the nanosecond, or their updates would drift across its boundaries.
+    pub(crate) fn new(start: Instant, period: Duration) -> Self {
+        Self { start, period_ns: period.as_nanos().clamp(1, u128::from(u64::MAX)) as u64, tick: 0 }
     }
 
     /// The next deadline: the next tick's, or, when the loop has fallen behind `now`, the latest deadline
@@ -41,8 +41,8 @@ mod tests {
     #[test]
     fn deadlines_follow_the_grid_and_a_late_loop_jumps_to_the_latest_past() {
         let start = Instant::now();
-        let mut grid = TickGrid::new(start, 60.0);
         let period = Duration::from_nanos(16_666_667);
+        let mut grid = TickGrid::new(start, period);
         assert_eq!(grid.next(start), start + period);
         assert_eq!(grid.next(start + period / 2), start + period * 2, "early: the next tick");
         assert_eq!(grid.next(start + period * 7 + period / 2), start + period * 7, "late: the latest one past");
@@ -59,8 +59,8 @@ mod tests {
             .init_resource::<Steps>()
             .add_systems(FixedUpdate, |mut steps: ResMut<Steps>| steps.0 += 1);
         let start = Instant::now();
-        let mut grid = TickGrid::new(start, 60.0);
-        let period = Duration::from_secs_f64(1.0 / 60.0);
+        let period = app.world().resource::<Time<Fixed>>().timestep();
+        let mut grid = TickGrid::new(start, period);
         let mut update = |app: &mut App, now: Instant| {
             let deadline = grid.next(now);
             app.insert_resource(TimeUpdateStrategy::ManualInstant(deadline));
